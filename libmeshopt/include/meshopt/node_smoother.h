@@ -1,0 +1,69 @@
+#pragma once
+// Simultaneous untangling and smoothing of a planar mesh, node by node
+// (Brovka 2013 Sect. 4; Gargallo-Peiro Algorithm 2 in the plane): Gauss-Seidel
+// sweeps over the free nodes; per node, delta from the submesh (Appendix B),
+// Newton steps with Armijo backtracking and a safe gradient fallback.
+//
+// The problem is given as free nodes with their local triangles; the library
+// knows nothing about where they come from (T-meshes, triangle meshes, ...).
+#include <Eigen/Core>
+#include <cstddef>
+#include <functional>
+#include <span>
+#include <vector>
+
+#include "meshopt/local_objective.h"
+
+namespace meshopt {
+
+/// Free nodes and their local submeshes in compressed form:
+/// node k = nodes[k] moves; its triangles are triangles[offsets[k] .. offsets[k+1]).
+struct SmoothingProblem {
+  std::vector<int> nodes;
+  std::vector<std::size_t> offsets{0};
+  std::vector<LocalTriangle> triangles;
+
+  /// Appends a free node with its triangles.
+  void add_node(int node, std::span<const LocalTriangle> node_triangles);
+  std::size_t size() const { return nodes.size(); }
+  std::span<const LocalTriangle> triangles_of(std::size_t k) const;
+};
+
+struct SmoothingOptions {
+  int max_sweeps = 200;
+  /// Stop when max over nodes of |move| / (local length) < tolerance in one sweep,
+  /// where local length is the mean distance to the submesh's other nodes.
+  double relative_displacement_tolerance = 1e-4;
+  /// Newton iterations per node per visit.
+  int newton_iterations_per_visit = 4;
+  /// alpha of the delta rule (Gargallo-Peiro Eq. 37), in [1e-6, 1e-3].
+  double alpha = 1e-3;
+  /// Armijo sufficient-decrease constant and maximum number of halvings.
+  double armijo_c = 1e-4;
+  int max_backtracks = 40;
+  /// Called after each sweep (may be empty): sweep index, max relative move, tangled nodes.
+  std::function<void(int, double, std::size_t)> progress;
+};
+
+struct SmoothingReport {
+  int sweeps = 0;
+  bool converged = false;
+  double last_max_relative_move = 0.0;
+  std::size_t tangled_nodes_before = 0;  ///< free nodes whose submesh has some sigma <= 0
+  std::size_t tangled_nodes_after = 0;
+  std::size_t newton_steps = 0;
+  std::size_t gradient_fallbacks = 0;
+};
+
+/// Moves positions[problem.nodes[k]] in place. Nodes not listed are fixed.
+/// \throw std::invalid_argument for indices out of range or bad options.
+SmoothingReport smooth(std::vector<Eigen::Vector2d>& positions, const SmoothingProblem& problem,
+                       const SmoothingOptions& options = {});
+
+/// Optimizes a single free node (used by smooth(); exposed for tests and for
+/// callers with their own sweep logic). Returns the new position.
+Eigen::Vector2d optimize_node(const Eigen::Vector2d& start, std::span<const Eigen::Vector2d> positions,
+                              std::span<const LocalTriangle> triangles, const SmoothingOptions& options,
+                              std::size_t* newton_steps = nullptr, std::size_t* gradient_fallbacks = nullptr);
+
+}  // namespace meshopt
