@@ -1,0 +1,63 @@
+#pragma once
+// The front half of the parameterization pipeline (Brovka 2013 Sects. 3-4):
+// validated polygon -> corners -> chord-length boundary map -> adapted balanced
+// T-mesh -> Coons start -> weighted K* untangling and smoothing.
+#include <Eigen/Core>
+#include <array>
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "meshopt/node_smoother.h"
+#include "tspline/boundary_map.h"
+#include "tspline/boundary_refinement.h"
+#include "tspline/mesh_quality.h"
+#include "tspline/polygon.h"
+#include "tspline/tmesh.h"
+
+namespace tspline {
+
+struct ParameterizationOptions {
+  /// Corner vertex indices in the file's own numbering; automatic if empty.
+  std::optional<std::array<long long, 4>> corners;
+  /// Boundary tolerance epsilon (an AREA, Sect. 3). If unset, epsilon =
+  /// tolerance_relative * (bounding-box diagonal)^2.
+  std::optional<double> tolerance_absolute;
+  double tolerance_relative = 1e-5;
+  /// Initial uniform level: 2^L x 2^L cells before boundary refinement.
+  int initial_level = 3;
+  /// No cell is refined beyond this level.
+  int max_level = 22;
+  /// Node optimization settings (libmeshopt).
+  meshopt::SmoothingOptions smoothing;
+  /// Progress lines (stage names, counts); may be empty.
+  std::function<void(const std::string&)> log;
+};
+
+struct StageTime {
+  std::string stage;
+  double seconds = 0.0;
+};
+
+/// Everything the front half produces, for writers and reports.
+struct FrontResult {
+  explicit FrontResult(BoundaryMap b) : boundary(std::move(b)) {}
+  BoundaryMap boundary;
+  TMesh mesh = TMesh(0);
+  double tolerance_area = 0.0;
+  bool tolerance_is_relative = true;
+  BoundaryRefinementReport refinement;
+  std::vector<Eigen::Vector2d> coons;      ///< physical vertex positions after the Coons start
+  std::vector<Eigen::Vector2d> optimized;  ///< after untangling and smoothing
+  MeshQualityStats quality_coons;
+  MeshQualityStats quality_optimized;
+  meshopt::SmoothingReport smoothing;
+  std::vector<StageTime> times;
+};
+
+/// Runs the front half on a polygon as read from a file (not yet validated).
+/// \throw InputError for invalid polygons, corners or options.
+FrontResult run_front(const Polygon& polygon, const ParameterizationOptions& options);
+
+}  // namespace tspline

@@ -1,0 +1,28 @@
+#pragma once
+// Output files of the front half (`tspline param`): ParaView meshes and the report.
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "tspline/parameterization.h"
+#include "tspline/io/vtu_writer.h"
+
+namespace tspline::io {
+
+/// The T-mesh as VTK polygons (each cell includes its hanging vertices) at the
+/// given vertex positions, with cell data level, valid, min_quality and point
+/// data hanging, boundary, and the parametric coordinates.
+VtuMesh tmesh_vtu(const TMesh& mesh, const std::vector<Eigen::Vector2d>& positions);
+
+/// The polygon as line cells plus one vertex cell per corner; point data
+/// file_index and corner (0..3 for the corners, -1 elsewhere), cell data side.
+VtuMesh boundary_vtu(const BoundaryMap& boundary);
+
+/// The JSON report: counts, tolerance, corners, inverted cells after Coons and
+/// after optimization, quality statistics, sweeps and per-stage wall times.
+nlohmann::json front_report(const FrontResult& result, const std::string& input_path);
+
+/// Writes parametric_tmesh.vtu, physical_tmesh.vtu, boundary.vtu and
+/// report.json (each atomically) into out_dir.
+void write_front_outputs(const FrontResult& result, const std::string& out_dir, const nlohmann::json& report);
+
+}  // namespace tspline::io
