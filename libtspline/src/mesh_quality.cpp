@@ -15,7 +15,7 @@ std::vector<std::array<int, 3>> cell_triangles(const TMesh& mesh, int c) {
     const IPoint& ph = mesh.vertex_ipos(h);
     for (int i = 0; i < 4; ++i) {
       for (int j = i + 1; j < 4; ++j) {
-        const __int128 o = orient_exact(ph, mesh.vertex_ipos(k[i]), mesh.vertex_ipos(k[j]));
+        const std::int64_t o = orient_exact(ph, mesh.vertex_ipos(k[i]), mesh.vertex_ipos(k[j]));
         if (o > 0) tris.push_back({h, k[i], k[j]});
         if (o < 0) tris.push_back({h, k[j], k[i]});
       }

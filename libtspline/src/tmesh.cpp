@@ -212,12 +212,12 @@ std::string TMesh::check_invariants() const {
   //    units of the finest cell), and leaves are disjoint because they are the
   //    leaves of a quadtree (each point descends to exactly one leaf).
   const int lmax = max_level();
-  unsigned __int128 area = 0;
+  std::uint64_t area = 0;  // in units of the finest cell: at most 4^30
   for (int n : cell_node_) {
     const int d = lmax - nodes_[n].level;
-    area += static_cast<unsigned __int128>(1) << (2 * d);
+    area += std::uint64_t{1} << (2 * d);
   }
-  if (area != (static_cast<unsigned __int128>(1) << (2 * lmax))) err << "cells do not tile [0,1]^2; ";
+  if (area != (std::uint64_t{1} << (2 * lmax))) err << "cells do not tile [0,1]^2; ";
   // 2. 2:1 balance across edges.
   for (std::size_t c = 0; c < cell_node_.size(); ++c) {
     const QuadNode& q = nodes_[cell_node_[c]];

@@ -21,7 +21,7 @@ void append_cell_triangles(const TMesh& mesh, int v, const std::array<int, 4>& c
   for (int i = 0; i < n; ++i) {
     for (int j = i + 1; j < n; ++j) {
       int a = other[i], b = other[j];
-      const __int128 o = orient_exact(pv, mesh.vertex_ipos(a), mesh.vertex_ipos(b));
+      const std::int64_t o = orient_exact(pv, mesh.vertex_ipos(a), mesh.vertex_ipos(b));
       if (o == 0) continue;  // the T-junction's own edge: flat in the ideal configuration
       if (o < 0) std::swap(a, b);
       meshopt::LocalTriangle t;

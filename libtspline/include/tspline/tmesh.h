@@ -23,9 +23,10 @@ struct IPoint {
   friend bool operator==(const IPoint&, const IPoint&) = default;
 };
 
-/// Twice the signed area of the triangle (a, b, c): exact for coordinates below 2^31.
-inline __int128 orient_exact(const IPoint& a, const IPoint& b, const IPoint& c) {
-  return static_cast<__int128>(b.x - a.x) * (c.y - a.y) - static_cast<__int128>(b.y - a.y) * (c.x - a.x);
+/// Twice the signed area of the triangle (a, b, c), exact: coordinates are at most 2^30,
+/// so each product is below 2^61.
+inline std::int64_t orient_exact(const IPoint& a, const IPoint& b, const IPoint& c) {
+  return static_cast<std::int64_t>(b.x - a.x) * (c.y - a.y) - static_cast<std::int64_t>(b.y - a.y) * (c.x - a.x);
 }
 
 /// A quadtree node; leaves are the T-mesh cells. Children are stored
