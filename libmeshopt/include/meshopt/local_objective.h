@@ -23,6 +23,9 @@ struct ObjectiveValue {
   Eigen::Matrix2d hessian = Eigen::Matrix2d::Zero();
 };
 
+// \pre every triangle's a, b index `positions` (not checked here; smooth() and
+// optimize_node() validate their input).
+
 /// Smallest sigma over the submesh with the free node at x.
 double min_sigma(const Eigen::Vector2d& x, std::span<const Eigen::Vector2d> positions,
                  std::span<const LocalTriangle> triangles);

@@ -36,7 +36,7 @@ struct SmoothingOptions {
   double relative_displacement_tolerance = 1e-4;
   /// Newton iterations per node per visit.
   int newton_iterations_per_visit = 4;
-  /// alpha of the delta rule (Gargallo-Peiro Eq. 37), in [1e-6, 1e-3].
+  /// alpha of the delta rule (Gargallo-Peiro Eq. 37), in [1e-6, 1e-3] (accepted: (0, 1]).
   double alpha = 1e-3;
   /// Armijo sufficient-decrease constant and maximum number of halvings.
   double armijo_c = 1e-4;
@@ -61,7 +61,9 @@ SmoothingReport smooth(std::vector<Eigen::Vector2d>& positions, const SmoothingP
                        const SmoothingOptions& options = {});
 
 /// Optimizes a single free node (used by smooth(); exposed for tests and for
-/// callers with their own sweep logic). Returns the new position.
+/// callers with their own sweep logic). Returns the new position. Counters, if given,
+/// are incremented by the accepted Newton / gradient steps.
+/// \throw std::invalid_argument for bad options or triangle indices out of range.
 Eigen::Vector2d optimize_node(const Eigen::Vector2d& start, std::span<const Eigen::Vector2d> positions,
                               std::span<const LocalTriangle> triangles, const SmoothingOptions& options,
                               std::size_t* newton_steps = nullptr, std::size_t* gradient_fallbacks = nullptr);

@@ -1,0 +1,219 @@
+// Node-by-node untangling and smoothing (Brovka 2013 Sect. 4; Gargallo-Peiro
+// Algorithm 2 in the plane). Per visit: delta from the submesh's smallest sigma
+// (Gargallo-Peiro Appendix B, corrected Eq. 38), then Newton steps with Armijo
+// backtracking; delta is set to 0 as soon as the node's submesh is valid.
+#include "meshopt/node_smoother.h"
+
+#include <algorithm>
+#include <Eigen/LU>  // determinant()
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+#include "meshopt/triangle_measure.h"
+
+namespace meshopt {
+
+void SmoothingProblem::add_node(int node, std::span<const LocalTriangle> node_triangles) {
+  if (offsets.empty()) offsets.push_back(0);
+  nodes.push_back(node);
+  triangles.insert(triangles.end(), node_triangles.begin(), node_triangles.end());
+  offsets.push_back(triangles.size());
+}
+
+std::span<const LocalTriangle> SmoothingProblem::triangles_of(std::size_t k) const {
+  return std::span<const LocalTriangle>(triangles).subspan(offsets[k], offsets[k + 1] - offsets[k]);
+}
+
+namespace {
+
+void validate_options(const SmoothingOptions& o) {
+  auto bad = [](const char* what) { throw std::invalid_argument(std::string("meshopt::smooth: ") + what); };
+  if (o.max_sweeps < 0) bad("max_sweeps must be >= 0");
+  if (!(o.relative_displacement_tolerance >= 0.0) || !std::isfinite(o.relative_displacement_tolerance))
+    bad("relative_displacement_tolerance must be finite and >= 0");
+  if (o.newton_iterations_per_visit < 1) bad("newton_iterations_per_visit must be >= 1");
+  if (!(o.alpha > 0.0 && o.alpha <= 1.0)) bad("alpha must be in (0, 1] (the paper uses [1e-6, 1e-3])");
+  if (!(o.armijo_c > 0.0 && o.armijo_c < 1.0)) bad("armijo_c must be in (0, 1)");
+  if (o.max_backtracks < 0) bad("max_backtracks must be >= 0");
+}
+
+void validate_triangles(std::span<const Eigen::Vector2d> positions, std::span<const LocalTriangle> tris,
+                        long long node) {
+  const auto n = static_cast<long long>(positions.size());
+  for (const LocalTriangle& t : tris) {
+    if (t.a < 0 || t.a >= n || t.b < 0 || t.b >= n)
+      throw std::invalid_argument("meshopt: triangle vertex index out of range");
+    if (t.a == node || t.b == node || t.a == t.b)
+      throw std::invalid_argument("meshopt: local triangle repeats a vertex (or references the free node)");
+    if (!std::isfinite(t.weight) || t.weight < 0.0 || !t.ideal_inv.allFinite())
+      throw std::invalid_argument("meshopt: triangle weight must be finite and >= 0, ideal_inv finite");
+    if (!positions[t.a].allFinite() || !positions[t.b].allFinite())
+      throw std::invalid_argument("meshopt: non-finite node position");
+  }
+}
+
+/// Mean distance from x to the submesh nodes (each triangle's a and b counted once per
+/// triangle; in a closed star or a quad-cell submesh every node appears equally often).
+double local_length(const Eigen::Vector2d& x, std::span<const Eigen::Vector2d> positions,
+                    std::span<const LocalTriangle> tris) {
+  if (tris.empty()) return 0.0;
+  double sum = 0.0;
+  for (const LocalTriangle& t : tris) sum += (positions[t.a] - x).norm() + (positions[t.b] - x).norm();
+  return sum / (2.0 * static_cast<double>(tris.size()));
+}
+
+/// True iff H is symmetric positive definite with eigenvalue ratio above a relative threshold.
+bool is_spd(const Eigen::Matrix2d& H) {
+  const double a = H(0, 0), b = 0.5 * (H(0, 1) + H(1, 0)), d = H(1, 1);
+  const double mean = 0.5 * (a + d);
+  const double rad = std::sqrt(0.25 * (a - d) * (a - d) + b * b);
+  const double lmax = mean + rad, lmin = mean - rad;
+  return std::isfinite(lmax) && lmax > 0.0 && lmin > 1e-12 * lmax;
+}
+
+struct Counters {
+  std::size_t newton = 0;
+  std::size_t gradient = 0;
+};
+
+Eigen::Vector2d optimize_impl(const Eigen::Vector2d& start, std::span<const Eigen::Vector2d> positions,
+                              std::span<const LocalTriangle> tris, const SmoothingOptions& opt, double L,
+                              Counters& cnt) {
+  if (tris.empty() || !(L > 0.0) || !std::isfinite(L) || !start.allFinite()) return start;
+  // sigma* (Gargallo-Peiro Appendix B); the typical |sigma| is only needed when sigma* == 0.
+  const double sigma_star = min_sigma(start, positions, tris);
+  if (std::isnan(sigma_star)) return start;
+  double abs_mean = 0.0;
+  if (sigma_star == 0.0) {
+    for (const LocalTriangle& t : tris)
+      abs_mean += std::abs(weighted_jacobian(start, positions[t.a], positions[t.b], t.ideal_inv).determinant());
+    abs_mean /= static_cast<double>(tris.size());
+  }
+  double delta = untangling_delta(sigma_star, opt.alpha, abs_mean);
+  const double tiny_step = std::max(1e-12, 1e-3 * opt.relative_displacement_tolerance) * L;
+  // After a full Newton step of length s on the unmodified measure the remaining error is
+  // O(s^2 / L) (quadratic convergence), so a step below 1e-1 * tolerance ends the visit.
+  const double newton_stop = std::max(1e-12, 1e-1 * opt.relative_displacement_tolerance) * L;
+
+  Eigen::Vector2d x = start;
+  for (int it = 0; it < opt.newton_iterations_per_visit; ++it) {
+    const ObjectiveValue ov = local_objective(x, positions, tris, delta);
+    const Eigen::Vector2d& g = ov.gradient;
+    const double gn = g.norm();
+    if (!std::isfinite(ov.value) || !std::isfinite(gn) || gn == 0.0) break;
+
+    Eigen::Vector2d d;
+    bool newton = is_spd(ov.hessian);
+    if (newton) {
+      const Eigen::Matrix2d& H = ov.hessian;
+      const double det = H(0, 0) * H(1, 1) - H(0, 1) * H(1, 0);
+      d = -Eigen::Vector2d(H(1, 1) * g.x() - H(0, 1) * g.y(), -H(1, 0) * g.x() + H(0, 0) * g.y()) / det;
+      if (!d.allFinite() || !(g.dot(d) < 0.0)) newton = false;
+    }
+    if (!newton) d = -g * (L / gn);  // gradient step of initial length L
+    // Trust cap: never try to move more than one local length per step.
+    const double dn = d.norm();
+    if (dn > L) d *= L / dn;
+    const double slope = g.dot(d);
+
+    double t = 1.0;
+    bool accepted = false;
+    Eigen::Vector2d xn;
+    for (int k = 0; k <= opt.max_backtracks; ++k, t *= 0.5) {
+      xn = x + t * d;
+      const double fn = local_objective_value(xn, positions, tris, delta);
+      if (std::isfinite(fn) && fn <= ov.value + opt.armijo_c * t * slope) {
+        accepted = true;
+        break;
+      }
+    }
+    if (!accepted) break;
+    ++(newton ? cnt.newton : cnt.gradient);
+    const double step = (xn - x).norm();
+    x = xn;
+    // Once the submesh is valid the paper optimizes the unmodified measure (delta = 0).
+    if (delta > 0.0 && min_sigma(x, positions, tris) > 0.0) {
+      delta = 0.0;
+      continue;
+    }
+    if (step < tiny_step || (newton && t == 1.0 && delta == 0.0 && step < newton_stop)) break;
+  }
+  return x;
+}
+
+}  // namespace
+
+Eigen::Vector2d optimize_node(const Eigen::Vector2d& start, std::span<const Eigen::Vector2d> positions,
+                              std::span<const LocalTriangle> triangles, const SmoothingOptions& options,
+                              std::size_t* newton_steps, std::size_t* gradient_fallbacks) {
+  validate_options(options);
+  validate_triangles(positions, triangles, -1);
+  Counters cnt;
+  const Eigen::Vector2d x =
+      optimize_impl(start, positions, triangles, options, local_length(start, positions, triangles), cnt);
+  if (newton_steps) *newton_steps += cnt.newton;
+  if (gradient_fallbacks) *gradient_fallbacks += cnt.gradient;
+  return x;
+}
+
+namespace {
+
+std::size_t count_tangled(const std::vector<Eigen::Vector2d>& positions, const SmoothingProblem& p) {
+  std::size_t n = 0;
+  for (std::size_t k = 0; k < p.size(); ++k) {
+    const auto tris = p.triangles_of(k);
+    if (!tris.empty() && !(min_sigma(positions[p.nodes[k]], positions, tris) > 0.0)) ++n;
+  }
+  return n;
+}
+
+void validate_problem(const std::vector<Eigen::Vector2d>& positions, const SmoothingProblem& p) {
+  if (p.offsets.size() != p.nodes.size() + 1 || p.offsets.front() != 0 ||
+      p.offsets.back() != p.triangles.size())
+    throw std::invalid_argument("meshopt::smooth: offsets inconsistent with nodes/triangles");
+  for (std::size_t k = 0; k < p.size(); ++k) {
+    if (p.offsets[k] > p.offsets[k + 1]) throw std::invalid_argument("meshopt::smooth: offsets not sorted");
+    const int node = p.nodes[k];
+    if (node < 0 || static_cast<std::size_t>(node) >= positions.size())
+      throw std::invalid_argument("meshopt::smooth: free node index out of range");
+    if (!positions[node].allFinite()) throw std::invalid_argument("meshopt::smooth: non-finite node position");
+    validate_triangles(positions, p.triangles_of(k), node);
+  }
+}
+
+}  // namespace
+
+SmoothingReport smooth(std::vector<Eigen::Vector2d>& positions, const SmoothingProblem& problem,
+                       const SmoothingOptions& options) {
+  validate_options(options);
+  validate_problem(positions, problem);
+  SmoothingReport rep;
+  rep.tangled_nodes_before = count_tangled(positions, problem);
+  const std::span<const Eigen::Vector2d> pos(positions);
+  Counters cnt;
+  for (int sweep = 0; sweep < options.max_sweeps; ++sweep) {
+    double max_move = 0.0;
+    for (std::size_t k = 0; k < problem.size(); ++k) {
+      const auto tris = problem.triangles_of(k);
+      Eigen::Vector2d& xk = positions[problem.nodes[k]];
+      const double L = local_length(xk, pos, tris);
+      const Eigen::Vector2d xn = optimize_impl(xk, pos, tris, options, L, cnt);
+      if (L > 0.0) max_move = std::max(max_move, (xn - xk).norm() / L);
+      xk = xn;
+    }
+    rep.sweeps = sweep + 1;
+    rep.last_max_relative_move = max_move;
+    if (options.progress) options.progress(sweep, max_move, count_tangled(positions, problem));
+    if (max_move < options.relative_displacement_tolerance) {
+      rep.converged = true;
+      break;
+    }
+  }
+  rep.tangled_nodes_after = count_tangled(positions, problem);
+  rep.newton_steps = cnt.newton;
+  rep.gradient_fallbacks = cnt.gradient;
+  return rep;
+}
+
+}  // namespace meshopt
