@@ -1,0 +1,38 @@
+// Benchmark of each stage of the front half (boundary, T-mesh, Coons,
+// optimization) on one domain at one resolution. Prints one table row:
+//   cells vertices boundary_s tmesh_s coons_s optimization_s sweeps peak_MiB inverted
+// Usage: bench_front POLYGON INIT_LEVEL TOL_REL [MAX_SWEEPS]
+// Run one size per process so the peak memory (getrusage) belongs to that size.
+#include <sys/resource.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <string>
+
+#include "tspline/io/polygon_reader.h"
+#include "tspline/parameterization.h"
+
+int main(int argc, char** argv) {
+  if (argc < 4) {
+    std::fprintf(stderr, "usage: %s POLYGON INIT_LEVEL TOL_REL [MAX_SWEEPS]\n", argv[0]);
+    return 1;
+  }
+  tspline::ParameterizationOptions opt;
+  opt.initial_level = std::atoi(argv[2]);
+  opt.tolerance_relative = std::atof(argv[3]);
+  if (argc > 4) opt.smoothing.max_sweeps = std::atoi(argv[4]);
+  const auto poly = tspline::io::read_polygon(argv[1]);
+  const tspline::FrontResult r = tspline::run_front(poly, opt);
+  double t[4] = {0, 0, 0, 0};
+  for (const auto& s : r.times) {
+    if (s.stage == "boundary") t[0] = s.seconds;
+    if (s.stage == "tmesh") t[1] = s.seconds;
+    if (s.stage == "coons") t[2] = s.seconds;
+    if (s.stage == "optimization") t[3] = s.seconds;
+  }
+  rusage ru{};
+  getrusage(RUSAGE_SELF, &ru);
+  std::printf("%9zu %9zu %9.4f %9.4f %9.4f %9.4f %6d %9.1f %8zu\n", r.mesh.num_cells(), r.mesh.num_vertices(), t[0],
+              t[1], t[2], t[3], r.smoothing.sweeps, ru.ru_maxrss / 1024.0, r.quality_optimized.inverted_cells);
+  return 0;
+}

@@ -1,0 +1,188 @@
+// End-to-end runs of the `tspline` command: good runs and every bad-input case.
+#include <doctest/doctest.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <set>
+#include <sstream>
+#include <string>
+
+namespace fs = std::filesystem;
+
+namespace {
+
+struct RunResult {
+  int exit_code = -1;
+  std::string out, err;
+};
+
+std::string slurp(const fs::path& p) {
+  std::ifstream f(p);
+  std::stringstream ss;
+  ss << f.rdbuf();
+  return ss.str();
+}
+
+// A fresh scratch directory per test case.
+fs::path scratch(const std::string& name) {
+  const fs::path d = fs::temp_directory_path() / ("tspline_app_test_" + std::to_string(::getpid())) / name;
+  fs::remove_all(d);
+  fs::create_directories(d);
+  return d;
+}
+
+RunResult run(const std::string& args, const fs::path& dir) {
+  const fs::path out = dir / "stdout.txt", err = dir / "stderr.txt";
+  const std::string cmd =
+      std::string("'") + TSPLINE_APP_PATH + "' " + args + " >'" + out.string() + "' 2>'" + err.string() + "'";
+  const int status = std::system(cmd.c_str());
+  RunResult r;
+  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  r.out = slurp(out);
+  r.err = slurp(err);
+  return r;
+}
+
+fs::path write_file(const fs::path& dir, const std::string& name, const std::string& content) {
+  const fs::path p = dir / name;
+  std::ofstream(p) << content;
+  return p;
+}
+
+std::string polygons(const std::string& name) { return std::string(TSPLINE_TEST_DATA_DIR) + "/polygons/" + name; }
+
+std::size_t count_lines(const std::string& s) {
+  std::size_t n = 0;
+  for (char c : s) n += (c == '\n');
+  return n;
+}
+
+bool dir_is_empty_or_missing(const fs::path& d) { return !fs::exists(d) || fs::is_empty(d); }
+
+// Bad input: non-zero exit, exactly one error line naming the problem, no output files.
+void expect_clean_failure(const std::string& args, const fs::path& dir, const std::string& needle,
+                          int expected_code) {
+  const RunResult r = run(args, dir);
+  CAPTURE(args);
+  CAPTURE(r.err);
+  CHECK(r.exit_code == expected_code);
+  CHECK(count_lines(r.err) == 1);
+  CHECK(r.err.rfind("tspline: error: ", 0) == 0);
+  CHECK(r.err.find(needle) != std::string::npos);
+  CHECK(dir_is_empty_or_missing(dir / "out"));
+}
+
+const char* kSquare = "0 0\n1 0\n1 1\n0 1\n";
+
+}  // namespace
+
+TEST_SUITE("app") {
+  TEST_CASE("param on the unit square writes every output and a consistent report") {
+    const fs::path d = scratch("square");
+    const RunResult r = run("param '" + polygons("square.txt") + "' --out '" + (d / "out").string() + "'", d);
+    CAPTURE(r.err);
+    REQUIRE(r.exit_code == 0);
+    for (const char* f : {"parametric_tmesh.vtu", "physical_tmesh.vtu", "boundary.vtu", "report.json"})
+      CHECK(fs::exists(d / "out" / f));
+    const auto rep = nlohmann::json::parse(slurp(d / "out" / "report.json"));
+    CHECK(rep["counts"]["polygon_vertices"] == 16);
+    CHECK(rep["optimized"]["inverted_cells"] == 0);
+    CHECK(rep["coons"]["inverted_cells"] == 0);
+    // The square maps onto itself: every triangle keeps its ideal shape.
+    CHECK(rep["optimized"]["min_mean_ratio"].get<double>() == doctest::Approx(1.0).epsilon(1e-9));
+    CHECK(rep["counts"]["cells"] == 64);  // default initial level 3, no boundary refinement needed
+    for (const char* stage : {"boundary", "tmesh", "coons", "optimization", "total"})
+      CHECK(rep["seconds"].contains(stage));
+    // Progress lines for each stage.
+    for (const char* stage : {"boundary:", "t-mesh:", "coons:", "optimization:"})
+      CHECK(r.out.find(stage) != std::string::npos);
+    // No temporary files left behind.
+    for (const auto& e : fs::directory_iterator(d / "out")) CHECK(e.path().filename().string()[0] != '.');
+  }
+
+  TEST_CASE("--help explains every option") {
+    const fs::path d = scratch("help");
+    const RunResult r = run("param --help", d);
+    CHECK(r.exit_code == 0);
+    for (const char* opt : {"--out", "--corners", "--tol", "--tol-rel", "--init-level", "--max-level", "--max-sweeps",
+                            "--sweep-tol", "--polygon", "--quiet"})
+      CHECK(r.out.find(opt) != std::string::npos);
+  }
+
+  TEST_CASE("given corners are used and reported in file numbering") {
+    const fs::path d = scratch("corners");
+    const RunResult r =
+        run("param '" + polygons("lshape_cw.txt") + "' --corners 3,9,21,33 --out '" + (d / "out").string() + "'", d);
+    CAPTURE(r.err);
+    REQUIRE(r.exit_code == 0);
+    const auto rep = nlohmann::json::parse(slurp(d / "out" / "report.json"));
+    CHECK(rep["corners"]["vertices"][0]["file_index"] == 3);
+    std::set<int> got;
+    for (const auto& c : rep["corners"]["vertices"]) got.insert(c["file_index"].get<int>());
+    CHECK(got == std::set<int>{3, 9, 21, 33});
+  }
+
+  TEST_CASE("bad input: each case one clear error line, non-zero exit, no output") {
+    const fs::path d = scratch("bad");
+    const std::string out = " --out '" + (d / "out").string() + "'";
+    auto param = [&](const fs::path& in, const std::string& extra = "") {
+      return "param '" + in.string() + "'" + out + extra;
+    };
+    SUBCASE("empty file") { expect_clean_failure(param(write_file(d, "e.txt", "")), d, "empty", 1); }
+    SUBCASE("only comments") {
+      expect_clean_failure(param(write_file(d, "c.txt", "# nothing\n\n# here\n")), d, "empty", 1);
+    }
+    SUBCASE("three vertices") {
+      expect_clean_failure(param(write_file(d, "t.txt", "0 0\n1 0\n0 1\n")), d, "3 vertices", 1);
+    }
+    SUBCASE("NaN coordinate") {
+      expect_clean_failure(param(write_file(d, "n.txt", "0 0\n1 0\nnan 1\n0 1\n")), d, "not finite", 1);
+    }
+    SUBCASE("non-numeric line") {
+      expect_clean_failure(param(write_file(d, "x.txt", "0 0\n1 0\nhello world\n0 1\n")), d, ":3:", 1);
+    }
+    SUBCASE("duplicate consecutive vertices") {
+      expect_clean_failure(param(write_file(d, "d.txt", "0 0\n1 0\n1 0\n1 1\n0 1\n")), d, "1 and 2", 1);
+    }
+    SUBCASE("self-intersecting polygon names the crossing edges") {
+      expect_clean_failure(param(write_file(d, "s.txt", "0 0\n1 1\n1 0\n0 1\n")), d, "0-1", 1);
+    }
+    SUBCASE("zero area") {
+      expect_clean_failure(param(write_file(d, "z.txt", "0 0\n1 0\n2 0\n3 0\n")), d, "area", 1);
+    }
+    SUBCASE("corner index out of range") {
+      expect_clean_failure(param(write_file(d, "q.txt", kSquare), " --corners 0,1,2,4"), d, "4", 1);
+    }
+    SUBCASE("repeated corner index") {
+      expect_clean_failure(param(write_file(d, "q.txt", kSquare), " --corners 0,1,1,3"), d, "1", 1);
+    }
+    SUBCASE("corners not in cyclic order") {
+      expect_clean_failure(param(write_file(d, "q.txt", kSquare), " --corners 0,2,1,3"), d, "cyclic", 1);
+    }
+    SUBCASE("malformed --corners") {
+      expect_clean_failure(param(write_file(d, "q.txt", kSquare), " --corners 0,1,x,3"), d, "x", 1);
+    }
+    SUBCASE("unreadable input path") {
+      expect_clean_failure(param(d / "does_not_exist.txt"), d, "does_not_exist.txt", 2);
+    }
+    SUBCASE("input path is a directory") { expect_clean_failure(param(d), d, d.string(), 2); }
+    SUBCASE("unwritable output path") {
+      const fs::path blocker = write_file(d, "blocker", "x");
+      const std::string args =
+          "param '" + write_file(d, "q.txt", kSquare).string() + "' --out '" + (blocker / "sub").string() + "'";
+      expect_clean_failure(args, d, "blocker", 2);
+    }
+    SUBCASE("negative tolerance") {
+      expect_clean_failure(param(write_file(d, "q.txt", kSquare), " --tol -1"), d, "--tol", 1);
+    }
+    SUBCASE("missing --out") {
+      const RunResult r = run("param '" + write_file(d, "q.txt", kSquare).string() + "'", d);
+      CHECK(r.exit_code == 1);
+      CHECK(count_lines(r.err) == 1);
+      CHECK(r.err.find("--out") != std::string::npos);
+    }
+  }
+}
