@@ -20,6 +20,9 @@ enum class Side { Bottom = 0, Right = 1, Top = 2, Left = 3 };
 /// chord length onto its side of the unit square.
 class BoundaryMap {
  public:
+  /// \throw std::invalid_argument unless the corners are distinct, in range and in
+  /// CCW order; NumericalError if an edge is too short for a strictly increasing
+  /// chord parameter (length below double resolution relative to its chain).
   BoundaryMap(Polygon ccw_polygon, Corners corners);
 
   const Polygon& polygon() const { return polygon_; }
@@ -27,6 +30,7 @@ class BoundaryMap {
 
   /// Point of the polygon at chord parameter t in [0,1] on `side` (t=0 at the
   /// chain's first corner). Exact at the chain's vertices. O(log n).
+  /// \throw std::invalid_argument if t is not in [0,1].
   Eigen::Vector2d point(Side side, double t) const;
 
   /// Physical point for a parametric point on the boundary of [0,1]^2
@@ -41,7 +45,7 @@ class BoundaryMap {
   double chain_length(Side side) const;
 
   /// Index range [first, last) into chain_points(side) of the vertices whose
-  /// chord parameter lies strictly inside (t0, t1), t0 < t1. O(log n).
+  /// chord parameter lies strictly inside (t0, t1), t0 < t1 (empty range otherwise). O(log n).
   std::pair<std::size_t, std::size_t> vertices_between(Side side, double t0, double t1) const;
 
  private:

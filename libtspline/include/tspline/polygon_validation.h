@@ -11,7 +11,9 @@ namespace tspline {
 ///   fewer than 4 vertices; a NaN/inf coordinate (names the vertex); two equal
 ///   consecutive vertices (names them); zero area; collinear-overlapping or
 ///   crossing edges (names the two edges by their file vertex indices, e.g.
-///   "edges 3-4 and 10-11 cross at (x, y)"). Runs in O(n log n).
+///   "polygon is not simple: edges 3-4 and 10-11 intersect near (x, y)"; "overlap
+///   near" for collinear overlaps). Runs in O(n log n + k), k = pairs of edges with
+///   overlapping bounding boxes. An empty `file_index` is filled with 0..n-1.
 Polygon validate_polygon(Polygon p);
 
 /// Signed area (positive for counter-clockwise).
