@@ -115,14 +115,15 @@ TEST_SUITE("app") {
   TEST_CASE("given corners are used and reported in file numbering") {
     const fs::path d = scratch("corners");
     const RunResult r =
-        run("param '" + polygons("lshape_cw.txt") + "' --corners 3,9,21,33 --out '" + (d / "out").string() + "'", d);
+        run("param '" + polygons("lshape_cw.txt") + "' --corners 7,15,31,39 --out '" + (d / "out").string() + "'", d);
     CAPTURE(r.err);
     REQUIRE(r.exit_code == 0);
     const auto rep = nlohmann::json::parse(slurp(d / "out" / "report.json"));
-    CHECK(rep["corners"]["vertices"][0]["file_index"] == 3);
+    CHECK(rep["corners"]["vertices"][0]["file_index"] == 7);
     std::set<int> got;
     for (const auto& c : rep["corners"]["vertices"]) got.insert(c["file_index"].get<int>());
-    CHECK(got == std::set<int>{3, 9, 21, 33});
+    CHECK(got == std::set<int>{7, 15, 31, 39});
+    CHECK(rep["optimized"]["inverted_cells"] == 0);
   }
 
   TEST_CASE("bad input: each case one clear error line, non-zero exit, no output") {
@@ -161,6 +162,9 @@ TEST_SUITE("app") {
     }
     SUBCASE("corners not in cyclic order") {
       expect_clean_failure(param(write_file(d, "q.txt", kSquare), " --corners 0,2,1,3"), d, "cyclic", 1);
+    }
+    SUBCASE("corner on a straight part of the boundary") {
+      expect_clean_failure(param(polygons("lshape_cw.txt"), " --corners 3,9,21,33"), d, "convex", 1);
     }
     SUBCASE("malformed --corners") {
       expect_clean_failure(param(write_file(d, "q.txt", kSquare), " --corners 0,1,x,3"), d, "x", 1);

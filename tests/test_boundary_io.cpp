@@ -4,6 +4,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -42,12 +43,14 @@ std::string message_of(F&& f) {
 bool contains(const std::string& s, const std::string& part) { return s.find(part) != std::string::npos; }
 
 std::string geojson_ring(const std::vector<V2>& v) {
-  std::string s = "[";
+  std::ostringstream s;
+  s << "[";
   for (std::size_t i = 0; i <= v.size(); ++i) {
     const V2& q = v[i % v.size()];  // closed ring, as GeoJSON requires
-    s += (i ? "," : "") + std::string("[") + std::to_string(q.x()) + "," + std::to_string(q.y()) + "]";
+    s << (i ? "," : "") << "[" << std::to_string(q.x()) << "," << std::to_string(q.y()) << "]";
   }
-  return s + "]";
+  s << "]";
+  return s.str();
 }
 
 }  // namespace

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <Eigen/LU>
 #include <map>
 
 #include "meshopt/local_objective.h"
@@ -102,7 +103,7 @@ TEST_SUITE("tmesh_submesh") {
   TEST_CASE("Appendix, regular vertex: weighted optimum of a 1:2:4 orthogonal mesh is orthogonal") {
     const TMesh m = regular_124_mesh();
     const int v = vertex_at(m, 0.5, 0.5);
-    for (const auto [a, b] : {std::pair{1.0, 1.0}, std::pair{1.0, 2.0}, std::pair{3.0, 0.7}}) {
+    for (const auto& [a, b] : {std::pair{1.0, 1.0}, std::pair{1.0, 2.0}, std::pair{3.0, 0.7}}) {
       CAPTURE(a);
       CAPTURE(b);
       const auto x = stretched(m, a, b);
@@ -116,7 +117,7 @@ TEST_SUITE("tmesh_submesh") {
   TEST_CASE("Appendix, hanging vertex: weighted optimum is orthogonal for any a != b") {
     const TMesh m = hanging_mesh();
     const int v = vertex_at(m, 0.5, 0.75);
-    for (const auto [a, b] : {std::pair{1.0, 2.0}, std::pair{2.0, 1.0}, std::pair{0.5, 1.3}, std::pair{3.0, 1.0}}) {
+    for (const auto& [a, b] : {std::pair{1.0, 2.0}, std::pair{2.0, 1.0}, std::pair{0.5, 1.3}, std::pair{3.0, 1.0}}) {
       CAPTURE(a);
       CAPTURE(b);
       const auto x = stretched(m, a, b);

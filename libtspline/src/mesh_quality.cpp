@@ -2,6 +2,8 @@
 
 #include <algorithm>
 
+#include <Eigen/LU>
+
 #include "meshopt/triangle_measure.h"
 
 namespace tspline {

@@ -9,6 +9,7 @@
 #include "tspline/errors.h"
 #include "tspline/polygon_validation.h"
 #include "tspline/tmesh_submesh.h"
+#include "tspline/tmesh_transfer.h"
 
 namespace tspline {
 
@@ -61,6 +62,19 @@ FrontResult run_front(const Polygon& input, const ParameterizationOptions& opt) 
       << (opt.corners ? " (given)" : " (automatic)");
     log(s.str());
   }
+  // A corner where the polygon is straight or reflex makes the corner cell
+  // degenerate or folded whatever the interior does: reject it.
+  for (int k = 0; k < 4; ++k) {
+    const std::size_t n = poly.vertices.size(), i = corners.index[k];
+    const Eigen::Vector2d a = poly.vertices[(i + n - 1) % n], b = poly.vertices[i], c = poly.vertices[(i + 1) % n];
+    const Eigen::Vector2d u = b - a, w = c - b;
+    if (!(u.x() * w.y() - u.y() * w.x() > 0.0)) {
+      std::ostringstream s;
+      s << "corner " << k << " (file vertex " << poly.file_index[i] << ") has an inner angle of "
+        << corners.inner_angle_deg[k] << " degrees: corners must be convex vertices (inner angle below 180)";
+      throw InputError(s.str());
+    }
+  }
   FrontResult r{BoundaryMap(std::move(poly), std::move(corners))};
   clock.stop("boundary");
 
@@ -87,25 +101,48 @@ FrontResult run_front(const Polygon& input, const ParameterizationOptions& opt) 
   clock.stop("coons");
 
   r.optimized = r.coons;
-  const meshopt::SmoothingProblem problem = build_smoothing_problem(r.mesh, true);
   meshopt::SmoothingOptions sopt = opt.smoothing;
   if (!sopt.progress && opt.log) {
     sopt.progress = [&](int sweep, double move, std::size_t tangled) {
-      if (sweep < 10 || sweep % 25 == 0) {
+      if (sweep < 5 || sweep % 50 == 0) {
         std::ostringstream s;
         s << "  sweep " << sweep << ": max relative move " << move << ", tangled nodes " << tangled;
         opt.log(s.str());
       }
     };
   }
-  r.smoothing = meshopt::smooth(r.optimized, problem, sopt);
-  r.quality_optimized = mesh_quality(r.mesh, r.optimized);
-  {
+  auto optimize = [&]() {
+    const meshopt::SmoothingProblem problem = build_smoothing_problem(r.mesh, true);
+    r.smoothing = meshopt::smooth(r.optimized, problem, sopt);
+    r.total_sweeps += r.smoothing.sweeps;
+    r.quality_optimized = mesh_quality(r.mesh, r.optimized);
     std::ostringstream s;
     s << "optimization: " << r.smoothing.sweeps << " sweeps, " << r.quality_optimized.inverted_cells
       << " inverted cells, min/mean quality " << r.quality_optimized.min_quality << " / "
       << r.quality_optimized.mean_quality;
     log(s.str());
+  };
+  optimize();
+  // Repair: cells that stay inverted lack interior freedom (typically thin
+  // features of the domain). Refine them, place the new vertices in the current
+  // physical mesh, re-balance and optimize again.
+  for (int round = 0; round < opt.max_repair_rounds && r.quality_optimized.inverted_cells > 0; ++round) {
+    const std::vector<CellQuality> q = cell_qualities(r.mesh, r.optimized);
+    const TMesh coarse = r.mesh;
+    std::size_t refined = 0;
+    for (int c = 0; c < static_cast<int>(q.size()); ++c) {
+      if (q[c].valid || coarse.cell_level(c) >= opt.max_level) continue;
+      r.mesh.refine(coarse.cell_node(c));
+      ++refined;
+    }
+    if (refined == 0) break;
+    r.mesh.balance();
+    r.mesh.build_topology();
+    r.optimized = transfer_positions(coarse, r.optimized, r.mesh, r.boundary);
+    r.repair_refined_cells.push_back(refined);
+    log("repair round " + std::to_string(round + 1) + ": refined " + std::to_string(refined) +
+        " inverted cells, now " + std::to_string(r.mesh.num_cells()) + " cells");
+    optimize();
   }
   clock.stop("optimization");
   r.times = std::move(times);

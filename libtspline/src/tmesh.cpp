@@ -145,7 +145,8 @@ void TMesh::build_topology() {
       if (v < 0) continue;
       // A vertex at the quarter point would mean two hanging vertices on one edge.
       const IPoint quarter = (e % 2 == 0) ? IPoint{lo.x + h / 2, mids[e].y} : IPoint{mids[e].x, lo.y + h / 2};
-      if (h >= 2 && find_vertex(quarter) >= 0)
+      const IPoint quarter2 = (e % 2 == 0) ? IPoint{hi.x - h / 2, mids[e].y} : IPoint{mids[e].x, hi.y - h / 2};
+      if (h >= 2 && (find_vertex(quarter) >= 0 || find_vertex(quarter2) >= 0))
         throw std::logic_error("TMesh::build_topology: the tree is not 2:1 balanced");
       cell_mid_[c][e] = v;
       vertex_hanging_cell_[v] = static_cast<int>(c);

@@ -29,6 +29,9 @@ struct ParameterizationOptions {
   int initial_level = 3;
   /// No cell is refined beyond this level.
   int max_level = 22;
+  /// If inverted cells remain after optimization, refine them, re-balance,
+  /// re-optimize; at most this many rounds (0 disables the repair).
+  int max_repair_rounds = 8;
   /// Node optimization settings (libmeshopt).
   meshopt::SmoothingOptions smoothing;
   /// Progress lines (stage names, counts); may be empty.
@@ -48,11 +51,14 @@ struct FrontResult {
   double tolerance_area = 0.0;
   bool tolerance_is_relative = true;
   BoundaryRefinementReport refinement;
-  std::vector<Eigen::Vector2d> coons;      ///< physical vertex positions after the Coons start
+  std::vector<Eigen::Vector2d> coons;      ///< positions after the Coons start (on the T-mesh before any repair)
   std::vector<Eigen::Vector2d> optimized;  ///< after untangling and smoothing
-  MeshQualityStats quality_coons;
+  MeshQualityStats quality_coons;  ///< of the Coons start, on the T-mesh before any repair
   MeshQualityStats quality_optimized;
-  meshopt::SmoothingReport smoothing;
+  meshopt::SmoothingReport smoothing;  ///< of the last optimization run
+  int total_sweeps = 0;                 ///< over all optimization runs
+  /// Cells refined in each repair round (inverted cells after optimization).
+  std::vector<std::size_t> repair_refined_cells;
   std::vector<StageTime> times;
 };
 
