@@ -99,6 +99,9 @@ int main(int argc, char** argv) {
   param->add_option("--max-level", opt.max_level, "Maximum refinement level of any cell")->capture_default_str();
   param->add_option("--max-sweeps", opt.smoothing.max_sweeps, "Maximum Gauss-Seidel sweeps of the optimization")
       ->capture_default_str();
+  param->add_option("--omega", opt.smoothing.over_relaxation,
+                    "Over-relaxation factor in [1, 2) of the node updates (1: plain Gauss-Seidel)")
+      ->capture_default_str();
   param->add_option("--sweep-tol", opt.smoothing.relative_displacement_tolerance,
                     "Stop when the largest node move relative to its local edge length is below this")
       ->capture_default_str();

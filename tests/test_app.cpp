@@ -97,7 +97,7 @@ TEST_SUITE("app") {
     for (const char* stage : {"boundary", "tmesh", "coons", "optimization", "total"})
       CHECK(rep["seconds"].contains(stage));
     // Progress lines for each stage.
-    for (const char* stage : {"boundary:", "t-mesh:", "coons:", "optimization:"})
+    for (const char* stage : {"boundary:", "t-mesh:", "coons:", "optimization ("})
       CHECK(r.out.find(stage) != std::string::npos);
     // No temporary files left behind.
     for (const auto& e : fs::directory_iterator(d / "out")) CHECK(e.path().filename().string()[0] != '.');

@@ -31,3 +31,33 @@ TEST_SUITE("parameterization") {
     }
   }
 }
+
+TEST_SUITE("parameterization") {
+  TEST_CASE("nested optimization ends on the same T-mesh as the direct one, and as good") {
+    const auto poly = tspline::io::read_polygon(std::string(TSPLINE_TEST_DATA_DIR) + "/polygons/flower.txt");
+    tspline::ParameterizationOptions opt;
+    opt.initial_level = 5;
+    opt.smoothing.relative_displacement_tolerance = 1e-5;
+    opt.smoothing.max_sweeps = 5000;
+    const tspline::FrontResult nested = tspline::run_front(poly, opt);
+    opt.nested_optimization = false;
+    const tspline::FrontResult direct = tspline::run_front(poly, opt);
+    REQUIRE(nested.mesh.num_cells() == direct.mesh.num_cells());
+    REQUIRE(nested.mesh.num_vertices() == direct.mesh.num_vertices());
+    // Same vertex set (exact integer coordinates), hence the same optimization problem.
+    for (int v = 0; v < static_cast<int>(direct.mesh.num_vertices()); ++v)
+      CHECK(nested.mesh.find_vertex(direct.mesh.vertex_ipos(v)) >= 0);
+    CHECK(nested.quality_optimized.inverted_cells == 0);
+    CHECK(direct.quality_optimized.inverted_cells == 0);
+    // Both converge to the same optimum: node positions agree to a small
+    // fraction of the smallest cell's physical size (~1e-2 here).
+    double worst = 0.0;
+    for (int v = 0; v < static_cast<int>(direct.mesh.num_vertices()); ++v) {
+      const int w = nested.mesh.find_vertex(direct.mesh.vertex_ipos(v));
+      worst = std::max(worst, (nested.optimized[w] - direct.optimized[v]).norm());
+    }
+    MESSAGE("largest node distance nested vs direct: " << worst);
+    CHECK(worst < 1e-3);
+    CHECK(nested.quality_optimized.mean_quality == doctest::Approx(direct.quality_optimized.mean_quality).epsilon(1e-4));
+  }
+}

@@ -36,6 +36,7 @@ void validate_options(const SmoothingOptions& o) {
   if (!(o.alpha > 0.0 && o.alpha <= 1.0)) bad("alpha must be in (0, 1] (the paper uses [1e-6, 1e-3])");
   if (!(o.armijo_c > 0.0 && o.armijo_c < 1.0)) bad("armijo_c must be in (0, 1)");
   if (o.max_backtracks < 0) bad("max_backtracks must be >= 0");
+  if (!(o.over_relaxation >= 1.0 && o.over_relaxation < 2.0)) bad("over_relaxation must be in [1, 2)");
 }
 
 void validate_triangles(std::span<const Eigen::Vector2d> positions, std::span<const LocalTriangle> tris,
@@ -184,6 +185,29 @@ void validate_problem(const std::vector<Eigen::Vector2d>& positions, const Smoot
 
 }  // namespace
 
+namespace {
+
+// For every global node, the free nodes (indices into problem.nodes) whose
+// submesh contains it, i.e. whose objective changes when it moves.
+std::vector<std::vector<int>> build_dependents(std::size_t num_positions, const SmoothingProblem& p) {
+  std::vector<std::vector<int>> dep(num_positions);
+  for (std::size_t k = 0; k < p.size(); ++k) {
+    for (const LocalTriangle& t : p.triangles_of(k)) {
+      for (int v : {t.a, t.b}) {
+        auto& d = dep[v];
+        if (d.empty() || d.back() != static_cast<int>(k)) d.push_back(static_cast<int>(k));
+      }
+    }
+  }
+  for (auto& d : dep) {
+    std::sort(d.begin(), d.end());
+    d.erase(std::unique(d.begin(), d.end()), d.end());
+  }
+  return dep;
+}
+
+}  // namespace
+
 SmoothingReport smooth(std::vector<Eigen::Vector2d>& positions, const SmoothingProblem& problem,
                        const SmoothingOptions& options) {
   validate_options(options);
@@ -192,18 +216,42 @@ SmoothingReport smooth(std::vector<Eigen::Vector2d>& positions, const SmoothingP
   rep.tangled_nodes_before = count_tangled(positions, problem);
   const std::span<const Eigen::Vector2d> pos(positions);
   Counters cnt;
+  // Active set: a node is visited again only if it, or a node of its submesh,
+  // moved by more than the tolerance since its last visit. Converged parts of the
+  // mesh then cost nothing, and the stopping rule (largest relative move below
+  // the tolerance) is unchanged: a skipped node's objective has not changed
+  // beyond the tolerance, so it would not move either.
+  const std::vector<std::vector<int>> dependents = build_dependents(positions.size(), problem);
+  std::vector<char> active(problem.size(), 1);
   for (int sweep = 0; sweep < options.max_sweeps; ++sweep) {
     double max_move = 0.0;
+    std::size_t visited = 0;
     for (std::size_t k = 0; k < problem.size(); ++k) {
+      if (!active[k]) continue;
+      active[k] = 0;
+      ++visited;
       const auto tris = problem.triangles_of(k);
       Eigen::Vector2d& xk = positions[problem.nodes[k]];
       const double L = local_length(xk, pos, tris);
-      const Eigen::Vector2d xn = optimize_impl(xk, pos, tris, options, L, cnt);
-      if (L > 0.0) max_move = std::max(max_move, (xn - xk).norm() / L);
+      Eigen::Vector2d xn = optimize_impl(xk, pos, tris, options, L, cnt);
+      // Nonlinear successive over-relaxation: push past the local optimum to
+      // speed up the smooth, domain-wide modes that plain Gauss-Seidel removes
+      // slowly. Taken only if the submesh stays valid there (no new tangling).
+      if (options.over_relaxation != 1.0) {
+        const Eigen::Vector2d xr = xk + options.over_relaxation * (xn - xk);
+        if (min_sigma(xn, pos, tris) > 0.0 && min_sigma(xr, pos, tris) > 0.0) xn = xr;
+      }
+      const double move = L > 0.0 ? (xn - xk).norm() / L : 0.0;
+      max_move = std::max(max_move, move);
       xk = xn;
+      if (move >= options.relative_displacement_tolerance) {
+        active[k] = 1;
+        for (int m : dependents[problem.nodes[k]]) active[m] = 1;
+      }
     }
     rep.sweeps = sweep + 1;
     rep.last_max_relative_move = max_move;
+    rep.node_visits += visited;
     if (options.progress) options.progress(sweep, max_move, count_tangled(positions, problem));
     if (max_move < options.relative_displacement_tolerance) {
       rep.converged = true;

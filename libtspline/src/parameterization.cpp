@@ -1,5 +1,6 @@
 #include "tspline/parameterization.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <sstream>
@@ -15,19 +16,68 @@ namespace tspline {
 
 namespace {
 
+// Accumulates wall time per stage; stages may be entered several times.
 class StageClock {
  public:
   explicit StageClock(std::vector<StageTime>& times) : times_(times) {}
   void stop(const std::string& stage) {
     const auto now = std::chrono::steady_clock::now();
-    times_.push_back({stage, std::chrono::duration<double>(now - start_).count()});
+    const double dt = std::chrono::duration<double>(now - start_).count();
     start_ = now;
+    for (StageTime& t : times_)
+      if (t.stage == stage) return void(t.seconds += dt);
+    times_.push_back({stage, dt});
   }
 
  private:
   std::vector<StageTime>& times_;
   std::chrono::steady_clock::time_point start_ = std::chrono::steady_clock::now();
 };
+
+// The nested sequence of meshes (coarse to fine) on which the optimization runs.
+// Stage k has uniform level level[k] and boundary tolerance tol[k]; both are
+// monotone, so every stage's tree refines the previous one, and the last stage
+// is exactly the T-mesh of (initial_level, tolerance) built directly (the
+// refinement criterion of a cell depends only on the cell, and the 2:1 balanced
+// closure of a tree is unique).
+struct Stages {
+  std::vector<int> level;
+  std::vector<double> tol;
+};
+
+Stages nested_stages(int initial_level, double tol, double diag, bool nested) {
+  Stages st;
+  if (!nested) return Stages{{initial_level}, {tol}};
+  // Coarsest stage: level <= 2 and a tolerance of 1e-3 diag^2 (a handful of
+  // boundary cells). Each stage halves the cell size: the uniform level grows by
+  // one, and the area criterion, which scales like h^3 on a smooth boundary
+  // (chord c, sagitta c^2/(8R): area ~ c^3/(16R)), tightens by 8.
+  const int l0 = std::min(initial_level, 2);
+  const double coarse_tol = 1e-3 * diag * diag;
+  int k_tol = 0;
+  while (tol * std::pow(8.0, k_tol) < coarse_tol && k_tol < 30) ++k_tol;
+  const int stages = std::max(initial_level - l0, k_tol) + 1;
+  for (int k = 0; k < stages; ++k) {
+    const int remaining = stages - 1 - k;
+    st.level.push_back(std::max(l0, initial_level - remaining));
+    st.tol.push_back(tol * std::pow(8.0, std::min(remaining, k_tol)));
+  }
+  return st;
+}
+
+// Splits every leaf below `level` (one uniform step of the nested sequence).
+void refine_below(TMesh& mesh, int level) {
+  for (bool again = true; again;) {
+    again = false;
+    const std::size_t n = mesh.nodes().size();
+    for (std::size_t i = 0; i < n; ++i) {
+      if (mesh.node(static_cast<int>(i)).is_leaf() && mesh.node(static_cast<int>(i)).level < level) {
+        mesh.refine(static_cast<int>(i));
+        again = true;
+      }
+    }
+  }
+}
 
 double bbox_diagonal(const Polygon& p) {
   Eigen::Vector2d lo = p.vertices.front(), hi = p.vertices.front();
@@ -49,19 +99,12 @@ FrontResult run_front(const Polygon& input, const ParameterizationOptions& opt) 
     throw InputError("--tol must be a positive finite area");
   if (!(opt.tolerance_relative > 0.0 && std::isfinite(opt.tolerance_relative)))
     throw InputError("--tol-rel must be a positive finite number");
+  if (opt.max_repair_rounds < 0) throw InputError("the number of repair rounds must be >= 0");
 
   std::vector<StageTime> times;
   StageClock clock(times);
   Polygon poly = validate_polygon(input);
   Corners corners = opt.corners ? corners_from_file_indices(poly, *opt.corners) : choose_corners(poly);
-  {
-    std::ostringstream s;
-    s << "boundary: " << poly.vertices.size() << " vertices, corners (file indices) "
-      << poly.file_index[corners.index[0]] << "," << poly.file_index[corners.index[1]] << ","
-      << poly.file_index[corners.index[2]] << "," << poly.file_index[corners.index[3]]
-      << (opt.corners ? " (given)" : " (automatic)");
-    log(s.str());
-  }
   // A corner where the polygon is straight or reflex makes the corner cell
   // degenerate or folded whatever the interior does: reject it.
   for (int k = 0; k < 4; ++k) {
@@ -75,57 +118,91 @@ FrontResult run_front(const Polygon& input, const ParameterizationOptions& opt) 
       throw InputError(s.str());
     }
   }
+  {
+    std::ostringstream s;
+    s << "boundary: " << poly.vertices.size() << " vertices, corners (file indices) "
+      << poly.file_index[corners.index[0]] << "," << poly.file_index[corners.index[1]] << ","
+      << poly.file_index[corners.index[2]] << "," << poly.file_index[corners.index[3]]
+      << (opt.corners ? " (given)" : " (automatic)");
+    log(s.str());
+  }
   FrontResult r{BoundaryMap(std::move(poly), std::move(corners))};
   clock.stop("boundary");
 
   r.tolerance_is_relative = !opt.tolerance_absolute.has_value();
   const double diag = bbox_diagonal(r.boundary.polygon());
   r.tolerance_area = opt.tolerance_absolute ? *opt.tolerance_absolute : opt.tolerance_relative * diag * diag;
-  r.mesh = TMesh(opt.initial_level);
-  r.refinement = refine_to_boundary(r.mesh, r.boundary, {r.tolerance_area, opt.max_level});
-  {
-    std::ostringstream s;
-    s << "t-mesh: " << r.mesh.num_cells() << " cells, " << r.mesh.num_vertices() << " vertices ("
-      << r.mesh.num_hanging_vertices() << " hanging), max level " << r.mesh.max_level() << ", tolerance "
-      << r.tolerance_area;
-    log(s.str());
-    if (r.refinement.edges_over_tolerance > 0)
-      log("warning: " + std::to_string(r.refinement.edges_over_tolerance) +
-          " boundary edges still exceed the tolerance at the maximum level " + std::to_string(opt.max_level));
-  }
-  clock.stop("tmesh");
 
-  r.coons = coons_positions(r.mesh, r.boundary);
-  r.quality_coons = mesh_quality(r.mesh, r.coons);
-  log("coons: " + std::to_string(r.quality_coons.inverted_cells) + " inverted cells");
-  clock.stop("coons");
-
-  r.optimized = r.coons;
   meshopt::SmoothingOptions sopt = opt.smoothing;
   if (!sopt.progress && opt.log) {
     sopt.progress = [&](int sweep, double move, std::size_t tangled) {
-      if (sweep < 5 || sweep % 50 == 0) {
+      if (sweep < 3 || sweep % 50 == 0) {
         std::ostringstream s;
         s << "  sweep " << sweep << ": max relative move " << move << ", tangled nodes " << tangled;
         opt.log(s.str());
       }
     };
   }
-  auto optimize = [&]() {
+  auto optimize = [&](const std::string& what) {
     const meshopt::SmoothingProblem problem = build_smoothing_problem(r.mesh, true);
     r.smoothing = meshopt::smooth(r.optimized, problem, sopt);
     r.total_sweeps += r.smoothing.sweeps;
+    r.node_visits += r.smoothing.node_visits;
     r.quality_optimized = mesh_quality(r.mesh, r.optimized);
     std::ostringstream s;
-    s << "optimization: " << r.smoothing.sweeps << " sweeps, " << r.quality_optimized.inverted_cells
+    s << "optimization (" << what << ", " << r.mesh.num_cells() << " cells): " << r.smoothing.sweeps << " sweeps"
+      << (r.smoothing.converged ? "" : " (not converged)") << ", " << r.quality_optimized.inverted_cells
       << " inverted cells, min/mean quality " << r.quality_optimized.min_quality << " / "
       << r.quality_optimized.mean_quality;
     log(s.str());
   };
-  optimize();
+
+  // Nested iteration: optimize on a coarse mesh, then refine, carry the
+  // positions over and optimize again. Gauss-Seidel sweeps remove the local
+  // errors quickly but the smooth, domain-wide ones slowly; on the coarse stages
+  // those are cheap, so the finest stage starts close to its optimum.
+  const Stages st = nested_stages(opt.initial_level, r.tolerance_area, diag, opt.nested_optimization);
+  for (std::size_t k = 0; k < st.level.size(); ++k) {
+    const bool last = k + 1 == st.level.size();
+    TMesh coarse = k == 0 ? TMesh(st.level[0]) : r.mesh;
+    if (k == 0) r.mesh = TMesh(st.level[0]);
+    refine_below(r.mesh, st.level[k]);
+    const BoundaryRefinementReport rep = refine_to_boundary(r.mesh, r.boundary, {st.tol[k], opt.max_level});
+    if (last) r.refinement = rep;
+    clock.stop("tmesh");
+    if (last) {
+      std::ostringstream s;
+      s << "t-mesh: " << r.mesh.num_cells() << " cells, " << r.mesh.num_vertices() << " vertices ("
+        << r.mesh.num_hanging_vertices() << " hanging), max level " << r.mesh.max_level() << ", tolerance "
+        << r.tolerance_area;
+      log(s.str());
+      if (rep.edges_over_tolerance > 0)
+        log("warning: " + std::to_string(rep.edges_over_tolerance) +
+            " boundary edges still exceed the tolerance at the maximum level " + std::to_string(opt.max_level));
+      // The Coons start of the final T-mesh, for the report (and the start if not nested).
+      r.coons = coons_positions(r.mesh, r.boundary);
+      r.quality_coons = mesh_quality(r.mesh, r.coons);
+      log("coons: " + std::to_string(r.quality_coons.inverted_cells) + " inverted cells");
+      clock.stop("coons");
+    }
+    // Carry the previous stage over only if it was untangled: a coarse stage
+    // can be impossible to untangle (its boundary too coarse for a thin part of
+    // the domain), and then the Coons start of the finer mesh is the better start.
+    const bool carry = k > 0 && r.quality_optimized.inverted_cells == 0;
+    if (carry)
+      r.optimized = transfer_positions(coarse, r.optimized, r.mesh, r.boundary);
+    else
+      r.optimized = last ? r.coons : coons_positions(r.mesh, r.boundary);
+    // Intermediate stages only provide a start: a bounded number of sweeps.
+    sopt.max_sweeps = last ? opt.smoothing.max_sweeps : std::min(opt.smoothing.max_sweeps, 100);
+    optimize(last ? "final mesh" : "stage " + std::to_string(k + 1) + " of " + std::to_string(st.level.size()));
+    clock.stop("optimization");
+  }
+
   // Repair: cells that stay inverted lack interior freedom (typically thin
   // features of the domain). Refine them, place the new vertices in the current
   // physical mesh, re-balance and optimize again.
+  sopt.max_sweeps = opt.smoothing.max_sweeps;
   for (int round = 0; round < opt.max_repair_rounds && r.quality_optimized.inverted_cells > 0; ++round) {
     const std::vector<CellQuality> q = cell_qualities(r.mesh, r.optimized);
     const TMesh coarse = r.mesh;
@@ -142,9 +219,9 @@ FrontResult run_front(const Polygon& input, const ParameterizationOptions& opt) 
     r.repair_refined_cells.push_back(refined);
     log("repair round " + std::to_string(round + 1) + ": refined " + std::to_string(refined) +
         " inverted cells, now " + std::to_string(r.mesh.num_cells()) + " cells");
-    optimize();
+    optimize("repair " + std::to_string(round + 1));
+    clock.stop("repair");
   }
-  clock.stop("optimization");
   r.times = std::move(times);
   return r;
 }

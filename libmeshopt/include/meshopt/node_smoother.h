@@ -30,14 +30,17 @@ struct SmoothingProblem {
 };
 
 struct SmoothingOptions {
-  int max_sweeps = 200;
+  int max_sweeps = 500;
   /// Stop when max over nodes of |move| / (local length) < tolerance in one sweep,
   /// where local length is the mean distance to the submesh's other nodes.
-  double relative_displacement_tolerance = 1e-4;
+  double relative_displacement_tolerance = 1e-3;
   /// Newton iterations per node per visit.
   int newton_iterations_per_visit = 4;
   /// alpha of the delta rule (Gargallo-Peiro Eq. 37), in [1e-6, 1e-3] (accepted: (0, 1]).
   double alpha = 1e-3;
+  /// Over-relaxation factor omega in [1, 2) applied to each node's move once its
+  /// submesh is valid (nonlinear SOR); 1 is plain Gauss-Seidel.
+  double over_relaxation = 1.0;
   /// Armijo sufficient-decrease constant and maximum number of halvings.
   double armijo_c = 1e-4;
   int max_backtracks = 40;
@@ -51,6 +54,7 @@ struct SmoothingReport {
   double last_max_relative_move = 0.0;
   std::size_t tangled_nodes_before = 0;  ///< free nodes whose submesh has some sigma <= 0
   std::size_t tangled_nodes_after = 0;
+  std::size_t node_visits = 0;  ///< node optimizations over all sweeps (converged nodes are skipped)
   std::size_t newton_steps = 0;
   std::size_t gradient_fallbacks = 0;
 };

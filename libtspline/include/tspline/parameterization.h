@@ -32,6 +32,9 @@ struct ParameterizationOptions {
   /// If inverted cells remain after optimization, refine them, re-balance,
   /// re-optimize; at most this many rounds (0 disables the repair).
   int max_repair_rounds = 8;
+  /// Optimize on a nested sequence of coarser T-meshes first (same final mesh,
+  /// far fewer sweeps on fine meshes). false: optimize the final mesh from Coons.
+  bool nested_optimization = true;
   /// Node optimization settings (libmeshopt).
   meshopt::SmoothingOptions smoothing;
   /// Progress lines (stage names, counts); may be empty.
@@ -57,6 +60,7 @@ struct FrontResult {
   MeshQualityStats quality_optimized;
   meshopt::SmoothingReport smoothing;  ///< of the last optimization run
   int total_sweeps = 0;                 ///< over all optimization runs
+  std::size_t node_visits = 0;          ///< node optimizations over all runs
   /// Cells refined in each repair round (inverted cells after optimization).
   std::vector<std::size_t> repair_refined_cells;
   std::vector<StageTime> times;

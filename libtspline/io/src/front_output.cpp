@@ -118,6 +118,7 @@ nlohmann::json front_report(const FrontResult& r, const std::string& input_path)
       {"optimization",
        {{"sweeps", r.total_sweeps},
         {"sweeps_last_run", r.smoothing.sweeps},
+        {"node_visits", r.node_visits},
         {"repair_rounds", r.repair_refined_cells.size()},
         {"repair_refined_cells", r.repair_refined_cells},
         {"converged", r.smoothing.converged},
