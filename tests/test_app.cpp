@@ -10,6 +10,8 @@
 #include <sstream>
 #include <string>
 
+#include "test_support.h"
+
 namespace fs = std::filesystem;
 
 namespace {
@@ -52,7 +54,7 @@ fs::path write_file(const fs::path& dir, const std::string& name, const std::str
   return p;
 }
 
-std::string polygons(const std::string& name) { return std::string(TSPLINE_TEST_DATA_DIR) + "/polygons/" + name; }
+std::string polygons(const std::string& name) { return test_support::polygon_file(name); }
 
 std::size_t count_lines(const std::string& s) {
   std::size_t n = 0;

@@ -1,6 +1,8 @@
 // Boundary: validation, corners, chord-length map (reading: test_boundary_io.cpp).
 #include <doctest/doctest.h>
 
+#include "test_support.h"
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -20,31 +22,14 @@ using V2 = Eigen::Vector2d;
 namespace {
 
 std::string poly_path(const std::string& name) {
-  return std::string(TSPLINE_TEST_DATA_DIR) + "/polygons/" + name + ".txt";
+  return test_support::polygon_file(name + ".txt");
 }
 Polygon read(const std::string& name) { return io::read_polygon(poly_path(name)); }
 Polygon validated(const std::string& name) { return validate_polygon(read(name)); }
 
-Polygon make(const std::vector<V2>& v) {
-  Polygon p;
-  p.vertices = v;
-  for (std::size_t i = 0; i < v.size(); ++i) p.file_index.push_back(i);
-  return p;
-}
-
-// The message of the exception thrown by f, checking its type.
-template <class E, class F>
-std::string message_of(F&& f) {
-  try {
-    f();
-  } catch (const E& e) {
-    return e.what();
-  }
-  FAIL("no exception of the expected type");
-  return {};
-}
-
-bool contains(const std::string& s, const std::string& part) { return s.find(part) != std::string::npos; }
+Polygon make(const std::vector<V2>& v) { return test_support::make_polygon(v); }
+using test_support::contains;
+using test_support::message_of;
 
 const std::vector<std::pair<std::string, std::size_t>> kDomains = {
     {"square", 16}, {"lshape_cw", 48}, {"disk", 256},   {"flower", 400},

@@ -1,6 +1,8 @@
 // Boundary: reading polygons from text and GeoJSON (suite "boundary").
 #include <doctest/doctest.h>
 
+#include "test_support.h"
+
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -18,29 +20,12 @@ using V2 = Eigen::Vector2d;
 namespace {
 
 Polygon read(const std::string& name) {
-  return io::read_polygon(std::string(TSPLINE_TEST_DATA_DIR) + "/polygons/" + name + ".txt");
+  return io::read_polygon(test_support::polygon_file(name + ".txt"));
 }
 
-Polygon make(const std::vector<V2>& v) {
-  Polygon p;
-  p.vertices = v;
-  for (std::size_t i = 0; i < v.size(); ++i) p.file_index.push_back(i);
-  return p;
-}
-
-// The message of the exception thrown by f, checking its type.
-template <class E, class F>
-std::string message_of(F&& f) {
-  try {
-    f();
-  } catch (const E& e) {
-    return e.what();
-  }
-  FAIL("no exception of the expected type");
-  return {};
-}
-
-bool contains(const std::string& s, const std::string& part) { return s.find(part) != std::string::npos; }
+Polygon make(const std::vector<V2>& v) { return test_support::make_polygon(v); }
+using test_support::contains;
+using test_support::message_of;
 
 std::string geojson_ring(const std::vector<V2>& v) {
   std::ostringstream s;

@@ -4,6 +4,8 @@
 
 #include <iostream>
 
+#include "test_support.h"
+
 #include "tspline/io/polygon_reader.h"
 #include "tspline/parameterization.h"
 
@@ -12,7 +14,7 @@ TEST_SUITE("parameterization") {
     for (const std::string name : {"square.txt", "lshape_cw.txt", "disk.txt", "flower.txt", "cshape.txt", "gear.txt",
                              "blob_bay.txt", "fjords.txt"}) {
       CAPTURE(name);
-      const auto poly = tspline::io::read_polygon(std::string(TSPLINE_TEST_DATA_DIR) + "/polygons/" + name);
+      const auto poly = tspline::io::read_polygon(test_support::polygon_file(name));
       const tspline::FrontResult r = tspline::run_front(poly, {});
       MESSAGE(name << ": " << r.mesh.num_cells() << " cells, inverted after Coons "
                    << r.quality_coons.inverted_cells << ", after optimization " << r.quality_optimized.inverted_cells
@@ -34,7 +36,7 @@ TEST_SUITE("parameterization") {
 
 TEST_SUITE("parameterization") {
   TEST_CASE("nested optimization ends on the same T-mesh as the direct one, and as good") {
-    const auto poly = tspline::io::read_polygon(std::string(TSPLINE_TEST_DATA_DIR) + "/polygons/flower.txt");
+    const auto poly = tspline::io::read_polygon(test_support::polygon_file("flower.txt"));
     tspline::ParameterizationOptions opt;
     opt.initial_level = 5;
     opt.smoothing.relative_displacement_tolerance = 1e-5;

@@ -3,6 +3,8 @@
 
 #include <random>
 
+#include "test_support.h"
+
 #include "tspline/boundary_refinement.h"
 #include "tspline/coons.h"
 #include "tspline/corners.h"
@@ -15,10 +17,8 @@ using tspline::TMesh;
 
 namespace {
 
-std::string data(const std::string& name) { return std::string(TSPLINE_TEST_DATA_DIR) + "/polygons/" + name; }
-
 tspline::BoundaryMap load_boundary(const std::string& name) {
-  tspline::Polygon p = tspline::validate_polygon(tspline::io::read_polygon(data(name)));
+  tspline::Polygon p = tspline::validate_polygon(tspline::io::read_polygon(test_support::polygon_file(name)));
   tspline::Corners c = tspline::choose_corners(p);
   return tspline::BoundaryMap(std::move(p), std::move(c));
 }
@@ -145,7 +145,7 @@ TEST_SUITE("tmesh") {
       }
     const tspline::BoundaryMap disk = load_boundary("disk.txt");
     for (double s : {0.0, 0.3, 0.77, 1.0}) {
-      for (const Eigen::Vector2d uv : {Eigen::Vector2d(s, 0.0), Eigen::Vector2d(s, 1.0), Eigen::Vector2d(0.0, s),
+      for (const Eigen::Vector2d& uv : {Eigen::Vector2d(s, 0.0), Eigen::Vector2d(s, 1.0), Eigen::Vector2d(0.0, s),
                                        Eigen::Vector2d(1.0, s)}) {
         CHECK((tspline::coons_point(disk, uv) - disk.point_at(uv)).norm() < 1e-14);
       }
