@@ -1,13 +1,19 @@
 #!/usr/bin/env bash
-# Stage timings of the front half at about 1e3, 1e4 and 1e5 cells (Release build).
+# Stage timings of the front half at about 1e3, 1e4, 1e5 (and 2.6e5) cells, Release build.
 # Usage: bash bench/run_benchmarks.sh [POLYGON]   (default: tests/data/polygons/flower.txt)
+# A second table refines a boundary-dominated domain (fjords) by tolerance alone.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 POLY=${1:-tests/data/polygons/flower.txt}
 BUILD_DIR=build BUILD_TYPE=Release bash scripts/build.sh > /dev/null
-echo "domain: $POLY"
-printf "%9s %9s %9s %9s %9s %9s %6s %9s %8s\n" cells vertices boundary tmesh coons optimize sweeps peak_MiB inverted
-# Sizes are set by the initial uniform level (the boundary tolerance adds a little).
-for level in 5 7 8; do
+header() { printf "%9s %9s %9s %9s %9s %9s %6s %9s %8s\n" cells vertices boundary tmesh coons optimize sweeps peak_MiB inverted; }
+echo "domain: $POLY (size set by the initial uniform level 5, 7, 8, 9; tol-rel 1e-6)"
+header
+for level in 5 7 8 9; do
   ./build/bench/bench_front "$POLY" "$level" 1e-6
+done
+echo "domain: tests/data/polygons/fjords.txt (initial level 3; size set by tol-rel 1e-5, 1e-7, 1e-8)"
+header
+for tol in 1e-5 1e-7 1e-8; do
+  ./build/bench/bench_front tests/data/polygons/fjords.txt 3 "$tol"
 done

@@ -91,8 +91,8 @@ FrontResult run_front(const Polygon& input, const ParameterizationOptions& opt) 
   auto log = [&](const std::string& s) {
     if (opt.log) opt.log(s);
   };
-  if (opt.initial_level < 0 || opt.initial_level > 12)
-    throw InputError("--init-level must be in [0, 12], got " + std::to_string(opt.initial_level));
+  if (opt.initial_level < 0 || opt.initial_level > 10)  // 2^10 x 2^10 = 10^6 cells, about 1 GB
+    throw InputError("--init-level must be in [0, 10], got " + std::to_string(opt.initial_level));
   if (opt.max_level < std::max(1, opt.initial_level) || opt.max_level > TMesh::kMaxLevel)
     throw InputError("--max-level must be in [max(1, init-level), " + std::to_string(TMesh::kMaxLevel) + "]");
   if (opt.tolerance_absolute && !(*opt.tolerance_absolute > 0.0 && std::isfinite(*opt.tolerance_absolute)))
