@@ -86,6 +86,10 @@ int main(int argc, char** argv) {
   param->add_option("--corners", corners,
                     "Four vertex indices i,j,k,l (0-based, the file's own numbering, in cyclic file order) "
                     "mapped to (0,0),(1,0),(1,1),(0,1); default: automatic choice explained in report.json");
+  param->add_option("--corner-trials", opt.corner_trials,
+                    "Automatic corners: run this many of the best choices and keep the one with the fewest "
+                    "inverted cells, then the best min + mean quality (1: no trials)")
+      ->capture_default_str();
   auto* tol_opt = param->add_option("--tol", tol,
                                     "Boundary tolerance epsilon as an absolute AREA (units^2): a boundary cell "
                                     "is refined while a polygon vertex forms with its edge a triangle larger "

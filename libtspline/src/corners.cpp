@@ -181,7 +181,13 @@ Corners corners_from_file_indices(const Polygon& p, const std::array<long long, 
   return c;
 }
 
-Corners choose_corners(const Polygon& p) {
+namespace {
+Corners finish_choice(const Polygon& p, const std::vector<double>& cum, const std::array<std::size_t, 4>& pick,
+                      double best_cost, std::size_t K);
+}  // namespace
+
+std::vector<Corners> corner_candidates(const Polygon& p, std::size_t count) {
+  if (count == 0) return {};
   const std::size_t n = p.vertices.size();
   if (n < 4 || p.file_index.size() != n) throw InputError("corners: the polygon must be validated first");
   const auto cum = arc_lengths(p);
@@ -236,9 +242,13 @@ Corners choose_corners(const Polygon& p) {
   cand.erase(std::unique(cand.begin(), cand.end()), cand.end());
 
   // Exhaustive search over ordered quadruples of candidates: O(K^4), K <= 72.
+  // Keep the kKeep cheapest in a max-heap, then pick up to `count` of them that
+  // differ from each other (some corner more than 2% of the perimeter away).
   const std::size_t K = cand.size();
-  double best_cost = std::numeric_limits<double>::infinity();
-  std::array<std::size_t, 4> pick{};
+  using Choice = std::pair<double, std::array<std::size_t, 4>>;
+  constexpr std::size_t kKeep = 256;
+  std::vector<Choice> heap;
+  heap.reserve(kKeep + 1);
   for (std::size_t a = 0; a < K; ++a)
     for (std::size_t b = a + 1; b < K; ++b)
       for (std::size_t c = b + 1; c < K; ++c)
@@ -247,11 +257,37 @@ Corners choose_corners(const Polygon& p) {
           const double L[4] = {cum[q[1]] - cum[q[0]], cum[q[2]] - cum[q[1]], cum[q[3]] - cum[q[2]],
                                per - (cum[q[3]] - cum[q[0]])};
           const double cost = choice_cost(L, vc[q[0]] + vc[q[1]] + vc[q[2]] + vc[q[3]]);
-          if (cost < best_cost) {
-            best_cost = cost;
-            pick = {q[0], q[1], q[2], q[3]};
+          if (heap.size() == kKeep && cost >= heap.front().first) continue;
+          heap.push_back({cost, {q[0], q[1], q[2], q[3]}});
+          std::push_heap(heap.begin(), heap.end());
+          if (heap.size() > kKeep) {
+            std::pop_heap(heap.begin(), heap.end());
+            heap.pop_back();
           }
         }
+  std::sort_heap(heap.begin(), heap.end());  // ascending cost
+  std::vector<Corners> result;
+  std::vector<std::array<std::size_t, 4>> kept;
+  for (const Choice& ch : heap) {
+    if (result.size() == count) break;
+    const bool distinct = std::all_of(kept.begin(), kept.end(), [&](const std::array<std::size_t, 4>& k) {
+      for (int i = 0; i < 4; ++i)
+        if (arc_dist(k[i], ch.second[i]) > 0.02 * per) return true;
+      return false;
+    });
+    if (!distinct) continue;
+    kept.push_back(ch.second);
+    result.push_back(finish_choice(p, cum, ch.second, ch.first, K));
+  }
+  return result;
+}
+
+Corners choose_corners(const Polygon& p) { return corner_candidates(p, 1).front(); }
+
+namespace {
+
+Corners finish_choice(const Polygon& p, const std::vector<double>& cum, const std::array<std::size_t, 4>& pick,
+                      double best_cost, std::size_t K) {
   // Which corner becomes (0,0): the one whose outgoing chord (to the next corner,
   // the image of the bottom side) points most nearly along +x, so the parametric
   // square is oriented like the domain.
@@ -275,5 +311,7 @@ Corners choose_corners(const Polygon& p) {
   describe(p, out, "Automatic", why);
   return out;
 }
+
+}  // namespace
 
 }  // namespace tspline

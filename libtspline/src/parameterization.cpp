@@ -87,47 +87,18 @@ double bbox_diagonal(const Polygon& p) {
 
 }  // namespace
 
-FrontResult run_front(const Polygon& input, const ParameterizationOptions& opt) {
+namespace {
+
+// Everything after the corners: adapted T-mesh, Coons start, nested optimization
+// and repair. `clock` may be null (trial runs).
+FrontResult optimize_front(BoundaryMap boundary, const ParameterizationOptions& opt, StageClock* clock_or_null) {
   auto log = [&](const std::string& s) {
     if (opt.log) opt.log(s);
   };
-  if (opt.initial_level < 0 || opt.initial_level > 10)  // 2^10 x 2^10 = 10^6 cells, about 1 GB
-    throw InputError("--init-level must be in [0, 10], got " + std::to_string(opt.initial_level));
-  if (opt.max_level < std::max(1, opt.initial_level) || opt.max_level > TMesh::kMaxLevel)
-    throw InputError("--max-level must be in [max(1, init-level), " + std::to_string(TMesh::kMaxLevel) + "]");
-  if (opt.tolerance_absolute && !(*opt.tolerance_absolute > 0.0 && std::isfinite(*opt.tolerance_absolute)))
-    throw InputError("--tol must be a positive finite area");
-  if (!(opt.tolerance_relative > 0.0 && std::isfinite(opt.tolerance_relative)))
-    throw InputError("--tol-rel must be a positive finite number");
-  if (opt.max_repair_rounds < 0) throw InputError("the number of repair rounds must be >= 0");
-
-  std::vector<StageTime> times;
-  StageClock clock(times);
-  Polygon poly = validate_polygon(input);
-  Corners corners = opt.corners ? corners_from_file_indices(poly, *opt.corners) : choose_corners(poly);
-  // A corner where the polygon is straight or reflex makes the corner cell
-  // degenerate or folded whatever the interior does: reject it.
-  for (int k = 0; k < 4; ++k) {
-    const std::size_t n = poly.vertices.size(), i = corners.index[k];
-    const Eigen::Vector2d a = poly.vertices[(i + n - 1) % n], b = poly.vertices[i], c = poly.vertices[(i + 1) % n];
-    const Eigen::Vector2d u = b - a, w = c - b;
-    if (!(u.x() * w.y() - u.y() * w.x() > 0.0)) {
-      std::ostringstream s;
-      s << "corner " << k << " (file vertex " << poly.file_index[i] << ") has an inner angle of "
-        << corners.inner_angle_deg[k] << " degrees: corners must be convex vertices (inner angle below 180)";
-      throw InputError(s.str());
-    }
-  }
-  {
-    std::ostringstream s;
-    s << "boundary: " << poly.vertices.size() << " vertices, corners (file indices) "
-      << poly.file_index[corners.index[0]] << "," << poly.file_index[corners.index[1]] << ","
-      << poly.file_index[corners.index[2]] << "," << poly.file_index[corners.index[3]]
-      << (opt.corners ? " (given)" : " (automatic)");
-    log(s.str());
-  }
-  FrontResult r{BoundaryMap(std::move(poly), std::move(corners))};
-  clock.stop("boundary");
+  std::vector<StageTime> scratch_times;
+  StageClock scratch(scratch_times);
+  StageClock& clock = clock_or_null ? *clock_or_null : scratch;
+  FrontResult r{std::move(boundary)};
 
   r.tolerance_is_relative = !opt.tolerance_absolute.has_value();
   const double diag = bbox_diagonal(r.boundary.polygon());
@@ -222,6 +193,90 @@ FrontResult run_front(const Polygon& input, const ParameterizationOptions& opt) 
     optimize("repair " + std::to_string(round + 1));
     clock.stop("repair");
   }
+  return r;
+}
+
+}  // namespace
+
+FrontResult run_front(const Polygon& input, const ParameterizationOptions& opt) {
+  auto log = [&](const std::string& s) {
+    if (opt.log) opt.log(s);
+  };
+  if (opt.initial_level < 0 || opt.initial_level > 10)  // 2^10 x 2^10 = 10^6 cells, about 1 GB
+    throw InputError("--init-level must be in [0, 10], got " + std::to_string(opt.initial_level));
+  if (opt.max_level < std::max(1, opt.initial_level) || opt.max_level > TMesh::kMaxLevel)
+    throw InputError("--max-level must be in [max(1, init-level), " + std::to_string(TMesh::kMaxLevel) + "]");
+  if (opt.tolerance_absolute && !(*opt.tolerance_absolute > 0.0 && std::isfinite(*opt.tolerance_absolute)))
+    throw InputError("--tol must be a positive finite area");
+  if (!(opt.tolerance_relative > 0.0 && std::isfinite(opt.tolerance_relative)))
+    throw InputError("--tol-rel must be a positive finite number");
+  if (opt.max_repair_rounds < 0) throw InputError("the number of repair rounds must be >= 0");
+  if (opt.corner_trials < 1) throw InputError("--corner-trials must be >= 1");
+
+  std::vector<StageTime> times;
+  StageClock clock(times);
+  Polygon poly = validate_polygon(input);
+  Corners corners;
+  std::vector<CornerTrial> trials;
+  if (opt.corners) {
+    corners = corners_from_file_indices(poly, *opt.corners);
+  } else {
+    std::vector<Corners> cands = corner_candidates(poly, static_cast<std::size_t>(std::max(1, opt.corner_trials)));
+    corners = cands.front();
+    if (cands.size() > 1) {
+      // Try the best few automatic choices (with the initial level capped at 5,
+      // which is the full problem for the default options) and keep the one with
+      // the fewest inverted cells, then the highest min + mean triangle quality
+      // (the minimum guards validity margins, the mean the overall distortion).
+      ParameterizationOptions topt = opt;
+      topt.log = nullptr;
+      topt.smoothing.progress = nullptr;
+      topt.corner_trials = 1;
+      topt.initial_level = std::min(opt.initial_level, 5);
+      std::size_t best = 0;
+      for (std::size_t k = 0; k < cands.size(); ++k) {
+        const FrontResult t = optimize_front(BoundaryMap(poly, cands[k]), topt, nullptr);
+        trials.push_back({cands[k].index, t.quality_optimized.inverted_cells, t.quality_optimized.min_quality,
+                          t.quality_optimized.mean_quality});
+        const CornerTrial& a = trials[k];
+        const CornerTrial& b = trials[best];
+        if (a.inverted_cells < b.inverted_cells ||
+            (a.inverted_cells == b.inverted_cells &&
+             a.min_quality + a.mean_quality > b.min_quality + b.mean_quality))
+          best = k;
+      }
+      corners = cands[best];
+      corners.explanation += " Of the " + std::to_string(cands.size()) +
+                             " best automatic choices, tried on the T-mesh, this one gave the fewest inverted "
+                             "cells and the best min + mean triangle quality (choice " + std::to_string(best + 1) + ").";
+      log("corners: tried " + std::to_string(cands.size()) + " automatic choices, kept choice " +
+          std::to_string(best + 1));
+    }
+  }
+  // A corner where the polygon is straight or reflex makes the corner cell
+  // degenerate or folded whatever the interior does: reject it.
+  for (int k = 0; k < 4; ++k) {
+    const std::size_t n = poly.vertices.size(), i = corners.index[k];
+    const Eigen::Vector2d a = poly.vertices[(i + n - 1) % n], b = poly.vertices[i], c = poly.vertices[(i + 1) % n];
+    const Eigen::Vector2d u = b - a, w = c - b;
+    if (!(u.x() * w.y() - u.y() * w.x() > 0.0)) {
+      std::ostringstream s;
+      s << "corner " << k << " (file vertex " << poly.file_index[i] << ") has an inner angle of "
+        << corners.inner_angle_deg[k] << " degrees: corners must be convex vertices (inner angle below 180)";
+      throw InputError(s.str());
+    }
+  }
+  {
+    std::ostringstream s;
+    s << "boundary: " << poly.vertices.size() << " vertices, corners (file indices) "
+      << poly.file_index[corners.index[0]] << "," << poly.file_index[corners.index[1]] << ","
+      << poly.file_index[corners.index[2]] << "," << poly.file_index[corners.index[3]]
+      << (opt.corners ? " (given)" : " (automatic)");
+    log(s.str());
+  }
+  clock.stop("boundary");
+  FrontResult r = optimize_front(BoundaryMap(std::move(poly), std::move(corners)), opt, &clock);
+  r.corner_trials = std::move(trials);
   r.times = std::move(times);
   return r;
 }

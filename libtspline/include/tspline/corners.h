@@ -3,6 +3,7 @@
 #include <array>
 #include <cstddef>
 #include <string>
+#include <vector>
 
 #include "tspline/polygon.h"
 
@@ -40,5 +41,10 @@ Corners corners_from_file_indices(const Polygon& ccw_polygon, const std::array<l
 /// corner whose chord to the next corner points most nearly along +x maps to (0,0).
 /// The explanation says why.
 Corners choose_corners(const Polygon& ccw_polygon);
+
+/// The `count` cheapest automatic choices (by the same cost; the first is
+/// choose_corners()), mutually distinct: any two differ in some corner by more
+/// than 2% of the perimeter. Fewer if there are not that many.
+std::vector<Corners> corner_candidates(const Polygon& ccw_polygon, std::size_t count);
 
 }  // namespace tspline

@@ -21,6 +21,10 @@ namespace tspline {
 struct ParameterizationOptions {
   /// Corner vertex indices in the file's own numbering; automatic if empty.
   std::optional<std::array<long long, 4>> corners;
+  /// Automatic corners: how many of the best choices to try (the whole front
+  /// half, initial level capped at 5) before keeping the one with the fewest
+  /// inverted cells, then the best min + mean triangle quality. 1: no trials.
+  int corner_trials = 4;
   /// Boundary tolerance epsilon (an AREA, Sect. 3). If unset, epsilon =
   /// tolerance_relative * (bounding-box diagonal)^2.
   std::optional<double> tolerance_absolute;
@@ -46,6 +50,14 @@ struct StageTime {
   double seconds = 0.0;
 };
 
+/// One automatic corner choice tried on a coarser T-mesh.
+struct CornerTrial {
+  std::array<std::size_t, 4> corners{};  ///< indices into the CCW polygon
+  std::size_t inverted_cells = 0;
+  double min_quality = 0.0;
+  double mean_quality = 0.0;
+};
+
 /// Everything the front half produces, for writers and reports.
 struct FrontResult {
   explicit FrontResult(BoundaryMap b) : boundary(std::move(b)) {}
@@ -63,6 +75,7 @@ struct FrontResult {
   std::size_t node_visits = 0;          ///< node optimizations over all runs
   /// Cells refined in each repair round (inverted cells after optimization).
   std::vector<std::size_t> repair_refined_cells;
+  std::vector<CornerTrial> corner_trials;  ///< empty unless automatic corners were tried
   std::vector<StageTime> times;
 };
 

@@ -93,6 +93,15 @@ nlohmann::json front_report(const FrontResult& r, const std::string& input_path)
   }
   json chains = json::array();
   for (int s = 0; s < 4; ++s) chains.push_back(r.boundary.chain_length(static_cast<Side>(s)));
+  json trials = json::array();
+  for (const CornerTrial& t : r.corner_trials) {
+    json idx = json::array();
+    for (std::size_t i : t.corners) idx.push_back(p.file_index[i]);
+    trials.push_back({{"file_indices", idx},
+                      {"inverted_cells", t.inverted_cells},
+                      {"min_mean_ratio", t.min_quality},
+                      {"mean_mean_ratio", t.mean_quality}});
+  }
   json times = json::object();
   double total = 0.0;
   for (const auto& t : r.times) times[t.stage] = t.seconds, total += t.seconds;
@@ -112,7 +121,7 @@ nlohmann::json front_report(const FrontResult& r, const std::string& input_path)
         {"balance_splits", r.refinement.balance_splits},
         {"edges_over_tolerance", r.refinement.edges_over_tolerance},
         {"max_edge_error", r.refinement.max_error}}},
-      {"corners", {{"vertices", corners}, {"chain_lengths", chains}, {"explanation", c.explanation}}},
+      {"corners", {{"vertices", corners}, {"chain_lengths", chains}, {"explanation", c.explanation}, {"trials", trials}}},
       {"coons", quality_json(r.quality_coons)},
       {"optimized", quality_json(r.quality_optimized)},
       {"optimization",
