@@ -1,0 +1,35 @@
+#pragma once
+// The T-spline file (tspline.json): a documented, versioned JSON format that
+// another program can read (see docs/tspline_format.md).
+#include <array>
+#include <cstddef>
+#include <string>
+
+#include "tspline/polygon.h"
+#include "tspline/tspline_map.h"
+
+namespace tspline::io {
+
+/// What the file records besides the map itself.
+struct TSplineFileMeta {
+  std::string source;                        ///< input file the map was built from (informative)
+  Polygon boundary;                          ///< the domain polygon, CCW, with file_index
+  std::array<std::size_t, 4> corners{};      ///< corner indices into `boundary` ((0,0),(1,0),(1,1),(0,1))
+};
+
+/// Writes the map atomically. Doubles are written so that they read back bit-identically.
+/// \throw IoError.
+void write_tspline_file(const std::string& path, const TSplineMap& map, const TSplineFileMeta& meta);
+
+struct LoadedTSpline {
+  TSplineMap map;
+  TSplineFileMeta meta;
+};
+
+/// Reads a T-spline file, rebuilds the T-mesh and basis, and checks that the
+/// stored knot vectors are the ones the basis produces.
+/// \throw IoError (unreadable), InputError (malformed, unsupported version,
+/// inconsistent or non-finite data; the message names the JSON path).
+LoadedTSpline read_tspline_file(const std::string& path);
+
+}  // namespace tspline::io
