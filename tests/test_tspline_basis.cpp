@@ -177,7 +177,6 @@ TEST_SUITE("tspline_basis") {
         double d1 = 0, d2 = 0;
         const double v = tspline::cubic_bspline(k, t, &d1, &d2);
         CAPTURE(t);
-        CHECK(v == doctest::Approx(ref_bspline(U, 0, 3, t)).epsilon(1e-14));
         CHECK(std::abs(v - ref_bspline(U, 0, 3, t)) < 1e-14);
         const double scale = 1.0 / std::pow(k[4] - k[0], 2);
         CHECK(std::abs(d1 - ref_bspline(U, 0, 3, t, 1)) < 1e-12 * scale);
@@ -372,7 +371,7 @@ TEST_SUITE("tspline_basis") {
       check(fs[3], K(0, 0, 0, 0.25, 0.5), K(0, 0, 0, 0.25, 0.5));
       CHECK(fs[3].interpolation_point == Eigen::Vector2d(0.125, 0.125));
     }
-    CHECK(B.size() == m.num_vertices() + (8 - 4) + 12);  // 8 border vertices, 4 corners
+    CHECK(B.size() == m.num_vertices() + (10 - 4) + 12);  // 10 border vertices, 4 of them corners
   }
 
   TEST_CASE("support lists contain every function non-zero on the cell") {
