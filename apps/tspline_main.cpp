@@ -12,6 +12,7 @@
 #include <sstream>
 #include <string>
 
+#include "commands.h"
 #include "tspline/errors.h"
 #include "tspline/io/atomic_file.h"
 #include "tspline/io/front_output.h"
@@ -113,6 +114,8 @@ int main(int argc, char** argv) {
                                    "GeoJSON MultiPolygon/FeatureCollection: which polygon (0-based); default "
                                    "the largest");
   param->add_flag("--quiet,-q", quiet, "Print errors only");
+  tspline_app::CommandAction command;  // set by the other subcommands when parsed (commands.h)
+  tspline_app::add_tspline_file_commands(app, command);
 
   try {
     app.parse(argc, argv);
@@ -125,6 +128,7 @@ int main(int argc, char** argv) {
     return 1;
   }
   try {
+    if (command) return command();
     if (param->parsed()) {
       if (tol_opt->count() > 0) opt.tolerance_absolute = tol;
       std::optional<std::size_t> gj;

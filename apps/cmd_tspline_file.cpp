@@ -1,0 +1,143 @@
+// `tspline eval` and `tspline info`: read a T-spline file (docs/tspline_format.md)
+// and evaluate the map S at given parametric points, or describe the file.
+#include <Eigen/Dense>
+#include <algorithm>
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <limits>
+#include <memory>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "commands.h"
+#include "tspline/errors.h"
+#include "tspline/io/tspline_file.h"
+
+namespace tspline_app {
+
+namespace {
+
+// The format version read_tspline_file accepts (docs/tspline_format.md).
+constexpr int kTSplineFormatVersion = 1;
+
+struct EvalArgs {
+  std::string file;
+  std::vector<std::pair<std::string, std::string>> at;
+  bool derivatives = false;
+};
+
+double parse_coordinate(const std::string& text, const char* name) {
+  errno = 0;
+  char* end = nullptr;
+  const double v = std::strtod(text.c_str(), &end);
+  if (text.empty() || end != text.c_str() + text.size() || errno == ERANGE || !std::isfinite(v))
+    throw tspline::InputError(std::string("--at: ") + name + " = '" + text + "' is not a finite number");
+  if (v < 0.0 || v > 1.0)
+    throw tspline::InputError(std::string("--at: ") + name + " = " + text +
+                              " is outside the parametric domain [0, 1]");
+  return v;
+}
+
+int run_eval(const EvalArgs& args) {
+  // Validate the points before reading a possibly large file.
+  std::vector<Eigen::Vector2d> points;
+  for (const auto& [u, v] : args.at) points.emplace_back(parse_coordinate(u, "U"), parse_coordinate(v, "V"));
+  const tspline::io::LoadedTSpline t = tspline::io::read_tspline_file(args.file);
+  for (const Eigen::Vector2d& uv : points) {
+    if (args.derivatives) {
+      const tspline::MapDerivatives d = t.map.derivatives(uv, 1);
+      std::printf("%.17g %.17g %.17g %.17g %.17g %.17g %.17g %.17g %.17g\n", uv.x(), uv.y(), d.x.x(), d.x.y(),
+                  d.J(0, 0), d.J(1, 0), d.J(0, 1), d.J(1, 1), d.J.determinant());
+    } else {
+      const Eigen::Vector2d x = t.map.point(uv);
+      std::printf("%.17g %.17g %.17g %.17g\n", uv.x(), uv.y(), x.x(), x.y());
+    }
+  }
+  std::fflush(stdout);
+  if (std::ferror(stdout)) throw tspline::IoError("cannot write to standard output");
+  return 0;
+}
+
+struct Box {
+  Eigen::Vector2d lo = Eigen::Vector2d::Constant(std::numeric_limits<double>::infinity());
+  Eigen::Vector2d hi = -lo;
+  void add(const Eigen::Vector2d& p) {
+    lo = lo.cwiseMin(p);
+    hi = hi.cwiseMax(p);
+  }
+};
+
+void print_box(const char* label, const Box& b) {
+  std::printf("%s: [%.17g, %.17g] x [%.17g, %.17g]\n", label, b.lo.x(), b.hi.x(), b.lo.y(), b.hi.y());
+}
+
+int run_info(const std::string& file) {
+  const tspline::io::LoadedTSpline t = tspline::io::read_tspline_file(file);
+  const tspline::TMesh& mesh = t.map.mesh();
+  const tspline::TSplineBasis& basis = t.map.basis();
+  std::size_t by_kind[3] = {0, 0, 0};
+  for (const tspline::BlendingFunction& f : basis.functions()) ++by_kind[static_cast<int>(f.kind)];
+  std::printf("format: tspline version %d (degree 3)\n", kTSplineFormatVersion);
+  std::printf("source: %s\n", t.meta.source.c_str());
+  std::printf("cells: %zu\n", mesh.num_cells());
+  std::printf("vertices: %zu\n", mesh.num_vertices());
+  std::printf("hanging vertices: %zu\n", mesh.num_hanging_vertices());
+  std::printf("functions: %zu (anchor %zu, edge %zu, corner %zu)\n", basis.size(), by_kind[0], by_kind[1],
+              by_kind[2]);
+  std::printf("max level: %d\n", mesh.max_level());
+  Box cp;
+  for (const Eigen::Vector2d& p : t.map.control_points()) cp.add(p);
+  print_box("control points bounding box", cp);
+  const tspline::Polygon& poly = t.meta.boundary;
+  if (poly.vertices.empty()) {
+    std::printf("boundary: none recorded\n");
+    return 0;
+  }
+  Box bb;
+  for (const Eigen::Vector2d& p : poly.vertices) bb.add(p);
+  std::printf("boundary polygon: %zu vertices\n", poly.vertices.size());
+  print_box("boundary bounding box", bb);
+  static const char* kCorner[4] = {"(0,0)", "(1,0)", "(1,1)", "(0,1)"};
+  for (int k = 0; k < 4; ++k) {
+    const std::size_t c = t.meta.corners[k];
+    std::printf("corner %s: polygon vertex %zu (file index %zu) at %.17g %.17g\n", kCorner[k], c, poly.file_index[c],
+                poly.vertices[c].x(), poly.vertices[c].y());
+  }
+  return 0;
+}
+
+}  // namespace
+
+void add_tspline_file_commands(CLI::App& app, CommandAction& action) {
+  auto eval_args = std::make_shared<EvalArgs>();
+  CLI::App* eval = app.add_subcommand(
+      "eval",
+      "Evaluate the T-spline map S(u, v) of a T-spline file at parametric points. Prints one line per point: "
+      "'u v x y' (with --derivatives also 'dx/du dy/du dx/dv dy/dv det_J'), numbers with 17 significant digits");
+  eval->add_option("TSPLINE", eval_args->file, "T-spline file (tspline.json, see docs/tspline_format.md)")
+      ->type_name("FILE")
+      ->required();
+  eval->add_option("--at", eval_args->at,
+                   "Parametric point U V, both in [0, 1] (u along xi, v along eta); repeat for several points, "
+                   "printed in the given order")
+      ->type_name("U V")
+      ->required();
+  eval->add_flag("--derivatives,-d", eval_args->derivatives,
+                 "Also print the Jacobian columns dS/du = (dx/du, dy/du), dS/dv = (dx/dv, dy/dv) and det J");
+  eval->callback([eval_args, &action] { action = [eval_args] { return run_eval(*eval_args); }; });
+
+  auto info_file = std::make_shared<std::string>();
+  CLI::App* info = app.add_subcommand(
+      "info",
+      "Describe a T-spline file: format version, source, T-mesh counts (cells, vertices, hanging vertices, max "
+      "level), blending functions by kind, bounding boxes of the control points and the boundary polygon, corners");
+  info->add_option("TSPLINE", *info_file, "T-spline file (tspline.json, see docs/tspline_format.md)")
+      ->type_name("FILE")
+      ->required();
+  info->callback([info_file, &action] { action = [info_file] { return run_info(*info_file); }; });
+}
+
+}  // namespace tspline_app

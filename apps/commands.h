@@ -1,0 +1,20 @@
+#pragma once
+// Subcommands of the `tspline` program that live outside tspline_main.cpp.
+//
+// Each add_*_commands() registers its subcommands on `app`. When one of them is
+// parsed, its callback stores the work to do in `action`; main() then runs
+// `action()` inside its usual error handling (InputError -> exit 1, IoError ->
+// exit 2, anything else -> exit 4), and returns the exit code it yields.
+#include <CLI/CLI.hpp>
+#include <functional>
+
+namespace tspline_app {
+
+/// The work of the parsed subcommand; returns the process exit code.
+using CommandAction = std::function<int()>;
+
+/// `tspline eval` and `tspline info`: evaluate / describe a T-spline file
+/// (docs/tspline_format.md).
+void add_tspline_file_commands(CLI::App& app, CommandAction& action);
+
+}  // namespace tspline_app
