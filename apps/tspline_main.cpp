@@ -3,19 +3,22 @@
 //   exit 0  success
 //   exit 1  invalid input (polygon, corners, options)
 //   exit 2  file could not be read or written
-//   exit 3  the run finished but the result is not valid (inverted cells remain)
+//   exit 3  the run finished but the map is not valid (det J <= 0 somewhere),
+//           or a numerical step failed (e.g. a singular interpolation system)
 //   exit 4  unexpected internal error
 #include <CLI/CLI.hpp>
 #include <array>
 #include <cstdio>
 #include <iostream>
+#include <optional>
 #include <sstream>
 #include <string>
 
 #include "commands.h"
 #include "tspline/errors.h"
 #include "tspline/io/atomic_file.h"
-#include "tspline/io/front_output.h"
+#include "tspline/adaptive_parameterization.h"
+#include "tspline/io/param_output.h"
 #include "tspline/io/polygon_reader.h"
 #include "tspline/parameterization.h"
 
@@ -43,8 +46,10 @@ std::array<long long, 4> parse_corners(const std::string& text) {
 }
 
 int run_param(const std::string& input, const std::string& out_dir, const std::string& corners_text,
-              tspline::ParameterizationOptions opt, std::optional<std::size_t> geojson_polygon, bool quiet) {
+              tspline::ParameterizationOptions opt, const tspline::AdaptiveOptions& adaptive, int samples,
+              std::optional<std::size_t> geojson_polygon, bool quiet) {
   if (!corners_text.empty()) opt.corners = parse_corners(corners_text);
+  if (samples < 1 || samples > 64) throw tspline::InputError("--samples must be in [1, 64]");
   if (!quiet) opt.log = [](const std::string& line) { std::cout << line << std::endl; };
   // Fail on an unwritable output directory before any computation.
   tspline::io::ensure_writable_directory(out_dir);
@@ -53,16 +58,27 @@ int run_param(const std::string& input, const std::string& out_dir, const std::s
   ropt.polygon_index = geojson_polygon;
   const tspline::Polygon polygon = tspline::io::read_polygon(input, ropt, &warnings);
   if (!warnings.empty() && !quiet) std::cout << "note: " << warnings << std::endl;
-  const tspline::FrontResult result = tspline::run_front(polygon, opt);
-  const nlohmann::json report = tspline::io::front_report(result, input);
-  tspline::io::write_front_outputs(result, out_dir, report);
-  if (!quiet) std::cout << "wrote parametric_tmesh.vtu, physical_tmesh.vtu, boundary.vtu, report.json to " << out_dir << std::endl;
-  if (result.quality_optimized.inverted_cells > 0) {
-    std::cerr << "tspline: error: " << result.quality_optimized.inverted_cells
-              << " cells are still inverted after optimization (see physical_tmesh.vtu, cell data 'valid')"
-              << std::endl;
+  tspline::io::AdaptSeriesWriter series(out_dir, samples);
+  const tspline::ParameterizationResult result = tspline::run_parameterization(
+      polygon, opt, adaptive,
+      [&](int it, const tspline::TMesh& mesh, const std::vector<Eigen::Vector2d>& x, const tspline::TSplineMap& map,
+          const std::vector<tspline::CellMapQuality>&) { series.add(it, mesh, x, map); });
+  series.finish();
+  const nlohmann::json report = tspline::io::param_report(result, input, adaptive);
+  tspline::io::write_param_outputs(result, out_dir, report, samples);
+  if (!quiet)
+    std::cout << "wrote tspline.json, surface.vtu, control_net.vtu, adapt.pvd, parametric_tmesh.vtu, "
+                 "physical_tmesh.vtu, boundary.vtu, report.json to "
+              << out_dir << std::endl;
+  if (!result.valid()) {
+    std::cerr << "tspline: error: the map is not valid: det J <= 0 at " << result.quality.nonpositive_det << " of "
+              << result.quality.points << " quadrature points; adaptive refinement stopped: " << result.stop_reason
+              << " (files written; see surface.vtu, point data det_jacobian)" << std::endl;
     return 3;
   }
+  if (!result.good(adaptive.min_jacobian) && !quiet)
+    std::cout << "warning: min J_r " << result.quality.min_mean_ratio << " is below --min-jacobian "
+              << adaptive.min_jacobian << "; adaptive refinement stopped: " << result.stop_reason << std::endl;
   return 0;
 }
 
@@ -74,7 +90,8 @@ int main(int argc, char** argv) {
   app.set_version_flag("--version", "tspline 0.1.0");
 
   CLI::App* param = app.add_subcommand(
-      "param", "Parameterize the domain bounded by a polygon: adapted T-mesh, Coons start, untangling and smoothing");
+      "param", "Parameterize the domain bounded by a polygon: adapted T-mesh, Coons start, untangling and smoothing, "
+      "cubic T-spline fit, Jacobian check and adaptive refinement");
   std::string input, out_dir, corners;
   tspline::ParameterizationOptions opt;
   double tol = 0.0;
@@ -113,6 +130,16 @@ int main(int argc, char** argv) {
   auto* gj_opt = param->add_option("--polygon", geojson_polygon,
                                    "GeoJSON MultiPolygon/FeatureCollection: which polygon (0-based); default "
                                    "the largest");
+  tspline::AdaptiveOptions adaptive;
+  int samples = 4;
+  param->add_option("--min-jacobian", adaptive.min_jacobian,
+                    "delta of Sect. 6.2: refine the cells where the mean ratio Jacobian J_r = 2 det J / |J|^2 is "
+                    "below it at some of the 4x4 Gauss points")
+      ->capture_default_str();
+  param->add_option("--max-adapt", adaptive.max_adapt, "Adaptive refinement rounds at most")->capture_default_str();
+  param->add_option("--max-cells", adaptive.max_cells, "Adaptive refinement never goes beyond this many cells")
+      ->capture_default_str();
+  param->add_option("--samples", samples, "surface.vtu: k x k sub-quads per T-mesh cell")->capture_default_str();
   param->add_flag("--quiet,-q", quiet, "Print errors only");
   tspline_app::CommandAction command;  // set by the other subcommands when parsed (commands.h)
   tspline_app::add_tspline_file_commands(app, command);
@@ -133,11 +160,14 @@ int main(int argc, char** argv) {
       if (tol_opt->count() > 0) opt.tolerance_absolute = tol;
       std::optional<std::size_t> gj;
       if (gj_opt->count() > 0) gj = geojson_polygon;
-      return run_param(input, out_dir, corners, opt, gj, quiet);
+      return run_param(input, out_dir, corners, opt, adaptive, samples, gj, quiet);
     }
   } catch (const tspline::InputError& e) {
     std::cerr << "tspline: error: " << e.what() << std::endl;
     return 1;
+  } catch (const tspline::NumericalError& e) {
+    std::cerr << "tspline: error: " << e.what() << std::endl;
+    return 3;
   } catch (const tspline::IoError& e) {
     std::cerr << "tspline: error: " << e.what() << std::endl;
     return 2;

@@ -2,6 +2,8 @@
 // trips, the documented fields, every malformed-file case, and the `tspline
 // eval` / `tspline info` subcommands run as a separate process.
 #include <doctest/doctest.h>
+
+#include <Eigen/LU>
 #include <sys/wait.h>
 #include <unistd.h>
 

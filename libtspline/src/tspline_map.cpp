@@ -14,6 +14,18 @@ TSplineMap::TSplineMap(TMesh mesh, std::vector<Eigen::Vector2d> control_points)
                                 std::to_string(basis_->size()) + " blending functions");
 }
 
+TSplineMap::TSplineMap(TMesh mesh)
+    : mesh_(std::make_unique<TMesh>(std::move(mesh))),
+      basis_(std::make_unique<TSplineBasis>(*mesh_)),
+      control_points_(basis_->size(), Eigen::Vector2d::Zero()) {}
+
+void TSplineMap::set_control_points(std::vector<Eigen::Vector2d> control_points) {
+  if (control_points.size() != basis_->size())
+    throw std::invalid_argument("TSplineMap: " + std::to_string(control_points.size()) + " control points for " +
+                                std::to_string(basis_->size()) + " blending functions");
+  control_points_ = std::move(control_points);
+}
+
 TSplineMap::TSplineMap(const TSplineMap& o)
     : mesh_(std::make_unique<TMesh>(*o.mesh_)),
       basis_(std::make_unique<TSplineBasis>(*mesh_)),

@@ -25,6 +25,8 @@ class TSplineMap {
   /// blending function of TSplineBasis(mesh), in its order.
   /// \throw std::invalid_argument if the number of control points is wrong.
   TSplineMap(TMesh mesh, std::vector<Eigen::Vector2d> control_points);
+  /// All control points at the origin (to be set with set_control_points()).
+  explicit TSplineMap(TMesh mesh);
   TSplineMap(const TSplineMap& other);
   TSplineMap& operator=(const TSplineMap& other);
   TSplineMap(TSplineMap&&) noexcept = default;
@@ -33,6 +35,8 @@ class TSplineMap {
   const TMesh& mesh() const { return *mesh_; }
   const TSplineBasis& basis() const { return *basis_; }
   const std::vector<Eigen::Vector2d>& control_points() const { return control_points_; }
+  /// \throw std::invalid_argument if the count differs from basis().size().
+  void set_control_points(std::vector<Eigen::Vector2d> control_points);
 
   Eigen::Vector2d point(const Eigen::Vector2d& uv) const;
   Eigen::Matrix2d jacobian(const Eigen::Vector2d& uv) const;

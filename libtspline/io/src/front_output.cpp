@@ -140,7 +140,7 @@ nlohmann::json front_report(const FrontResult& r, const std::string& input_path)
   };
 }
 
-void write_front_outputs(const FrontResult& r, const std::string& out_dir, const nlohmann::json& report) {
+void write_front_meshes(const FrontResult& r, const std::string& out_dir) {
   ensure_writable_directory(out_dir);
   const std::filesystem::path dir(out_dir);
   std::vector<Eigen::Vector2d> param(r.mesh.num_vertices());
@@ -148,7 +148,11 @@ void write_front_outputs(const FrontResult& r, const std::string& out_dir, const
   write_vtu((dir / "parametric_tmesh.vtu").string(), tmesh_vtu(r.mesh, param));
   write_vtu((dir / "physical_tmesh.vtu").string(), tmesh_vtu(r.mesh, r.optimized));
   write_vtu((dir / "boundary.vtu").string(), boundary_vtu(r.boundary));
-  write_text_atomic((dir / "report.json").string(), report.dump(2) + "\n");
+}
+
+void write_front_outputs(const FrontResult& r, const std::string& out_dir, const nlohmann::json& report) {
+  write_front_meshes(r, out_dir);
+  write_text_atomic((std::filesystem::path(out_dir) / "report.json").string(), report.dump(2) + "\n");
 }
 
 }  // namespace tspline::io

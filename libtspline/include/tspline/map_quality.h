@@ -1,0 +1,42 @@
+#pragma once
+// Quality of the T-spline map at Gauss points (Brovka 2013 Sect. 6.1):
+//   mean ratio Jacobian J_r = 2 det J / |J|_F^2 (Eq. 9; 1 where S is conformal),
+//   det J, and the scaled Jacobian J_s = det J / (|S_xi| |S_eta|).
+// 0 <= |J_r| <= |J_s| <= 1.
+#include <Eigen/Core>
+#include <cstddef>
+#include <vector>
+
+#include "tspline/tspline_map.h"
+
+namespace tspline {
+
+double mean_ratio_jacobian(const Eigen::Matrix2d& J);
+double scaled_jacobian(const Eigen::Matrix2d& J);
+
+/// Gauss-Legendre points on [0,1] (n = 1..6) and their weights.
+void gauss_points_01(int n, std::vector<double>& points, std::vector<double>& weights);
+
+struct CellMapQuality {
+  double min_mean_ratio = 1.0;
+  double min_det = 0.0;
+  double min_scaled = 1.0;
+};
+
+struct MapQualityStats {
+  std::size_t points = 0;
+  std::size_t nonpositive_det = 0;  ///< quadrature points with det J <= 0
+  double min_mean_ratio = 1.0;
+  double mean_mean_ratio = 0.0;
+  double min_det = 0.0;
+  double max_det = 0.0;
+  double min_scaled = 1.0;
+};
+
+/// Per cell, over gauss x gauss points.
+std::vector<CellMapQuality> cell_map_quality(const TSplineMap& map, int gauss = 4);
+
+/// Over all cells' gauss x gauss points.
+MapQualityStats map_quality(const TSplineMap& map, int gauss = 4, std::vector<CellMapQuality>* per_cell = nullptr);
+
+}  // namespace tspline

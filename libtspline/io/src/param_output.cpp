@@ -1,0 +1,160 @@
+#include "tspline/io/param_output.h"
+
+#include <cstdio>
+#include <filesystem>
+
+#include <Eigen/LU>
+
+#include "tspline/io/atomic_file.h"
+#include "tspline/io/front_output.h"
+#include "tspline/io/tspline_file.h"
+#include "tspline/map_quality.h"
+
+namespace tspline::io {
+
+VtuMesh surface_vtu(const TSplineMap& map, int k) {
+  if (k < 1 || k > 64) throw std::invalid_argument("samples per cell edge must be in [1, 64]");
+  const TMesh& mesh = map.mesh();
+  VtuMesh out;
+  const std::size_t per_cell = static_cast<std::size_t>((k + 1) * (k + 1));
+  out.points.reserve(mesh.num_cells() * per_cell);
+  std::vector<double> jr, det, js;
+  std::vector<Eigen::Vector2d> param;
+  std::vector<int> cell_id, level;
+  for (int c = 0; c < static_cast<int>(mesh.num_cells()); ++c) {
+    const Eigen::Vector2d lo = mesh.cell_min(c), hi = mesh.cell_max(c);
+    const int base = static_cast<int>(out.points.size());
+    for (int j = 0; j <= k; ++j)
+      for (int i = 0; i <= k; ++i) {
+        const Eigen::Vector2d uv(lo.x() + (hi.x() - lo.x()) * i / k, lo.y() + (hi.y() - lo.y()) * j / k);
+        const MapDerivatives d = map.derivatives(uv, 1, c);
+        out.points.push_back(d.x);
+        jr.push_back(mean_ratio_jacobian(d.J));
+        det.push_back(d.J.determinant());
+        js.push_back(scaled_jacobian(d.J));
+        param.push_back(uv);
+      }
+    for (int j = 0; j < k; ++j)
+      for (int i = 0; i < k; ++i) {
+        const int a = base + j * (k + 1) + i;
+        out.cells.push_back({a, a + 1, a + k + 2, a + k + 1});
+        cell_id.push_back(c);
+        level.push_back(mesh.cell_level(c));
+      }
+  }
+  out.quads_as_polygons = false;
+  out.point_scalars["mean_ratio_jacobian"] = std::move(jr);
+  out.point_scalars["det_jacobian"] = std::move(det);
+  out.point_scalars["scaled_jacobian"] = std::move(js);
+  out.point_vectors["parametric"] = std::move(param);
+  out.cell_ints["cell"] = std::move(cell_id);
+  out.cell_ints["level"] = std::move(level);
+  return out;
+}
+
+VtuMesh control_net_vtu(const TSplineMap& map) {
+  VtuMesh out;
+  out.points = map.control_points();
+  std::vector<int> kind, fn;
+  for (int a = 0; a < static_cast<int>(map.basis().size()); ++a) {
+    out.cells.push_back({a});
+    kind.push_back(static_cast<int>(map.basis().function(a).kind));
+    fn.push_back(a);
+  }
+  out.point_ints["kind"] = std::move(kind);
+  out.point_ints["function"] = std::move(fn);
+  return out;
+}
+
+AdaptSeriesWriter::AdaptSeriesWriter(std::string out_dir, int samples) : out_dir_(std::move(out_dir)), samples_(samples) {}
+
+void AdaptSeriesWriter::add(int it, const TMesh& mesh, const std::vector<Eigen::Vector2d>& x, const TSplineMap& map) {
+  // Created on first use, so that a run failing before the first fit leaves nothing.
+  if (entries_.empty()) ensure_writable_directory((std::filesystem::path(out_dir_) / "adapt").string());
+  char name[64];
+  std::snprintf(name, sizeof name, "adapt/mesh_%03d.vtu", it);
+  const std::string mesh_file = name;
+  std::snprintf(name, sizeof name, "adapt/surface_%03d.vtu", it);
+  const std::string surface_file = name;
+  const std::filesystem::path dir(out_dir_);
+  write_vtu((dir / mesh_file).string(), tmesh_vtu(mesh, x));
+  write_vtu((dir / surface_file).string(), surface_vtu(map, samples_));
+  entries_.push_back({static_cast<double>(it), mesh_file, 0});
+  entries_.push_back({static_cast<double>(it), surface_file, 1});
+}
+
+void AdaptSeriesWriter::finish() const {
+  write_pvd((std::filesystem::path(out_dir_) / "adapt.pvd").string(), entries_);
+}
+
+namespace {
+
+nlohmann::json map_quality_json(const MapQualityStats& q) {
+  return {{"points", q.points},
+          {"nonpositive_det_points", q.nonpositive_det},
+          {"min_mean_ratio_jacobian", q.min_mean_ratio},
+          {"mean_mean_ratio_jacobian", q.mean_mean_ratio},
+          {"min_det_jacobian", q.min_det},
+          {"max_det_jacobian", q.max_det},
+          {"min_scaled_jacobian", q.min_scaled}};
+}
+
+}  // namespace
+
+nlohmann::json param_report(const ParameterizationResult& r, const std::string& input_path,
+                            const AdaptiveOptions& ad) {
+  using nlohmann::json;
+  json rep = front_report(r.front, input_path);
+  std::size_t kinds[3] = {0, 0, 0};
+  for (const auto& f : r.map->basis().functions()) ++kinds[static_cast<int>(f.kind)];
+  rep["tspline"] = {{"degree", 3},
+                    {"blending_functions", r.map->basis().size()},
+                    {"control_points", r.map->control_points().size()},
+                    {"anchor_functions", kinds[0]},
+                    {"edge_extra_functions", kinds[1]},
+                    {"corner_extra_functions", kinds[2]},
+                    {"interpolation_max_residual", r.fit.max_residual},
+                    {"interpolation_relative_residual", r.fit.relative_residual},
+                    {"matrix_nonzeros", r.fit.nonzeros}};
+  rep["jacobian"] = map_quality_json(r.quality);
+  rep["jacobian"]["gauss_points_per_direction"] = ad.gauss;
+  rep["jacobian"]["threshold"] = ad.min_jacobian;
+  rep["valid"] = r.valid();
+  rep["good"] = r.good(ad.min_jacobian);
+  json its = json::array();
+  for (const AdaptIteration& it : r.iterations)
+    its.push_back({{"cells", it.cells},
+                   {"vertices", it.vertices},
+                   {"functions", it.functions},
+                   {"inverted_tmesh_cells", it.inverted_cells},
+                   {"cells_refined_after", it.refined_cells},
+                   {"interpolation_relative_residual", it.fit.relative_residual},
+                   {"jacobian", map_quality_json(it.quality)},
+                   {"seconds", it.seconds}});
+  rep["adaptive"] = {{"max_rounds", ad.max_adapt},
+                     {"stall_rounds", ad.stall_rounds},
+                     {"max_cells", ad.max_cells},
+                     {"iterations", its},
+                     {"kept_iteration", r.kept_iteration},
+                     {"stop_reason", r.stop_reason}};
+  double total = 0.0;
+  for (const auto& t : r.front.times) rep["seconds"][t.stage] = t.seconds, total += t.seconds;
+  rep["seconds"]["total"] = total;
+  return rep;
+}
+
+void write_param_outputs(const ParameterizationResult& r, const std::string& out_dir, const nlohmann::json& report,
+                         int samples) {
+  const std::filesystem::path dir(out_dir);
+  write_front_meshes(r.front, out_dir);
+  TSplineFileMeta meta;
+  meta.source = report.value("input", "");
+  meta.boundary = r.front.boundary.polygon();
+  meta.corners = r.front.boundary.corners().index;
+  write_tspline_file((dir / "tspline.json").string(), *r.map, meta);
+  write_vtu((dir / "surface.vtu").string(), surface_vtu(*r.map, samples));
+  write_vtu((dir / "control_net.vtu").string(), control_net_vtu(*r.map));
+  write_text_atomic((dir / "report.json").string(), report.dump(2) + "\n");  // last: the run's summary
+}
+
+}  // namespace tspline::io

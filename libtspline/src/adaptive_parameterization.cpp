@@ -1,0 +1,157 @@
+#include "tspline/adaptive_parameterization.h"
+
+#include <chrono>
+#include <cmath>
+#include <sstream>
+
+#include "tspline/errors.h"
+#include "tspline/tmesh_submesh.h"
+
+namespace tspline {
+
+namespace {
+
+double seconds_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+// Positions for the refined mesh: old vertices keep theirs, new boundary vertices
+// go on the polygon, new interior vertices where the current map puts them.
+std::vector<Eigen::Vector2d> place_new_vertices(const TMesh& coarse, const std::vector<Eigen::Vector2d>& coarse_x,
+                                                const TMesh& fine, const TSplineMap& map,
+                                                const BoundaryMap& boundary) {
+  std::vector<Eigen::Vector2d> x(fine.num_vertices());
+  for (int v = 0; v < static_cast<int>(x.size()); ++v) {
+    const int old = coarse.find_vertex(fine.vertex_ipos(v));
+    if (old >= 0)
+      x[v] = coarse_x[old];
+    else if (fine.vertex_on_boundary(v))
+      x[v] = boundary.point_at(fine.vertex_param(v));
+    else
+      x[v] = map.point(fine.vertex_param(v));
+  }
+  return x;
+}
+
+}  // namespace
+
+ParameterizationResult run_parameterization(const Polygon& polygon, const ParameterizationOptions& opt,
+                                            const AdaptiveOptions& ad, const IterationCallback& on_iteration) {
+  if (!(ad.min_jacobian > 0.0 && ad.min_jacobian <= 1.0))
+    throw InputError("--min-jacobian must be in (0, 1], got " + std::to_string(ad.min_jacobian));
+  if (ad.max_adapt < 0) throw InputError("--max-adapt must be >= 0");
+  if (ad.gauss < 1 || ad.gauss > 6) throw InputError("Gauss points per direction must be in [1, 6]");
+  auto log = [&](const std::string& s) {
+    if (opt.log) opt.log(s);
+  };
+  ParameterizationResult r{run_front(polygon, opt), std::nullopt, {}, {}, {}, {}, 0, {}};
+  FrontResult& f = r.front;
+  double t_fit = 0.0, t_check = 0.0, t_refine = 0.0;
+  // The best iteration so far: fewest det J <= 0 points, then highest min J_r.
+  struct Snapshot {
+    TMesh mesh = TMesh(0);
+    std::vector<Eigen::Vector2d> x;
+    MeshQualityStats tmesh_quality;
+    std::optional<TSplineMap> map;
+    FitReport fit;
+    MapQualityStats quality;
+    std::vector<CellMapQuality> cells;
+  };
+  std::optional<Snapshot> best;
+  int best_it = 0;
+  auto better = [](const MapQualityStats& a, const MapQualityStats& b) {
+    return a.nonpositive_det < b.nonpositive_det ||
+           (a.nonpositive_det == b.nonpositive_det && a.min_mean_ratio > b.min_mean_ratio);
+  };
+  for (int it = 0;; ++it) {
+    const auto t0 = std::chrono::steady_clock::now();
+    AdaptIteration rec;
+    r.map.emplace(fit_tspline(f.mesh, f.optimized, f.boundary, &r.fit));
+    t_fit += seconds_since(t0);
+    const auto t1 = std::chrono::steady_clock::now();
+    r.quality = map_quality(*r.map, ad.gauss, &r.cell_quality);
+    t_check += seconds_since(t1);
+    rec.cells = f.mesh.num_cells();
+    rec.vertices = f.mesh.num_vertices();
+    rec.functions = r.map->basis().size();
+    rec.inverted_cells = f.quality_optimized.inverted_cells;
+    rec.fit = r.fit;
+    rec.quality = r.quality;
+    {
+      std::ostringstream s;
+      s << "t-spline (iteration " << it << "): " << rec.functions << " functions, residual " << r.fit.relative_residual
+        << ", J_r min/mean " << r.quality.min_mean_ratio << " / " << r.quality.mean_mean_ratio << ", det J <= 0 at "
+        << r.quality.nonpositive_det << " of " << r.quality.points << " points";
+      log(s.str());
+    }
+    if (on_iteration) on_iteration(it, f.mesh, f.optimized, *r.map, r.cell_quality);
+    if (!best || better(r.quality, best->quality)) {
+      best = Snapshot{f.mesh, f.optimized, f.quality_optimized, r.map, r.fit, r.quality, r.cell_quality};
+      best_it = it;
+    }
+    std::vector<int> marked;
+    if (r.good(ad.min_jacobian)) {
+      r.stop_reason = "every quadrature point has det J > 0 and J_r >= " + std::to_string(ad.min_jacobian);
+    } else if (it >= ad.max_adapt) {
+      r.stop_reason = "reached --max-adapt " + std::to_string(ad.max_adapt);
+    } else if (it - best_it >= ad.stall_rounds) {
+      r.stop_reason = "no improvement in the last " + std::to_string(ad.stall_rounds) +
+                      " rounds (the remaining distortion is not one refinement can remove)";
+    } else {
+      for (int c = 0; c < static_cast<int>(f.mesh.num_cells()); ++c)
+        if (!(r.cell_quality[c].min_mean_ratio >= ad.min_jacobian) && f.mesh.cell_level(c) < opt.max_level)
+          marked.push_back(c);
+      if (marked.empty())
+        r.stop_reason = "the cells to refine are at --max-level";
+      else if (f.mesh.num_cells() + 3 * marked.size() > ad.max_cells) {
+        r.stop_reason = "refining " + std::to_string(marked.size()) + " more cells would exceed the budget of " +
+                        std::to_string(ad.max_cells) + " cells";
+        marked.clear();
+      }
+    }
+    rec.refined_cells = marked.size();
+    if (marked.empty()) {
+      rec.seconds = seconds_since(t0);
+      r.iterations.push_back(rec);
+      break;
+    }
+    // Sect. 6.2: refine the marked cells, re-balance, place the new vertices
+    // with the current map, optimize the T-mesh again; the next pass re-fits.
+    const auto t2 = std::chrono::steady_clock::now();
+    const TMesh coarse = f.mesh;
+    for (int c : marked) f.mesh.refine(coarse.cell_node(c));
+    f.mesh.balance();
+    f.mesh.build_topology();
+    f.optimized = place_new_vertices(coarse, f.optimized, f.mesh, *r.map, f.boundary);
+    const meshopt::SmoothingProblem problem = build_smoothing_problem(f.mesh, true);
+    meshopt::SmoothingOptions sopt = opt.smoothing;
+    sopt.progress = nullptr;
+    f.smoothing = meshopt::smooth(f.optimized, problem, sopt);
+    f.total_sweeps += f.smoothing.sweeps;
+    f.quality_optimized = mesh_quality(f.mesh, f.optimized);
+    log("adaptive refinement " + std::to_string(it + 1) + ": refined " + std::to_string(marked.size()) +
+        " cells with J_r < " + std::to_string(ad.min_jacobian) + ", now " + std::to_string(f.mesh.num_cells()) +
+        " cells, " + std::to_string(f.smoothing.sweeps) + " sweeps, " +
+        std::to_string(f.quality_optimized.inverted_cells) + " inverted cells");
+    t_refine += seconds_since(t2);
+    rec.seconds = seconds_since(t0);
+    r.iterations.push_back(rec);
+  }
+  r.kept_iteration = best_it;
+  if (best_it != static_cast<int>(r.iterations.size()) - 1) {
+    f.mesh = std::move(best->mesh);
+    f.optimized = std::move(best->x);
+    f.quality_optimized = best->tmesh_quality;
+    r.map = std::move(best->map);
+    r.fit = best->fit;
+    r.quality = best->quality;
+    r.cell_quality = std::move(best->cells);
+  }
+  log("adaptive refinement stopped: " + r.stop_reason + "; kept iteration " + std::to_string(best_it));
+  f.times.push_back({"tspline_fit", t_fit});
+  f.times.push_back({"jacobian_check", t_check});
+  f.times.push_back({"adaptive_refinement", t_refine});
+  return r;
+}
+
+}  // namespace tspline

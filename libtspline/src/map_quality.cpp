@@ -1,0 +1,88 @@
+#include "tspline/map_quality.h"
+
+#include <Eigen/LU>
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+
+namespace tspline {
+
+double mean_ratio_jacobian(const Eigen::Matrix2d& J) {
+  const double f = J.squaredNorm();
+  return f > 0.0 ? 2.0 * J.determinant() / f : 0.0;
+}
+
+double scaled_jacobian(const Eigen::Matrix2d& J) {
+  const double n = J.col(0).norm() * J.col(1).norm();
+  return n > 0.0 ? J.determinant() / n : 0.0;
+}
+
+void gauss_points_01(int n, std::vector<double>& p, std::vector<double>& w) {
+  // Nodes and weights of Gauss-Legendre on [-1,1], mapped to [0,1].
+  static const std::vector<std::vector<std::pair<double, double>>> table = {
+      {{0.0, 2.0}},
+      {{-0.5773502691896257, 1.0}, {0.5773502691896257, 1.0}},
+      {{-0.7745966692414834, 5.0 / 9}, {0.0, 8.0 / 9}, {0.7745966692414834, 5.0 / 9}},
+      {{-0.8611363115940526, 0.3478548451374538},
+       {-0.3399810435848563, 0.6521451548625461},
+       {0.3399810435848563, 0.6521451548625461},
+       {0.8611363115940526, 0.3478548451374538}},
+      {{-0.9061798459386640, 0.2369268850561891},
+       {-0.5384693101056831, 0.4786286704993665},
+       {0.0, 0.5688888888888889},
+       {0.5384693101056831, 0.4786286704993665},
+       {0.9061798459386640, 0.2369268850561891}},
+      {{-0.9324695142031521, 0.1713244923791704},
+       {-0.6612093864662645, 0.3607615730481386},
+       {-0.2386191860831969, 0.4679139345726910},
+       {0.2386191860831969, 0.4679139345726910},
+       {0.6612093864662645, 0.3607615730481386},
+       {0.9324695142031521, 0.1713244923791704}}};
+  if (n < 1 || n > 6) throw std::invalid_argument("gauss_points_01: n must be in [1, 6]");
+  p.clear(), w.clear();
+  for (const auto& [x, wt] : table[n - 1]) p.push_back(0.5 * (x + 1.0)), w.push_back(0.5 * wt);
+}
+
+std::vector<CellMapQuality> cell_map_quality(const TSplineMap& map, int gauss) {
+  std::vector<CellMapQuality> per_cell;
+  map_quality(map, gauss, &per_cell);
+  return per_cell;
+}
+
+MapQualityStats map_quality(const TSplineMap& map, int gauss, std::vector<CellMapQuality>* per_cell) {
+  std::vector<double> gp, gw;
+  gauss_points_01(gauss, gp, gw);
+  const TMesh& mesh = map.mesh();
+  MapQualityStats s;
+  s.min_det = std::numeric_limits<double>::infinity();
+  s.max_det = -std::numeric_limits<double>::infinity();
+  double sum = 0.0;
+  if (per_cell) per_cell->assign(mesh.num_cells(), CellMapQuality{});
+  for (int c = 0; c < static_cast<int>(mesh.num_cells()); ++c) {
+    const Eigen::Vector2d lo = mesh.cell_min(c), hi = mesh.cell_max(c);
+    CellMapQuality q;
+    q.min_det = std::numeric_limits<double>::infinity();
+    for (double a : gp)
+      for (double b : gp) {
+        const Eigen::Vector2d uv(lo.x() + a * (hi.x() - lo.x()), lo.y() + b * (hi.y() - lo.y()));
+        const Eigen::Matrix2d J = map.derivatives(uv, 1, c).J;
+        const double det = J.determinant(), jr = mean_ratio_jacobian(J), js = scaled_jacobian(J);
+        q.min_mean_ratio = std::min(q.min_mean_ratio, jr);
+        q.min_det = std::min(q.min_det, det);
+        q.min_scaled = std::min(q.min_scaled, js);
+        ++s.points;
+        if (!(det > 0.0)) ++s.nonpositive_det;
+        sum += jr;
+        s.max_det = std::max(s.max_det, det);
+      }
+    s.min_mean_ratio = std::min(s.min_mean_ratio, q.min_mean_ratio);
+    s.min_det = std::min(s.min_det, q.min_det);
+    s.min_scaled = std::min(s.min_scaled, q.min_scaled);
+    if (per_cell) (*per_cell)[c] = q;
+  }
+  s.mean_mean_ratio = s.points ? sum / static_cast<double>(s.points) : 0.0;
+  return s;
+}
+
+}  // namespace tspline
