@@ -11,6 +11,7 @@
 #include <string>
 
 #include "meshopt/triangle_measure.h"
+#include "newton_descent.h"
 
 namespace meshopt {
 
@@ -25,7 +26,7 @@ std::span<const LocalTriangle> SmoothingProblem::triangles_of(std::size_t k) con
   return std::span<const LocalTriangle>(triangles).subspan(offsets[k], offsets[k + 1] - offsets[k]);
 }
 
-namespace {
+namespace detail {
 
 void validate_options(const SmoothingOptions& o) {
   auto bad = [](const char* what) { throw std::invalid_argument(std::string("meshopt::smooth: ") + what); };
@@ -38,6 +39,11 @@ void validate_options(const SmoothingOptions& o) {
   if (o.max_backtracks < 0) bad("max_backtracks must be >= 0");
   if (!(o.over_relaxation >= 1.0 && o.over_relaxation < 2.0)) bad("over_relaxation must be in [1, 2)");
 }
+
+}  // namespace detail
+
+namespace {
+
 
 void validate_triangles(std::span<const Eigen::Vector2d> positions, std::span<const LocalTriangle> tris,
                         long long node) {
@@ -64,83 +70,32 @@ double local_length(const Eigen::Vector2d& x, std::span<const Eigen::Vector2d> p
   return sum / (2.0 * static_cast<double>(tris.size()));
 }
 
-/// True iff H is symmetric positive definite with eigenvalue ratio above a relative threshold.
-bool is_spd(const Eigen::Matrix2d& H) {
-  const double a = H(0, 0), b = 0.5 * (H(0, 1) + H(1, 0)), d = H(1, 1);
-  const double mean = 0.5 * (a + d);
-  const double rad = std::sqrt(0.25 * (a - d) * (a - d) + b * b);
-  const double lmax = mean + rad, lmin = mean - rad;
-  return std::isfinite(lmax) && lmax > 0.0 && lmin > 1e-12 * lmax;
-}
+using detail::Counters;
 
-struct Counters {
-  std::size_t newton = 0;
-  std::size_t gradient = 0;
+// The triangle objective in the form newton_descent expects.
+struct TriangleObjective {
+  std::span<const Eigen::Vector2d> positions;
+  std::span<const LocalTriangle> tris;
+  double min_sigma(const Eigen::Vector2d& x) const { return meshopt::min_sigma(x, positions, tris); }
+  double mean_abs_sigma(const Eigen::Vector2d& x) const {
+    double s = 0.0;
+    for (const LocalTriangle& t : tris)
+      s += std::abs(weighted_jacobian(x, positions[t.a], positions[t.b], t.ideal_inv).determinant());
+    return s / static_cast<double>(tris.size());
+  }
+  ObjectiveValue full(const Eigen::Vector2d& x, double delta) const {
+    return local_objective(x, positions, tris, delta);
+  }
+  double value(const Eigen::Vector2d& x, double delta) const {
+    return local_objective_value(x, positions, tris, delta);
+  }
 };
 
 Eigen::Vector2d optimize_impl(const Eigen::Vector2d& start, std::span<const Eigen::Vector2d> positions,
                               std::span<const LocalTriangle> tris, const SmoothingOptions& opt, double L,
                               Counters& cnt) {
-  if (tris.empty() || !(L > 0.0) || !std::isfinite(L) || !start.allFinite()) return start;
-  // sigma* (Gargallo-Peiro Appendix B); the typical |sigma| is only needed when sigma* == 0.
-  const double sigma_star = min_sigma(start, positions, tris);
-  if (std::isnan(sigma_star)) return start;
-  double abs_mean = 0.0;
-  if (sigma_star == 0.0) {
-    for (const LocalTriangle& t : tris)
-      abs_mean += std::abs(weighted_jacobian(start, positions[t.a], positions[t.b], t.ideal_inv).determinant());
-    abs_mean /= static_cast<double>(tris.size());
-  }
-  double delta = untangling_delta(sigma_star, opt.alpha, abs_mean);
-  const double tiny_step = std::max(1e-12, 1e-3 * opt.relative_displacement_tolerance) * L;
-  // After a full Newton step of length s on the unmodified measure the remaining error is
-  // O(s^2 / L) (quadratic convergence), so a step below 1e-1 * tolerance ends the visit.
-  const double newton_stop = std::max(1e-12, 1e-1 * opt.relative_displacement_tolerance) * L;
-
-  Eigen::Vector2d x = start;
-  for (int it = 0; it < opt.newton_iterations_per_visit; ++it) {
-    const ObjectiveValue ov = local_objective(x, positions, tris, delta);
-    const Eigen::Vector2d& g = ov.gradient;
-    const double gn = g.norm();
-    if (!std::isfinite(ov.value) || !std::isfinite(gn) || gn == 0.0) break;
-
-    Eigen::Vector2d d;
-    bool newton = is_spd(ov.hessian);
-    if (newton) {
-      const Eigen::Matrix2d& H = ov.hessian;
-      const double det = H(0, 0) * H(1, 1) - H(0, 1) * H(1, 0);
-      d = -Eigen::Vector2d(H(1, 1) * g.x() - H(0, 1) * g.y(), -H(1, 0) * g.x() + H(0, 0) * g.y()) / det;
-      if (!d.allFinite() || !(g.dot(d) < 0.0)) newton = false;
-    }
-    if (!newton) d = -g * (L / gn);  // gradient step of initial length L
-    // Trust cap: never try to move more than one local length per step.
-    const double dn = d.norm();
-    if (dn > L) d *= L / dn;
-    const double slope = g.dot(d);
-
-    double t = 1.0;
-    bool accepted = false;
-    Eigen::Vector2d xn;
-    for (int k = 0; k <= opt.max_backtracks; ++k, t *= 0.5) {
-      xn = x + t * d;
-      const double fn = local_objective_value(xn, positions, tris, delta);
-      if (std::isfinite(fn) && fn <= ov.value + opt.armijo_c * t * slope) {
-        accepted = true;
-        break;
-      }
-    }
-    if (!accepted) break;
-    ++(newton ? cnt.newton : cnt.gradient);
-    const double step = (xn - x).norm();
-    x = xn;
-    // Once the submesh is valid the paper optimizes the unmodified measure (delta = 0).
-    if (delta > 0.0 && min_sigma(x, positions, tris) > 0.0) {
-      delta = 0.0;
-      continue;
-    }
-    if (step < tiny_step || (newton && t == 1.0 && delta == 0.0 && step < newton_stop)) break;
-  }
-  return x;
+  if (tris.empty()) return start;
+  return detail::newton_descent(start, TriangleObjective{positions, tris}, opt, L, cnt);
 }
 
 }  // namespace
@@ -148,7 +103,7 @@ Eigen::Vector2d optimize_impl(const Eigen::Vector2d& start, std::span<const Eige
 Eigen::Vector2d optimize_node(const Eigen::Vector2d& start, std::span<const Eigen::Vector2d> positions,
                               std::span<const LocalTriangle> triangles, const SmoothingOptions& options,
                               std::size_t* newton_steps, std::size_t* gradient_fallbacks) {
-  validate_options(options);
+  detail::validate_options(options);
   validate_triangles(positions, triangles, -1);
   Counters cnt;
   const Eigen::Vector2d x =
@@ -210,7 +165,7 @@ std::vector<std::vector<int>> build_dependents(std::size_t num_positions, const 
 
 SmoothingReport smooth(std::vector<Eigen::Vector2d>& positions, const SmoothingProblem& problem,
                        const SmoothingOptions& options) {
-  validate_options(options);
+  detail::validate_options(options);
   validate_problem(positions, problem);
   SmoothingReport rep;
   rep.tangled_nodes_before = count_tangled(positions, problem);

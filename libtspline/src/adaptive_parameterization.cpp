@@ -44,15 +44,16 @@ ParameterizationResult run_parameterization(const Polygon& polygon, const Parame
   auto log = [&](const std::string& s) {
     if (opt.log) opt.log(s);
   };
-  ParameterizationResult r{run_front(polygon, opt), std::nullopt, {}, {}, {}, {}, 0, {}};
+  ParameterizationResult r{run_front(polygon, opt), std::nullopt, {}, {}, {}, {}, 0, false, {}};
   FrontResult& f = r.front;
-  double t_fit = 0.0, t_check = 0.0, t_refine = 0.0;
+  double t_fit = 0.0, t_check = 0.0, t_refine = 0.0, t_cpo = 0.0;
   // The best iteration so far: fewest det J <= 0 points, then highest min J_r.
   struct Snapshot {
     TMesh mesh = TMesh(0);
     std::vector<Eigen::Vector2d> x;
     MeshQualityStats tmesh_quality;
     std::optional<TSplineMap> map;
+    bool control_points_optimized = false;
     FitReport fit;
     MapQualityStats quality;
     std::vector<CellMapQuality> cells;
@@ -71,6 +72,28 @@ ParameterizationResult run_parameterization(const Polygon& polygon, const Parame
     const auto t1 = std::chrono::steady_clock::now();
     r.quality = map_quality(*r.map, ad.gauss, &r.cell_quality);
     t_check += seconds_since(t1);
+    if (ad.optimize_control_points && !r.good(ad.min_jacobian)) {
+      const auto t3 = std::chrono::steady_clock::now();
+      TSplineMap candidate = *r.map;
+      ControlPointOptimizationOptions copt;
+      copt.gauss = ad.gauss;
+      copt.node = opt.smoothing;
+      copt.node.progress = nullptr;
+      const ControlPointOptimizationReport cr = optimize_control_points(candidate, copt);
+      const bool keep = better(cr.after, r.quality);
+      if (keep) {
+        r.map.emplace(std::move(candidate));
+        r.quality = map_quality(*r.map, ad.gauss, &r.cell_quality);
+      }
+      rec.control_points_optimized = keep;
+      std::ostringstream s;
+      s << "control point optimization: " << cr.free_points << " free points, " << cr.sweeps << " sweeps, J_r min "
+        << cr.before.min_mean_ratio << " -> " << cr.after.min_mean_ratio << ", det J <= 0 at "
+        << cr.before.nonpositive_det << " -> " << cr.after.nonpositive_det << " points"
+        << (keep ? " (kept)" : " (not better: discarded)");
+      log(s.str());
+      t_cpo += seconds_since(t3);
+    }
     rec.cells = f.mesh.num_cells();
     rec.vertices = f.mesh.num_vertices();
     rec.functions = r.map->basis().size();
@@ -86,7 +109,8 @@ ParameterizationResult run_parameterization(const Polygon& polygon, const Parame
     }
     if (on_iteration) on_iteration(it, f.mesh, f.optimized, *r.map, r.cell_quality);
     if (!best || better(r.quality, best->quality)) {
-      best = Snapshot{f.mesh, f.optimized, f.quality_optimized, r.map, r.fit, r.quality, r.cell_quality};
+      best = Snapshot{f.mesh, f.optimized, f.quality_optimized, r.map, rec.control_points_optimized, r.fit, r.quality,
+                      r.cell_quality};
       best_it = it;
     }
     std::vector<int> marked;
@@ -147,10 +171,12 @@ ParameterizationResult run_parameterization(const Polygon& polygon, const Parame
     r.quality = best->quality;
     r.cell_quality = std::move(best->cells);
   }
+  r.control_points_optimized = best->control_points_optimized;
   log("adaptive refinement stopped: " + r.stop_reason + "; kept iteration " + std::to_string(best_it));
   f.times.push_back({"tspline_fit", t_fit});
   f.times.push_back({"jacobian_check", t_check});
   f.times.push_back({"adaptive_refinement", t_refine});
+  f.times.push_back({"control_point_optimization", t_cpo});
   return r;
 }
 

@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "tspline/control_point_optimization.h"
 #include "tspline/map_quality.h"
 #include "tspline/parameterization.h"
 #include "tspline/tspline_fit.h"
@@ -26,6 +27,10 @@ struct AdaptiveOptions {
   int stall_rounds = 2;
   /// Never refine beyond this many cells.
   std::size_t max_cells = 200000;
+  /// After each fit that is not valid and good, optimize the interior control
+  /// points for the Jacobian (control_point_optimization.h) and keep the result
+  /// if it is better.
+  bool optimize_control_points = true;
 };
 
 struct AdaptIteration {
@@ -35,7 +40,8 @@ struct AdaptIteration {
   std::size_t inverted_cells = 0;  ///< of the optimized T-mesh
   std::size_t refined_cells = 0;   ///< cells marked after this iteration (0 for the last)
   FitReport fit;
-  MapQualityStats quality;
+  bool control_points_optimized = false;
+  MapQualityStats quality;         ///< of the map kept in this iteration
   double seconds = 0.0;            ///< optimization (after refinement) + fit + check
 };
 
@@ -47,6 +53,9 @@ struct ParameterizationResult {
   std::vector<CellMapQuality> cell_quality;
   std::vector<AdaptIteration> iterations;
   int kept_iteration = 0;       ///< the best iteration, whose mesh and map these are
+  /// Whether the kept map's interior control points were optimized (so it does
+  /// not interpolate the interior T-mesh vertices).
+  bool control_points_optimized = false;
   std::string stop_reason;      ///< why the adaptive loop stopped
   bool valid() const { return quality.nonpositive_det == 0; }
   bool good(double min_jacobian) const { return valid() && quality.min_mean_ratio >= min_jacobian; }
