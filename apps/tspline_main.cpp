@@ -139,6 +139,14 @@ int main(int argc, char** argv) {
   param->add_option("--max-adapt", adaptive.max_adapt, "Adaptive refinement rounds at most")->capture_default_str();
   param->add_option("--max-cells", adaptive.max_cells, "Adaptive refinement never goes beyond this many cells")
       ->capture_default_str();
+  bool no_cpo = false;
+  param->add_flag("--no-control-point-optimization", no_cpo,
+                  "Keep the interpolating map even where it is invalid or below --min-jacobian (by default the "
+                  "interior control points are then optimized for the Jacobian)");
+  param->add_option("--cpo-power", adaptive.control_point_power,
+                    "Exponent p of the control point optimization's objective sum (1/J_r)^p: larger p raises the "
+                    "minimum J_r")
+      ->capture_default_str();
   param->add_option("--samples", samples, "surface.vtu: k x k sub-quads per T-mesh cell")->capture_default_str();
   param->add_flag("--quiet,-q", quiet, "Print errors only");
   tspline_app::CommandAction command;  // set by the other subcommands when parsed (commands.h)
@@ -158,6 +166,7 @@ int main(int argc, char** argv) {
     if (command) return command();
     if (param->parsed()) {
       if (tol_opt->count() > 0) opt.tolerance_absolute = tol;
+      adaptive.optimize_control_points = !no_cpo;
       std::optional<std::size_t> gj;
       if (gj_opt->count() > 0) gj = geojson_polygon;
       return run_param(input, out_dir, corners, opt, adaptive, samples, gj, quiet);

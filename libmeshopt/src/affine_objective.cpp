@@ -59,7 +59,8 @@ double affine_objective_value(const Eigen::Vector2d& x, std::span<const AffineTe
     if (delta == 0.0 && !(sigma > 0.0)) return kInf;
     double h, dh, d2h;
     regularized(sigma, delta, h, dh, d2h);
-    value += t.weight * S.squaredNorm() / (2.0 * h);
+    const double eta = S.squaredNorm() / (2.0 * h);
+    value += t.weight * (t.power == 1.0 ? eta : std::pow(eta, t.power));
   }
   return value;
 }
@@ -87,10 +88,22 @@ ObjectiveValue affine_objective(const Eigen::Vector2d& x, std::span<const Affine
     const double w = t.weight, invh = 1.0 / h, inv2h = 0.5 * invh;
     const double a1 = dh * inv2h * invh;                             // h' / (2 h^2)
     const double a2 = f * invh * invh * (dh * dh * invh - 0.5 * d2h);  // f (h'^2/h^3 - h''/(2h^2))
-    value += w * f * inv2h;
-    g += w * (gf * inv2h - f * a1 * gs);
-    H += w * (2.0 * c2 * inv2h * Eigen::Matrix2d::Identity() - a1 * (gf * gs.transpose() + gs * gf.transpose()) +
-              a2 * gs * gs.transpose());
+    // eta = f / (2h) and its derivatives (cf. the triangle objective's header).
+    const double eta = f * inv2h;
+    const Eigen::Vector2d geta = gf * inv2h - f * a1 * gs;
+    const Eigen::Matrix2d Heta = 2.0 * c2 * inv2h * Eigen::Matrix2d::Identity() -
+                                 a1 * (gf * gs.transpose() + gs * gf.transpose()) + a2 * gs * gs.transpose();
+    if (t.power == 1.0) {
+      value += w * eta;
+      g += w * geta;
+      H += w * Heta;
+    } else {
+      // w eta^p: grad = p eta^(p-1) grad eta, Hess = p eta^(p-1) Hess eta + p (p-1) eta^(p-2) grad grad^T.
+      const double p = t.power, ep1 = std::pow(eta, p - 1.0);
+      value += w * ep1 * eta;
+      g += w * p * ep1 * geta;
+      H += w * (p * ep1 * Heta + p * (p - 1.0) * ep1 / eta * geta * geta.transpose());
+    }
   }
   out.value = value;
   out.gradient = g;

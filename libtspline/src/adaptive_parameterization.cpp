@@ -41,6 +41,8 @@ ParameterizationResult run_parameterization(const Polygon& polygon, const Parame
     throw InputError("--min-jacobian must be in (0, 1], got " + std::to_string(ad.min_jacobian));
   if (ad.max_adapt < 0) throw InputError("--max-adapt must be >= 0");
   if (ad.gauss < 1 || ad.gauss > 6) throw InputError("Gauss points per direction must be in [1, 6]");
+  if (!(ad.control_point_power >= 1.0 && ad.control_point_power <= 16.0))
+    throw InputError("--cpo-power must be in [1, 16]");
   auto log = [&](const std::string& s) {
     if (opt.log) opt.log(s);
   };
@@ -77,6 +79,7 @@ ParameterizationResult run_parameterization(const Polygon& polygon, const Parame
       TSplineMap candidate = *r.map;
       ControlPointOptimizationOptions copt;
       copt.gauss = ad.gauss;
+      copt.power = ad.control_point_power;
       copt.node = opt.smoothing;
       copt.node.progress = nullptr;
       const ControlPointOptimizationReport cr = optimize_control_points(candidate, copt);

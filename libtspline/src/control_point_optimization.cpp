@@ -99,6 +99,7 @@ ControlPointOptimizationReport optimize_control_points(TSplineMap& map, const Co
         t.S0 = d.J[g] - P[a] * grad.transpose();
         t.c = grad;
         t.weight = d.weight[g];
+        t.power = opt.power;
         terms.push_back(t);
         jsum += d.J[g].norm() / std::sqrt(2.0);
       }

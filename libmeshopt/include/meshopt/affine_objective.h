@@ -22,6 +22,9 @@ struct AffineTerm {
   Eigen::Matrix2d S0 = Eigen::Matrix2d::Zero();
   Eigen::Vector2d c = Eigen::Vector2d::Zero();
   double weight = 1.0;
+  /// The term is weight * eta^power, eta = f / (2h): power > 1 weighs the worst
+  /// terms more (towards a min-max of the distortion); 1 is the paper's K*.
+  double power = 1.0;
 };
 
 double affine_min_sigma(const Eigen::Vector2d& x, std::span<const AffineTerm> terms);

@@ -119,6 +119,7 @@ nlohmann::json param_report(const ParameterizationResult& r, const std::string& 
   rep["jacobian"] = map_quality_json(r.quality);
   rep["jacobian"]["gauss_points_per_direction"] = ad.gauss;
   rep["jacobian"]["threshold"] = ad.min_jacobian;
+  rep["tspline"]["control_points_optimized"] = r.control_points_optimized;
   rep["valid"] = r.valid();
   rep["good"] = r.good(ad.min_jacobian);
   json its = json::array();
@@ -129,11 +130,14 @@ nlohmann::json param_report(const ParameterizationResult& r, const std::string& 
                    {"inverted_tmesh_cells", it.inverted_cells},
                    {"cells_refined_after", it.refined_cells},
                    {"interpolation_relative_residual", it.fit.relative_residual},
+                   {"control_points_optimized", it.control_points_optimized},
                    {"jacobian", map_quality_json(it.quality)},
                    {"seconds", it.seconds}});
   rep["adaptive"] = {{"max_rounds", ad.max_adapt},
                      {"stall_rounds", ad.stall_rounds},
                      {"max_cells", ad.max_cells},
+                     {"control_point_optimization", ad.optimize_control_points},
+                     {"control_point_power", ad.control_point_power},
                      {"iterations", its},
                      {"kept_iteration", r.kept_iteration},
                      {"stop_reason", r.stop_reason}};
