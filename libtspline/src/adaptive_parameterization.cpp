@@ -81,6 +81,7 @@ ParameterizationResult run_parameterization(const Polygon& polygon, const Parame
       copt.gauss = ad.gauss;
       copt.power = ad.control_point_power;
       copt.node = opt.smoothing;
+      copt.node.newton_iterations_per_visit = 1;  // one damped Newton step per point and sweep
       copt.node.progress = nullptr;
       const ControlPointOptimizationReport cr = optimize_control_points(candidate, copt);
       const bool keep = better(cr.after, r.quality);

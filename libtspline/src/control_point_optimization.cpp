@@ -79,10 +79,19 @@ ControlPointOptimizationReport optimize_control_points(TSplineMap& map, const Co
       free.push_back(a);
   }
   rep.free_points = free.size();
+  // Active set (as in meshopt::smooth): a point is visited again only if it or a
+  // function sharing one of its Gauss points moved by more than the tolerance.
+  std::vector<std::vector<int>> at_point(d.weight.size());
+  for (int a : free)
+    for (std::size_t k = d.fn_offsets[a]; k < d.fn_offsets[a + 1]; ++k) at_point[d.fn_points[k]].push_back(a);
+  std::vector<char> active(basis.size(), 0);
+  for (int a : free) active[a] = 1;
   std::vector<meshopt::AffineTerm> terms;
   for (int sweep = 0; sweep < opt.max_sweeps; ++sweep) {
     double max_move = 0.0;
     for (int a : free) {
+      if (!active[a]) continue;
+      active[a] = 0;
       const std::size_t b = d.fn_offsets[a], e = d.fn_offsets[a + 1];
       if (b == e) continue;
       // J_g = (J_g - P_a grad^T) + P_a grad^T: S0 = J_rest, c = grad (W = I).
@@ -109,7 +118,11 @@ ControlPointOptimizationReport optimize_control_points(TSplineMap& map, const Co
       if (delta.squaredNorm() == 0.0) continue;
       for (std::size_t k = b; k < e; ++k) d.J[d.fn_points[k]] += delta * d.fn_grads[k].transpose();
       P[a] = moved;
-      max_move = std::max(max_move, delta.norm() / length);
+      const double rel = delta.norm() / length;
+      max_move = std::max(max_move, rel);
+      if (rel >= opt.relative_tolerance)
+        for (std::size_t k = b; k < e; ++k)
+          for (int n : at_point[d.fn_points[k]]) active[n] = 1;
     }
     rep.sweeps = sweep + 1;
     if (max_move < opt.relative_tolerance) {

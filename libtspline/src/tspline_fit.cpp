@@ -137,8 +137,14 @@ TSplineMap fit_tspline(const TMesh& mesh, const std::vector<Eigen::Vector2d>& x,
   Eigen::SparseMatrix<double> A(n, n);
   A.setFromTriplets(trip.begin(), trip.end());
   A.makeCompressed();
+  // Solve for control points relative to the centre of the targets: the
+  // functions sum to 1 (Eq. 6), so a translation of all control points
+  // translates the map, and far-from-origin coordinates (UTM, say) lose no digits.
+  Eigen::Vector2d lo = data.targets.front(), hi = lo;
+  for (const Eigen::Vector2d& t : data.targets) lo = lo.cwiseMin(t), hi = hi.cwiseMax(t);
+  const Eigen::Vector2d centre = 0.5 * (lo + hi);
   Eigen::MatrixX2d rhs(n, 2);
-  for (int b = 0; b < n; ++b) rhs.row(b) = data.targets[b].transpose();
+  for (int b = 0; b < n; ++b) rhs.row(b) = (data.targets[b] - centre).transpose();
   Eigen::SparseLU<Eigen::SparseMatrix<double>, Eigen::COLAMDOrdering<int>> lu;
   lu.compute(A);
   if (lu.info() != Eigen::Success)
@@ -148,16 +154,12 @@ TSplineMap fit_tspline(const TMesh& mesh, const std::vector<Eigen::Vector2d>& x,
   if (lu.info() != Eigen::Success || !P.allFinite())
     throw NumericalError("interpolation system (Eq. 8) could not be solved");
   std::vector<Eigen::Vector2d> cp(n);
-  for (int a = 0; a < n; ++a) cp[a] = P.row(a).transpose();
+  for (int a = 0; a < n; ++a) cp[a] = P.row(a).transpose() + centre;
   map.set_control_points(std::move(cp));
   const TSplineMap& fitted = map;
   // Residual of the interpolation conditions, evaluated through the map itself.
-  Eigen::Vector2d lo = data.targets.front(), hi = lo;
   double res = 0.0;
-  for (int b = 0; b < n; ++b) {
-    lo = lo.cwiseMin(data.targets[b]), hi = hi.cwiseMax(data.targets[b]);
-    res = std::max(res, (fitted.point(data.params[b]) - data.targets[b]).norm());
-  }
+  for (int b = 0; b < n; ++b) res = std::max(res, (fitted.point(data.params[b]) - data.targets[b]).norm());
   const double diag = (hi - lo).norm();
   const double rel = diag > 0 ? res / diag : res;
   if (!(rel <= 1e-8)) {

@@ -29,7 +29,7 @@ struct ControlPointOptimizationOptions {
   /// Exponent p of the distortion per Gauss point (sum of eta^p): p > 1 pushes
   /// up the minimum J_r rather than the mean.
   double power = 1.0;
-  double relative_tolerance = 1e-4;  ///< stop when every move < this * the point's local length
+  double relative_tolerance = 1e-3;  ///< stop when every move < this * the point's local length
   meshopt::SmoothingOptions node;    ///< Newton settings per visit
 };
 
