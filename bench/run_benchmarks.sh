@@ -17,3 +17,8 @@ header
 for tol in 1e-5 1e-7 1e-8; do
   ./build/bench/bench_front tests/data/polygons/fjords.txt 3 "$tol"
 done
+echo "T-spline stages on $POLY (initial level 5, 7, 9; tol-rel 1e-6); fit includes its own basis build"
+printf "%9s %9s %9s %9s %9s %9s %9s %8s\n" cells functions basis fit check cpo20 peak_MiB min_Jr
+for level in 5 7 9; do
+  ./build/bench/bench_fit "$POLY" "$level" 1e-6
+done

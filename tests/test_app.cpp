@@ -16,37 +16,14 @@ namespace fs = std::filesystem;
 
 namespace {
 
-struct RunResult {
-  int exit_code = -1;
-  std::string out, err;
-};
-
-std::string slurp(const fs::path& p) {
-  std::ifstream f(p);
-  std::stringstream ss;
-  ss << f.rdbuf();
-  return ss.str();
-}
+using RunResult = test_support::AppRun;
+using test_support::count_lines;
+using test_support::slurp;
 
 // A fresh scratch directory per test case.
-fs::path scratch(const std::string& name) {
-  const fs::path d = fs::temp_directory_path() / ("tspline_app_test_" + std::to_string(::getpid())) / name;
-  fs::remove_all(d);
-  fs::create_directories(d);
-  return d;
-}
+fs::path scratch(const std::string& name) { return test_support::scratch_dir("app_test", name); }
 
-RunResult run(const std::string& args, const fs::path& dir) {
-  const fs::path out = dir / "stdout.txt", err = dir / "stderr.txt";
-  const std::string cmd =
-      std::string("'") + TSPLINE_APP_PATH + "' " + args + " >'" + out.string() + "' 2>'" + err.string() + "'";
-  const int status = std::system(cmd.c_str());
-  RunResult r;
-  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  r.out = slurp(out);
-  r.err = slurp(err);
-  return r;
-}
+RunResult run(const std::string& args, const fs::path& dir) { return test_support::run_app(args, dir); }
 
 fs::path write_file(const fs::path& dir, const std::string& name, const std::string& content) {
   const fs::path p = dir / name;
@@ -56,11 +33,6 @@ fs::path write_file(const fs::path& dir, const std::string& name, const std::str
 
 std::string polygons(const std::string& name) { return test_support::polygon_file(name); }
 
-std::size_t count_lines(const std::string& s) {
-  std::size_t n = 0;
-  for (char c : s) n += (c == '\n');
-  return n;
-}
 
 bool dir_is_empty_or_missing(const fs::path& d) { return !fs::exists(d) || fs::is_empty(d); }
 

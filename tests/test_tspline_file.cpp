@@ -37,19 +37,11 @@ using tspline::io::write_tspline_file;
 
 namespace {
 
-fs::path scratch(const std::string& name) {
-  const fs::path d = fs::temp_directory_path() / ("tspline_file_test_" + std::to_string(::getpid())) / name;
-  fs::remove_all(d);
-  fs::create_directories(d);
-  return d;
-}
-
-std::string slurp(const fs::path& p) {
-  std::ifstream f(p);
-  std::stringstream ss;
-  ss << f.rdbuf();
-  return ss.str();
-}
+fs::path scratch(const std::string& name) { return test_support::scratch_dir("file_test", name); }
+using test_support::count_lines;
+using test_support::run_app;
+using test_support::slurp;
+using RunResult = test_support::AppRun;
 
 void spit(const fs::path& p, const std::string& s) { std::ofstream(p) << s; }
 
@@ -134,25 +126,6 @@ LoadedTSpline round_trip(const TSplineMap& map, const TSplineFileMeta& meta, con
 }
 
 // ---------------------------------------------------------------- app runs
-struct RunResult {
-  int exit_code = -1;
-  std::string out, err;
-};
-
-RunResult run_app(const std::string& args, const fs::path& dir) {
-  const fs::path out = dir / "stdout.txt", err = dir / "stderr.txt";
-  const std::string cmd =
-      std::string("'") + TSPLINE_APP_PATH + "' " + args + " >'" + out.string() + "' 2>'" + err.string() + "'";
-  const int status = std::system(cmd.c_str());
-  RunResult r;
-  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  r.out = slurp(out);
-  r.err = slurp(err);
-  return r;
-}
-
-std::size_t count_lines(const std::string& s) { return static_cast<std::size_t>(std::count(s.begin(), s.end(), '\n')); }
-
 std::string g17(double v) {
   char buf[64];
   std::snprintf(buf, sizeof buf, "%.17g", v);
