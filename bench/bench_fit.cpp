@@ -45,6 +45,7 @@ int main(int argc, char** argv) {
   tspline::ControlPointOptimizationOptions copt;
   copt.max_sweeps = 20;
   copt.node.newton_iterations_per_visit = 1;
+  copt.region_below = 0.4;  // as in tspline param (2 x the default min J_r)
   tspline::optimize_control_points(map, copt);
   const double t_cpo = since(t);
   rusage ru{};

@@ -26,7 +26,9 @@ struct GaussData {
   std::vector<Eigen::Vector2d> fn_grads;
 };
 
-GaussData build_gauss_data(const TSplineMap& map, int gauss) {
+// Gauss data of the included cells; gradients are kept only for free functions.
+GaussData build_gauss_data(const TSplineMap& map, int gauss, const std::vector<char>& is_free,
+                           const std::vector<char>& cell_included) {
   std::vector<double> gp, gw;
   gauss_points_01(gauss, gp, gw);
   const TMesh& mesh = map.mesh();
@@ -35,6 +37,7 @@ GaussData build_gauss_data(const TSplineMap& map, int gauss) {
   std::vector<std::vector<std::pair<int, Eigen::Vector2d>>> per_fn(basis.size());
   BasisValues v;
   for (int c = 0; c < static_cast<int>(mesh.num_cells()); ++c) {
+    if (!cell_included[c]) continue;
     const Eigen::Vector2d lo = mesh.cell_min(c), hi = mesh.cell_max(c);
     for (std::size_t a = 0; a < gp.size(); ++a)
       for (std::size_t b = 0; b < gp.size(); ++b) {
@@ -50,7 +53,7 @@ GaussData build_gauss_data(const TSplineMap& map, int gauss) {
           const Eigen::Vector2d& P = map.control_points()[v.ids[k]];
           J.col(0) += grad.x() * P;
           J.col(1) += grad.y() * P;
-          if (grad.x() != 0.0 || grad.y() != 0.0) per_fn[v.ids[k]].push_back({g, grad});
+          if (is_free[v.ids[k]] && (grad.x() != 0.0 || grad.y() != 0.0)) per_fn[v.ids[k]].push_back({g, grad});
         }
         d.J.push_back(J);
       }
@@ -67,16 +70,34 @@ GaussData build_gauss_data(const TSplineMap& map, int gauss) {
 
 ControlPointOptimizationReport optimize_control_points(TSplineMap& map, const ControlPointOptimizationOptions& opt) {
   ControlPointOptimizationReport rep;
-  rep.before = map_quality(map, opt.gauss);
-  GaussData d = build_gauss_data(map, opt.gauss);
-  std::vector<Eigen::Vector2d> P = map.control_points();
+  std::vector<CellMapQuality> cells;
+  rep.before = map_quality(map, opt.gauss, &cells);
   const TSplineBasis& basis = map.basis();
+  const TMesh& mesh = map.mesh();
+  // Free: interior functions (vanishing on the border) that are non-zero on a
+  // cell with J_r below region_below (all interior functions if region_below <= 0).
+  std::vector<char> is_free(basis.size(), 0);
+  for (int c = 0; c < static_cast<int>(mesh.num_cells()); ++c) {
+    if (opt.region_below > 0.0 && cells[c].min_mean_ratio >= opt.region_below) continue;
+    for (int a : basis.functions_on_cell(c))
+      if (!touches_border(basis.function(a))) is_free[a] = 1;
+  }
+  // Cells whose Jacobian a free control point changes.
+  std::vector<char> cell_included(mesh.num_cells(), 0);
+  for (int c = 0; c < static_cast<int>(mesh.num_cells()); ++c)
+    for (int a : basis.functions_on_cell(c))
+      if (is_free[a]) {
+        cell_included[c] = 1;
+        break;
+      }
+  GaussData d = build_gauss_data(map, opt.gauss, is_free, cell_included);
+  std::vector<Eigen::Vector2d> P = map.control_points();
   std::vector<int> free;
   for (int a = 0; a < static_cast<int>(basis.size()); ++a) {
-    if (touches_border(basis.function(a)))
-      ++rep.fixed_points;
-    else
+    if (is_free[a])
       free.push_back(a);
+    else
+      ++rep.fixed_points;
   }
   rep.free_points = free.size();
   // Active set (as in meshopt::smooth): a point is visited again only if it or a

@@ -28,8 +28,8 @@ struct AdaptiveOptions {
   /// Never refine beyond this many cells.
   std::size_t max_cells = 200000;
   /// After each fit that is not valid and good, optimize the interior control
-  /// points for the Jacobian (control_point_optimization.h) and keep the result
-  /// if it is better.
+  /// points acting on cells with J_r < 2 min_jacobian for the Jacobian
+  /// (control_point_optimization.h) and keep the result if it is better.
   bool optimize_control_points = true;
   /// Exponent p of that optimization's objective sum_g (1/J_r)^p (regularized).
   /// p = 1 is the paper's K* and favours the mean; larger p pushes up the

@@ -31,11 +31,15 @@ struct ControlPointOptimizationOptions {
   double power = 1.0;
   double relative_tolerance = 1e-3;  ///< stop when every move < this * the point's local length
   meshopt::SmoothingOptions node;    ///< Newton settings per visit
+  /// If > 0, only the control points of functions that are non-zero on some
+  /// cell with J_r below this move (a local repair: memory and time scale with
+  /// the poor region, not the mesh); if <= 0, every interior control point.
+  double region_below = 0.0;
 };
 
 struct ControlPointOptimizationReport {
   std::size_t free_points = 0;
-  std::size_t fixed_points = 0;
+  std::size_t fixed_points = 0;  ///< border functions, and those outside the region
   int sweeps = 0;
   bool converged = false;
   MapQualityStats before;
