@@ -1,7 +1,8 @@
 // Benchmark of each stage of the front half (boundary, T-mesh, Coons,
 // optimization) on one domain at one resolution. Prints one table row:
 //   cells vertices boundary_s tmesh_s coons_s optimization_s sweeps(all stages) peak_MiB inverted
-// Usage: bench_front POLYGON INIT_LEVEL TOL_REL [MAX_SWEEPS]
+// Usage: bench_front POLYGON INIT_LEVEL TOL_REL [MAX_SWEEPS [CORNER_TRIALS]]
+// ("boundary" includes the automatic corner trials).
 // Run one size per process so the peak memory (getrusage) belongs to that size.
 #include <sys/resource.h>
 
@@ -21,6 +22,7 @@ int main(int argc, char** argv) {
   opt.initial_level = std::atoi(argv[2]);
   opt.tolerance_relative = std::atof(argv[3]);
   if (argc > 4) opt.smoothing.max_sweeps = std::atoi(argv[4]);
+  if (argc > 5) opt.corner_trials = std::atoi(argv[5]);
   const auto poly = tspline::io::read_polygon(argv[1]);
   const tspline::FrontResult r = tspline::run_front(poly, opt);
   double t[4] = {0, 0, 0, 0};

@@ -232,7 +232,15 @@ FrontResult run_front(const Polygon& input, const ParameterizationOptions& opt) 
       topt.log = nullptr;
       topt.smoothing.progress = nullptr;
       topt.corner_trials = 1;
+      // Trials at most at the default resolution (level <= 5, tolerance no finer
+      // than the default 1e-5 diag^2): for the default options that is the run
+      // itself; for fine user settings it keeps the trials cheap.
       topt.initial_level = std::min(opt.initial_level, 5);
+      {
+        const double d = bbox_diagonal(poly);
+        const double tol = opt.tolerance_absolute ? *opt.tolerance_absolute : opt.tolerance_relative * d * d;
+        topt.tolerance_absolute = std::max(tol, 1e-5 * d * d);
+      }
       std::size_t best = 0;
       for (std::size_t k = 0; k < cands.size(); ++k) {
         const FrontResult t = optimize_front(BoundaryMap(poly, cands[k]), topt, nullptr);
