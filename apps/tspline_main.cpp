@@ -116,7 +116,7 @@ int main(int argc, char** argv) {
                     "Boundary tolerance relative to the squared bounding-box diagonal, used when --tol is "
                     "not given")
       ->capture_default_str();
-  param->add_option("--init-level", opt.initial_level, "Initial uniform level L: 2^L x 2^L cells")
+  param->add_option("--init-level", opt.initial_level, "Initial uniform level L in [0, 10]: 2^L x 2^L cells")
       ->capture_default_str();
   param->add_option("--max-level", opt.max_level, "Maximum refinement level of any cell")->capture_default_str();
   param->add_option("--max-sweeps", opt.smoothing.max_sweeps, "Maximum Gauss-Seidel sweeps of the optimization")
