@@ -77,12 +77,31 @@ TEST_SUITE("app") {
     for (const auto& e : fs::directory_iterator(d / "out")) CHECK(e.path().filename().string()[0] != '.');
   }
 
+  TEST_CASE("an invalid final map: exit 3, one clear line, files written and saying so") {
+    // The gear's interpolating map folds at reflex tooth roots; without the
+    // control point repair and without adaptive rounds it stays invalid.
+    const fs::path d = scratch("invalid_map");
+    const RunResult r = run("param '" + polygons("gear.txt") + "' --no-control-point-optimization --max-adapt 0 --out '" +
+                                (d / "out").string() + "'",
+                            d);
+    CHECK(r.exit_code == 3);
+    CHECK(count_lines(r.err) == 1);
+    CHECK(r.err.find("not valid") != std::string::npos);
+    for (const char* f : {"tspline.json", "surface.vtu", "control_net.vtu", "adapt.pvd", "report.json"})
+      CHECK(fs::exists(d / "out" / f));
+    const auto rep = nlohmann::json::parse(slurp(d / "out" / "report.json"));
+    CHECK(rep["valid"] == false);
+    CHECK(rep["jacobian"]["nonpositive_det_points"].get<int>() > 0);
+    CHECK(rep["tspline"]["control_points_optimized"] == false);
+  }
+
   TEST_CASE("--help explains every option") {
     const fs::path d = scratch("help");
     const RunResult r = run("param --help", d);
     CHECK(r.exit_code == 0);
-    for (const char* opt : {"--out", "--corners", "--tol", "--tol-rel", "--init-level", "--max-level", "--max-sweeps",
-                            "--sweep-tol", "--polygon", "--quiet"})
+    for (const char* opt : {"--out", "--corners", "--corner-trials", "--tol", "--tol-rel", "--init-level", "--max-level",
+                            "--max-sweeps", "--omega", "--sweep-tol", "--polygon", "--min-jacobian", "--max-adapt",
+                            "--max-cells", "--samples", "--no-control-point-optimization", "--cpo-power", "--quiet"})
       CHECK(r.out.find(opt) != std::string::npos);
   }
 
