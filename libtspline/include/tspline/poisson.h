@@ -1,0 +1,180 @@
+#pragma once
+// Isogeometric Poisson solver with a residual-based adaptive loop
+// (Brovka 2013 Sect. 7.2; DESIGN.md "IGA Poisson").
+//
+//   -Laplace(u) = f in Omega = S([0,1]^2),   u = g on the boundary of Omega.
+//
+// Analysis space: the cubic T-spline blending functions (TSplineBasis) of an
+// ANALYSIS T-mesh. It starts equal to the geometry's T-mesh and is refined
+// independently; the geometry map S stays the one of the parameterization, so
+// after refinement the method is NOT isoparametric (as in the paper). Every
+// analysis cell lies inside one geometry cell, located once per cell, so that S
+// and its derivatives are evaluated with the geometry cell's function list.
+//
+// Discretization (Galerkin):
+//  * stiffness K_ab = int grad R_a . grad R_b dx, load b_a = int f R_a dx, both with
+//    4x4 Gauss points per analysis cell; grad_x R = J^{-T} grad_xi R, weight |det J|.
+//  * Dirichlet data by INTERPOLATION: the boundary functions are those that do not
+//    vanish on the border of [0,1]^2 (touches_border); each has its interpolation
+//    point on the border. Their coefficients solve the small sparse collocation
+//    system  sum_{b in B} c_b R_b(p_a) = g(S(p_a)), a in B (interior functions
+//    vanish on the border, so they do not enter). Those DOFs are then eliminated
+//    (lifted into the right-hand side); the interior system is symmetric positive
+//    definite.
+//  * Solve: Eigen::SimplicialLDLT; if its factorization fails, conjugate gradients
+//    with an incomplete Cholesky preconditioner.
+//
+// Errors (when an exact solution is given): L2 and H1-seminorm, 6x6 Gauss points per
+// analysis cell. If the exact gradient is not given it is computed by central
+// differences with the absolute step kGradientStep (error ~ step^2 |u'''|/6 plus
+// round-off ~ eps |u| / step).
+//
+// Estimator: eta_e^2 = int_{S(e)} h_e^2 (f + Laplace u_h)^2 dx (4x4 Gauss points),
+// h_e = physical cell diameter, taken as the longer of the two diagonals of the
+// image of the cell's corners, |S(c00) - S(c11)| and |S(c10) - S(c01)|.
+// Laplace u_h uses the physical Hessian (see physical_hessian()).
+//
+// Known limitation (measured in tests/test_poisson.cpp): on T-meshes with hanging
+// vertices the normalized blending functions R = N / sum N do not reproduce linear
+// functions near the T-junctions, so the spaces are not nested and uniform
+// refinement of such a mesh converges at about h^2 (L2) and h (H1) instead of h^4
+// and h^3. On meshes without T-junctions the rates are optimal.
+#include <Eigen/Core>
+#include <Eigen/SparseCore>
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "tspline/tmesh.h"
+#include "tspline/tspline_basis.h"
+#include "tspline/tspline_map.h"
+
+namespace tspline {
+
+using ScalarField = std::function<double(double, double)>;
+using VectorField = std::function<Eigen::Vector2d(double, double)>;
+
+/// Central-difference step for the exact gradient when none is given.
+inline constexpr double kGradientStep = 1e-5;
+
+struct PoissonProblem {
+  ScalarField f;               ///< source (required)
+  ScalarField g;               ///< Dirichlet data (required)
+  ScalarField exact;           ///< exact solution (optional: enables errors)
+  VectorField exact_gradient;  ///< its gradient (optional: central differences if absent)
+};
+
+/// The analysis space: T-mesh, its basis, and per analysis cell its geometry cell.
+class AnalysisSpace {
+ public:
+  /// \pre analysis_mesh has topology and refines map.mesh() (each cell inside one
+  /// geometry cell). \throw InputError otherwise.
+  AnalysisSpace(const TSplineMap& map, TMesh analysis_mesh);
+  const TMesh& mesh() const { return *mesh_; }
+  const TSplineBasis& basis() const { return *basis_; }
+  int geometry_cell(int c) const { return geometry_cell_[c]; }
+  std::size_t num_dofs() const { return basis_->size(); }
+
+ private:
+  std::unique_ptr<TMesh> mesh_;  // heap: the basis keeps a pointer to it
+  std::unique_ptr<TSplineBasis> basis_;
+  std::vector<int> geometry_cell_;
+};
+
+struct SolverStats {
+  std::string kind;                ///< "SimplicialLDLT" or "ConjugateGradient+IncompleteCholesky"
+  double seconds = 0.0;            ///< factorization + solve
+  double relative_residual = 0.0;  ///< ||K u - b|| / ||b|| of the interior system (0 if b = 0)
+  int iterations = 0;              ///< CG iterations (0 for the direct solver)
+};
+
+struct PoissonSolution {
+  std::shared_ptr<const AnalysisSpace> space;
+  Eigen::VectorXd coefficients;        ///< one per basis function (size space->num_dofs())
+  std::vector<bool> is_boundary;       ///< Dirichlet DOFs
+  std::size_t interior_dofs = 0;       ///< unknowns of the solved system
+  SolverStats solver;
+  double assembly_seconds = 0.0;
+  double dirichlet_seconds = 0.0;
+};
+
+/// Value, gradient and Hessian of u_h at a point in physical coordinates.
+struct SolutionValue {
+  Eigen::Vector2d x = Eigen::Vector2d::Zero();  ///< S(uv)
+  double u = 0.0;
+  Eigen::Vector2d grad = Eigen::Vector2d::Zero();
+  Eigen::Matrix2d hessian = Eigen::Matrix2d::Zero();  ///< only for order 2
+  double det_j = 0.0;
+};
+
+/// Physical Hessian from the parametric one: with g = grad_x u,
+///   H_x = J^{-T} (H_xi - sum_k g_k Hess_xi(S_k)) J^{-1},
+/// derived from d2u/dxi_i dxi_j = J^T H_x J + sum_k g_k d2S_k/dxi_i dxi_j.
+/// \pre d holds second derivatives.
+Eigen::Matrix2d physical_hessian(const Eigen::Vector2d& grad_x, const Eigen::Matrix2d& hessian_xi,
+                                 const MapDerivatives& d);
+
+/// Solves the problem on the given analysis T-mesh (a refinement of map.mesh()).
+/// \throw InputError if f or g are missing or produce a non-finite value;
+/// NumericalError if the Dirichlet system or both solvers fail.
+PoissonSolution solve_poisson(const TSplineMap& map, const TMesh& analysis_mesh, const PoissonProblem& problem);
+/// Same on an already built analysis space (built with the same map).
+PoissonSolution solve_poisson(const TSplineMap& map, std::shared_ptr<const AnalysisSpace> space,
+                              const PoissonProblem& problem);
+
+/// u_h at parametric point uv of analysis cell c (order 0, 1 or 2).
+SolutionValue evaluate_solution(const TSplineMap& map, const PoissonSolution& sol, int c, const Eigen::Vector2d& uv,
+                                int order = 1);
+
+struct PoissonErrors {
+  double l2 = 0.0;             ///< ||u - u_h||_L2
+  double h1 = 0.0;             ///< |u - u_h|_H1 (seminorm)
+  double l2_exact = 0.0;       ///< ||u||_L2
+  double h1_exact = 0.0;       ///< |u|_H1
+  double max_abs_at_qp = 0.0;  ///< max |u - u_h| over the quadrature points
+};
+
+/// \throw InputError if problem.exact is missing.
+PoissonErrors compute_errors(const TSplineMap& map, const PoissonSolution& sol, const PoissonProblem& problem);
+
+/// eta_e per analysis cell (not squared).
+std::vector<double> estimate_cells(const TSplineMap& map, const PoissonSolution& sol, const PoissonProblem& problem);
+
+/// Cells with eta_e > gamma * max eta (none if max eta is 0). \throw InputError unless 0 <= gamma <= 1.
+std::vector<int> mark_cells(const std::vector<double>& eta, double gamma);
+
+/// A copy of `mesh` with the given cells split, balanced, topology rebuilt.
+TMesh refine_cells(const TMesh& mesh, const std::vector<int>& cells);
+
+struct AdaptiveSolveOptions {
+  enum class Refine { Adaptive, Uniform };
+  Refine refine = Refine::Adaptive;
+  int steps = 5;                ///< number of solves (>= 1)
+  double gamma = 0.5;           ///< marking parameter in [0,1]
+  std::size_t max_dofs = 200000;  ///< stop before a solve on a space with more DOFs
+};
+
+struct PoissonStep {
+  int step = 0;
+  std::size_t dofs = 0;
+  std::size_t cells = 0;
+  double eta = 0.0;  ///< sqrt(sum eta_e^2)
+  bool has_errors = false;
+  PoissonErrors errors;
+  SolverStats solver;
+  double assembly_seconds = 0.0;
+  double seconds = 0.0;  ///< whole step (solve, errors, estimator)
+  std::size_t marked = 0;
+};
+
+/// Called after each step with its record, the solution and the per-cell eta.
+using PoissonStepCallback =
+    std::function<void(const PoissonStep&, const PoissonSolution&, const std::vector<double>& eta)>;
+
+/// Solve, estimate, mark (adaptive) or split all cells (uniform), repeat.
+/// \throw InputError for bad options (steps < 1, gamma outside [0,1]).
+std::vector<PoissonStep> solve_adaptive(const TSplineMap& map, const PoissonProblem& problem,
+                                        const AdaptiveSolveOptions& options, const PoissonStepCallback& callback = {});
+
+}  // namespace tspline

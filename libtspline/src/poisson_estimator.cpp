@@ -1,0 +1,152 @@
+// Errors, residual estimator, marking, refinement and the adaptive loop of the
+// IGA Poisson solver (see poisson.h).
+#include <Eigen/Dense>
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+
+#include "tspline/errors.h"
+#include "tspline/map_quality.h"
+#include "tspline/poisson.h"
+
+namespace tspline {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+
+Eigen::Vector2d exact_gradient(const PoissonProblem& p, double x, double y) {
+  if (p.exact_gradient) return p.exact_gradient(x, y);
+  const double h = kGradientStep;
+  return {(p.exact(x + h, y) - p.exact(x - h, y)) / (2 * h), (p.exact(x, y + h) - p.exact(x, y - h)) / (2 * h)};
+}
+
+}  // namespace
+
+PoissonErrors compute_errors(const TSplineMap& map, const PoissonSolution& sol, const PoissonProblem& problem) {
+  if (!problem.exact) throw InputError("Poisson errors: no exact solution given");
+  const TMesh& mesh = sol.space->mesh();
+  std::vector<double> gp, gw;
+  gauss_points_01(6, gp, gw);
+  PoissonErrors e;
+  double l2 = 0, h1 = 0, l2u = 0, h1u = 0;
+  for (int c = 0; c < static_cast<int>(mesh.num_cells()); ++c) {
+    const Eigen::Vector2d lo = mesh.cell_min(c), len = mesh.cell_max(c) - lo;
+    for (std::size_t i = 0; i < gp.size(); ++i)
+      for (std::size_t j = 0; j < gp.size(); ++j) {
+        const Eigen::Vector2d uv(lo.x() + gp[i] * len.x(), lo.y() + gp[j] * len.y());
+        const SolutionValue v = evaluate_solution(map, sol, c, uv, 1);
+        const double w = gw[i] * gw[j] * len.x() * len.y() * std::abs(v.det_j);
+        const double ue = problem.exact(v.x.x(), v.x.y());
+        const Eigen::Vector2d ge = exact_gradient(problem, v.x.x(), v.x.y());
+        l2 += w * (ue - v.u) * (ue - v.u);
+        h1 += w * (ge - v.grad).squaredNorm();
+        l2u += w * ue * ue;
+        h1u += w * ge.squaredNorm();
+        e.max_abs_at_qp = std::max(e.max_abs_at_qp, std::abs(ue - v.u));
+      }
+  }
+  e.l2 = std::sqrt(l2);
+  e.h1 = std::sqrt(h1);
+  e.l2_exact = std::sqrt(l2u);
+  e.h1_exact = std::sqrt(h1u);
+  return e;
+}
+
+std::vector<double> estimate_cells(const TSplineMap& map, const PoissonSolution& sol, const PoissonProblem& problem) {
+  const TMesh& mesh = sol.space->mesh();
+  std::vector<double> gp, gw;
+  gauss_points_01(4, gp, gw);
+  std::vector<double> eta(mesh.num_cells(), 0.0);
+  for (int c = 0; c < static_cast<int>(mesh.num_cells()); ++c) {
+    const Eigen::Vector2d lo = mesh.cell_min(c), hi = mesh.cell_max(c), len = hi - lo;
+    const int g = sol.space->geometry_cell(c);
+    // h_e: the longer diagonal of the image of the cell's corners.
+    const Eigen::Vector2d p00 = map.derivatives(lo, 0, g).x, p11 = map.derivatives(hi, 0, g).x;
+    const Eigen::Vector2d p10 = map.derivatives({hi.x(), lo.y()}, 0, g).x;
+    const Eigen::Vector2d p01 = map.derivatives({lo.x(), hi.y()}, 0, g).x;
+    const double h = std::max((p11 - p00).norm(), (p01 - p10).norm());
+    double s = 0;
+    for (std::size_t i = 0; i < gp.size(); ++i)
+      for (std::size_t j = 0; j < gp.size(); ++j) {
+        const Eigen::Vector2d uv(lo.x() + gp[i] * len.x(), lo.y() + gp[j] * len.y());
+        const SolutionValue v = evaluate_solution(map, sol, c, uv, 2);
+        const double w = gw[i] * gw[j] * len.x() * len.y() * std::abs(v.det_j);
+        const double r = problem.f(v.x.x(), v.x.y()) + v.hessian.trace();
+        s += w * r * r;
+      }
+    eta[c] = h * std::sqrt(s);
+  }
+  return eta;
+}
+
+std::vector<int> mark_cells(const std::vector<double>& eta, double gamma) {
+  if (!(gamma >= 0.0 && gamma <= 1.0)) throw InputError("gamma must lie in [0, 1], got " + std::to_string(gamma));
+  std::vector<int> marked;
+  if (eta.empty()) return marked;
+  const double m = *std::max_element(eta.begin(), eta.end());
+  if (!(m > 0.0)) return marked;
+  for (int c = 0; c < static_cast<int>(eta.size()); ++c)
+    if (eta[c] > gamma * m) marked.push_back(c);
+  return marked;
+}
+
+TMesh refine_cells(const TMesh& mesh, const std::vector<int>& cells) {
+  TMesh out = mesh;
+  std::vector<int> nodes;
+  nodes.reserve(cells.size());
+  for (int c : cells) nodes.push_back(mesh.cell_node(c));  // node ids stay valid: refine() appends
+  for (int n : nodes)
+    if (out.node(n).is_leaf()) out.refine(n);
+  out.balance();
+  out.build_topology();
+  return out;
+}
+
+std::vector<PoissonStep> solve_adaptive(const TSplineMap& map, const PoissonProblem& problem,
+                                        const AdaptiveSolveOptions& options, const PoissonStepCallback& callback) {
+  if (options.steps < 1) throw InputError("Poisson: steps must be at least 1");
+  if (!(options.gamma >= 0.0 && options.gamma <= 1.0))
+    throw InputError("gamma must lie in [0, 1], got " + std::to_string(options.gamma));
+  std::vector<PoissonStep> steps;
+  TMesh mesh = map.mesh();
+  for (int k = 0; k < options.steps; ++k) {
+    const auto t0 = Clock::now();
+    auto space = std::make_shared<const AnalysisSpace>(map, mesh);
+    if (k > 0 && space->num_dofs() > options.max_dofs) break;
+    const PoissonSolution sol = solve_poisson(map, space, problem);
+    PoissonStep st;
+    st.step = k;
+    st.dofs = space->num_dofs();
+    st.cells = space->mesh().num_cells();
+    st.solver = sol.solver;
+    st.assembly_seconds = sol.assembly_seconds;
+    if (problem.exact) {
+      st.has_errors = true;
+      st.errors = compute_errors(map, sol, problem);
+    }
+    const std::vector<double> eta = estimate_cells(map, sol, problem);
+    double s = 0;
+    for (double e : eta) s += e * e;
+    st.eta = std::sqrt(s);
+    std::vector<int> marked;
+    if (options.refine == AdaptiveSolveOptions::Refine::Uniform) {
+      marked.resize(eta.size());
+      for (int c = 0; c < static_cast<int>(eta.size()); ++c) marked[c] = c;
+    } else {
+      marked = mark_cells(eta, options.gamma);
+    }
+    st.marked = marked.size();
+    st.seconds = seconds_since(t0);
+    steps.push_back(st);
+    if (callback) callback(st, sol, eta);
+    if (k + 1 < options.steps) {
+      if (marked.empty()) break;
+      mesh = refine_cells(mesh, marked);
+    }
+  }
+  return steps;
+}
+
+}  // namespace tspline
