@@ -17,4 +17,8 @@ using CommandAction = std::function<int()>;
 /// (docs/tspline_format.md).
 void add_tspline_file_commands(CLI::App& app, CommandAction& action);
 
+/// `tspline poisson`: isogeometric Poisson solve with adaptive or uniform
+/// refinement on the domain of a T-spline file (cmd_poisson.cpp).
+void add_poisson_command(CLI::App& app, CommandAction& action);
+
 }  // namespace tspline_app

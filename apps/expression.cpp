@@ -1,0 +1,57 @@
+#include "expression.h"
+
+#include <muParser.h>
+
+#include <numbers>
+#include <utility>
+
+#include "tspline/errors.h"
+
+namespace tspline_app {
+
+struct Expression::Impl {
+  // The parser keeps the addresses of x and y: Impl lives on the heap and is
+  // never copied or moved.
+  double x = 0.0, y = 0.0;
+  mu::Parser parser;
+};
+
+Expression::Expression(std::string option, std::string text)
+    : option_(std::move(option)), text_(std::move(text)), impl_(std::make_unique<Impl>()) {
+  try {
+    impl_->parser.DefineVar("x", &impl_->x);
+    impl_->parser.DefineVar("y", &impl_->y);
+    impl_->parser.DefineConst("pi", std::numbers::pi);
+    impl_->parser.SetExpr(text_);
+    // muParser parses lazily, on the first evaluation: force it now so that a
+    // syntax error is reported before any work (the value itself is not checked).
+    int results = 0;
+    impl_->parser.Eval(results);
+    if (results != 1)
+      throw tspline::InputError(option_ + ": cannot parse '" + text_ + "': it gives " +
+                                std::to_string(results) +
+                                " comma-separated values, expected one expression in x and y");
+  } catch (const mu::Parser::exception_type& e) {
+    throw tspline::InputError(option_ + ": cannot parse '" + text_ + "': " + e.GetMsg());
+  }
+}
+
+Expression::~Expression() = default;
+
+double Expression::operator()(double x, double y) const {
+  impl_->x = x;
+  impl_->y = y;
+  try {
+    return impl_->parser.Eval();
+  } catch (const mu::Parser::exception_type& e) {
+    throw tspline::InputError(option_ + ": cannot evaluate '" + text_ + "' at x = " + std::to_string(x) +
+                              ", y = " + std::to_string(y) + ": " + e.GetMsg());
+  }
+}
+
+tspline::ScalarField make_field(const std::string& option, const std::string& text) {
+  auto e = std::make_shared<const Expression>(option, text);
+  return [e](double x, double y) { return (*e)(x, y); };
+}
+
+}  // namespace tspline_app
