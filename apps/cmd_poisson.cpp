@@ -269,6 +269,7 @@ tspline::io::VtuMesh solution_vtu(const tspline::TSplineMap& map, const tspline:
 }
 
 std::string short_solver(const tspline::SolverStats& s) {
+  if (s.kind == "CholmodSupernodalLLT") return "CHOLMOD";
   if (s.kind == "SimplicialLDLT") return "LDLT";
   if (s.kind == "ConjugateGradient+IncompleteCholesky") return "CG+IC(" + std::to_string(s.iterations) + ")";
   return s.kind;

@@ -83,7 +83,7 @@ int main(int argc, char** argv) {
   getrusage(RUSAGE_SELF, &ru);
   std::printf("%5d %9zu %9zu %8.3f %11.3f %10.3f %8.3f %-6s %9.1e %9.1e %9.1f\n", level, m.num_cells(),
               space->num_dofs(), space_s, sol.dirichlet_seconds, sol.assembly_seconds, sol.solver.seconds,
-              sol.solver.kind == "SimplicialLDLT" ? "LDLT" : "CG+IC", sol.solver.relative_residual, max_err,
+              sol.solver.kind == "CholmodSupernodalLLT" ? "CHOLMOD" : sol.solver.kind == "SimplicialLDLT" ? "LDLT" : "CG+IC", sol.solver.relative_residual, max_err,
               ru.ru_maxrss / 1024.0);
   return 0;
 }

@@ -168,7 +168,7 @@ TEST_SUITE("poisson_app") {
     }
     for (const auto& row : rows) {
       CHECK(num(row, "eta_over_h1") == doctest::Approx(num(row, "eta") / num(row, "h1")).epsilon(1e-12));
-      CHECK(row.at("solver") == "SimplicialLDLT");
+      CHECK(row.at("solver") == "CholmodSupernodalLLT");
     }
     // ParaView collection: one dataset per step, each file present with its arrays.
     const std::string pvd = slurp(out / "solution.pvd");

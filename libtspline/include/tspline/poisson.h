@@ -21,7 +21,8 @@
 //    vanish on the border, so they do not enter). Those DOFs are then eliminated
 //    (lifted into the right-hand side); the interior system is symmetric positive
 //    definite.
-//  * Solve: Eigen::SimplicialLDLT; if its factorization fails, conjugate gradients
+//  * Solve: CHOLMOD's supernodal Cholesky (SuiteSparse); if it fails, Eigen's
+//    SimplicialLDLT; if that fails too, conjugate gradients
 //    with an incomplete Cholesky preconditioner.
 //
 // Errors (when an exact solution is given): L2 and H1-seminorm, 6x6 Gauss points per
@@ -83,7 +84,7 @@ class AnalysisSpace {
 };
 
 struct SolverStats {
-  std::string kind;                ///< "SimplicialLDLT" or "ConjugateGradient+IncompleteCholesky"
+  std::string kind;                ///< "CholmodSupernodalLLT", "SimplicialLDLT" or "ConjugateGradient+IncompleteCholesky"
   double seconds = 0.0;            ///< factorization + solve
   double relative_residual = 0.0;  ///< ||K u - b|| / ||b|| of the interior system (0 if b = 0)
   int iterations = 0;              ///< CG iterations (0 for the direct solver)
