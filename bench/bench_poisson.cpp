@@ -28,17 +28,11 @@ double seconds_since(Clock::time_point t0) {
   return std::chrono::duration<double>(Clock::now() - t0).count();
 }
 
-/// The identity on [0,1]^2 on a uniform T-mesh (as tests/test_poisson.cpp builds it).
+/// The identity on [0,1]^2 as a T-spline map on a uniform T-mesh (Greville control points).
 tspline::TSplineMap identity_map(int level) {
   tspline::TMesh m(level);
   m.build_topology();
-  tspline::TSplineMap map(m);
-  std::vector<Eigen::Vector2d> P;
-  for (const auto& f : map.basis().functions())
-    P.emplace_back((f.knots_xi[1] + f.knots_xi[2] + f.knots_xi[3]) / 3.0,
-                   (f.knots_eta[1] + f.knots_eta[2] + f.knots_eta[3]) / 3.0);
-  map.set_control_points(std::move(P));
-  return map;
+  return tspline::greville_identity_map(std::move(m));
 }
 
 }  // namespace

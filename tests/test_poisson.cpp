@@ -19,18 +19,11 @@ namespace {
 
 constexpr double kPi = std::numbers::pi;
 
-/// The identity on [0,1]^2 as a T-spline map on a uniform T-mesh: control points
-/// at the Greville abscissae (mean of the three middle local knots).
+/// The identity on [0,1]^2 as a T-spline map on a uniform T-mesh (Greville control points).
 tspline::TSplineMap identity_map(int level) {
-  TMesh m(level);
+  tspline::TMesh m(level);
   m.build_topology();
-  tspline::TSplineMap map(m);
-  std::vector<Eigen::Vector2d> P;
-  for (const auto& f : map.basis().functions())
-    P.emplace_back((f.knots_xi[1] + f.knots_xi[2] + f.knots_xi[3]) / 3.0,
-                   (f.knots_eta[1] + f.knots_eta[2] + f.knots_eta[3]) / 3.0);
-  map.set_control_points(std::move(P));
-  return map;
+  return tspline::greville_identity_map(std::move(m));
 }
 
 tspline::PoissonProblem sinsin() {

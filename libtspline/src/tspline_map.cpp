@@ -57,6 +57,17 @@ MapDerivatives TSplineMap::derivatives(const Eigen::Vector2d& uv, int order, int
   return d;
 }
 
+TSplineMap greville_identity_map(TMesh mesh) {
+  TSplineMap map(std::move(mesh));
+  std::vector<Eigen::Vector2d> P;
+  P.reserve(map.basis().size());
+  for (const BlendingFunction& f : map.basis().functions())
+    P.emplace_back((f.knots_xi[1] + f.knots_xi[2] + f.knots_xi[3]) / 3.0,
+                   (f.knots_eta[1] + f.knots_eta[2] + f.knots_eta[3]) / 3.0);
+  map.set_control_points(std::move(P));
+  return map;
+}
+
 Eigen::Vector2d TSplineMap::point(const Eigen::Vector2d& uv) const { return derivatives(uv, 0).x; }
 
 Eigen::Matrix2d TSplineMap::jacobian(const Eigen::Vector2d& uv) const { return derivatives(uv, 1).J; }

@@ -49,4 +49,11 @@ class TSplineMap {
   std::vector<Eigen::Vector2d> control_points_;
 };
 
+/// The map whose control points are the Greville abscissae of the blending
+/// functions (mean of the three middle local knots in each direction). On a
+/// T-mesh without T-junctions this is exactly the identity of [0,1]^2 (the
+/// reference geometry for analysis tests and benchmarks); with T-junctions it
+/// is only close to it (the normalized basis does not reproduce linear functions).
+TSplineMap greville_identity_map(TMesh mesh);
+
 }  // namespace tspline
