@@ -27,6 +27,7 @@
 #include "tspline/errors.h"
 #include "tspline/io/atomic_file.h"
 #include "tspline/io/tspline_file.h"
+#include "tspline/io/cell_grid.h"
 #include "tspline/io/vtu_writer.h"
 #include "tspline/poisson.h"
 
@@ -226,45 +227,24 @@ tspline::io::VtuMesh solution_vtu(const tspline::TSplineMap& map, const tspline:
                                   const tspline::PoissonProblem& problem, const std::vector<double>& eta,
                                   int k) {
   const tspline::TMesh& mesh = sol.space->mesh();
-  tspline::io::VtuMesh out;
-  const std::size_t per_cell = static_cast<std::size_t>((k + 1) * (k + 1));
-  out.points.reserve(mesh.num_cells() * per_cell);
   std::vector<double> uh, ue, err, cell_eta;
-  std::vector<int> cell_id, level;
-  uh.reserve(mesh.num_cells() * per_cell);
-  for (int c = 0; c < static_cast<int>(mesh.num_cells()); ++c) {
-    const Eigen::Vector2d lo = mesh.cell_min(c), hi = mesh.cell_max(c);
-    const int base = static_cast<int>(out.points.size());
-    for (int j = 0; j <= k; ++j)
-      for (int i = 0; i <= k; ++i) {
-        const Eigen::Vector2d uv(lo.x() + (hi.x() - lo.x()) * i / k, lo.y() + (hi.y() - lo.y()) * j / k);
-        const tspline::SolutionValue v = tspline::evaluate_solution(map, sol, c, uv, 0);
-        out.points.push_back(v.x);
-        uh.push_back(v.u);
-        if (problem.exact) {
-          const double u = problem.exact(v.x.x(), v.x.y());
-          ue.push_back(u);
-          err.push_back(v.u - u);
-        }
-      }
-    for (int j = 0; j < k; ++j)
-      for (int i = 0; i < k; ++i) {
-        const int a = base + j * (k + 1) + i;
-        out.cells.push_back({a, a + 1, a + k + 2, a + k + 1});
-        cell_eta.push_back(eta[c]);
-        cell_id.push_back(c);
-        level.push_back(mesh.cell_level(c));
-      }
-  }
-  out.quads_as_polygons = false;
+  tspline::io::VtuMesh out = tspline::io::cell_grid_vtu(mesh, k, [&](int c, const Eigen::Vector2d& uv) {
+    const tspline::SolutionValue v = tspline::evaluate_solution(map, sol, c, uv, 0);
+    uh.push_back(v.u);
+    if (problem.exact) {
+      const double u = problem.exact(v.x.x(), v.x.y());
+      ue.push_back(u);
+      err.push_back(v.u - u);
+    }
+    return v.x;
+  });
+  for (int c : out.cell_ints["cell"]) cell_eta.push_back(eta[c]);
   out.point_scalars["u_h"] = std::move(uh);
   if (problem.exact) {
     out.point_scalars["u_exact"] = std::move(ue);
     out.point_scalars["error"] = std::move(err);
   }
   out.cell_scalars["eta"] = std::move(cell_eta);
-  out.cell_ints["level"] = std::move(level);
-  out.cell_ints["cell"] = std::move(cell_id);
   return out;
 }
 

@@ -6,6 +6,7 @@
 #include <Eigen/LU>
 
 #include "tspline/io/atomic_file.h"
+#include "tspline/io/cell_grid.h"
 #include "tspline/io/front_output.h"
 #include "tspline/io/tspline_file.h"
 #include "tspline/map_quality.h"
@@ -13,42 +14,20 @@
 namespace tspline::io {
 
 VtuMesh surface_vtu(const TSplineMap& map, int k) {
-  if (k < 1 || k > 64) throw std::invalid_argument("samples per cell edge must be in [1, 64]");
-  const TMesh& mesh = map.mesh();
-  VtuMesh out;
-  const std::size_t per_cell = static_cast<std::size_t>((k + 1) * (k + 1));
-  out.points.reserve(mesh.num_cells() * per_cell);
   std::vector<double> jr, det, js;
   std::vector<Eigen::Vector2d> param;
-  std::vector<int> cell_id, level;
-  for (int c = 0; c < static_cast<int>(mesh.num_cells()); ++c) {
-    const Eigen::Vector2d lo = mesh.cell_min(c), hi = mesh.cell_max(c);
-    const int base = static_cast<int>(out.points.size());
-    for (int j = 0; j <= k; ++j)
-      for (int i = 0; i <= k; ++i) {
-        const Eigen::Vector2d uv(lo.x() + (hi.x() - lo.x()) * i / k, lo.y() + (hi.y() - lo.y()) * j / k);
-        const MapDerivatives d = map.derivatives(uv, 1, c);
-        out.points.push_back(d.x);
-        jr.push_back(mean_ratio_jacobian(d.J));
-        det.push_back(d.J.determinant());
-        js.push_back(scaled_jacobian(d.J));
-        param.push_back(uv);
-      }
-    for (int j = 0; j < k; ++j)
-      for (int i = 0; i < k; ++i) {
-        const int a = base + j * (k + 1) + i;
-        out.cells.push_back({a, a + 1, a + k + 2, a + k + 1});
-        cell_id.push_back(c);
-        level.push_back(mesh.cell_level(c));
-      }
-  }
-  out.quads_as_polygons = false;
+  VtuMesh out = cell_grid_vtu(map.mesh(), k, [&](int c, const Eigen::Vector2d& uv) {
+    const MapDerivatives d = map.derivatives(uv, 1, c);
+    jr.push_back(mean_ratio_jacobian(d.J));
+    det.push_back(d.J.determinant());
+    js.push_back(scaled_jacobian(d.J));
+    param.push_back(uv);
+    return d.x;
+  });
   out.point_scalars["mean_ratio_jacobian"] = std::move(jr);
   out.point_scalars["det_jacobian"] = std::move(det);
   out.point_scalars["scaled_jacobian"] = std::move(js);
   out.point_vectors["parametric"] = std::move(param);
-  out.cell_ints["cell"] = std::move(cell_id);
-  out.cell_ints["level"] = std::move(level);
   return out;
 }
 
