@@ -21,4 +21,8 @@ void add_tspline_file_commands(CLI::App& app, CommandAction& action);
 /// refinement on the domain of a T-spline file (cmd_poisson.cpp).
 void add_poisson_command(CLI::App& app, CommandAction& action);
 
+/// `tspline check`: certify det J > 0 on every Bezier element of a T-spline
+/// file (cmd_check.cpp); exit 3 if the map is not certified valid.
+void add_check_command(CLI::App& app, CommandAction& action);
+
 }  // namespace tspline_app

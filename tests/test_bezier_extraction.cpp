@@ -80,7 +80,8 @@ int check_extraction(const TSplineMap& map, int samples, unsigned seed) {
       }
       for (int k = 0; k < samples; ++k) {
         const Eigen::Vector2d st(u01(rng), u01(rng));
-        const Eigen::Vector2d uv(e.lo.x() + st.x() * (e.hi.x() - e.lo.x()), e.lo.y() + st.y() * (e.hi.y() - e.lo.y()));
+        const Eigen::Vector2d uv(e.lo.x() + st.x() * (e.hi.x() - e.lo.x()),
+                                 e.lo.y() + st.y() * (e.hi.y() - e.lo.y()));
         CHECK((e.local(uv) - st).norm() < 1e-12);
         // Every function on the cell: the Bernstein form where listed, zero elsewhere.
         Eigen::Vector2d X = Eigen::Vector2d::Zero();
@@ -111,7 +112,8 @@ int check_extraction(const TSplineMap& map, int samples, unsigned seed) {
 TSplineMap smooth_map(TMesh mesh) {
   TSplineMap map = tspline::greville_identity_map(std::move(mesh));
   std::vector<Eigen::Vector2d> P = map.control_points();
-  for (Eigen::Vector2d& p : P) p = Eigen::Vector2d(2.0 * p.x() + 0.3 * std::sin(3.0 * p.y()), p.y() + 0.2 * p.x() * p.x());
+  for (Eigen::Vector2d& p : P)
+    p = Eigen::Vector2d(2.0 * p.x() + 0.3 * std::sin(3.0 * p.y()), p.y() + 0.2 * p.x() * p.x());
   map.set_control_points(P);
   return map;
 }
@@ -162,7 +164,8 @@ TEST_SUITE("bezier_extraction") {
       CHECK(ex.cell_begin(static_cast<int>(map.mesh().num_cells())) == ex.elements().size());
       for (int c = 0; c < static_cast<int>(map.mesh().num_cells()); ++c) {
         CHECK(ex.cell_begin(c + 1) > ex.cell_begin(c));
-        for (std::size_t k = ex.cell_begin(c); k < ex.cell_begin(c + 1); ++k) CHECK(ex.elements()[k].cell == c);
+        for (std::size_t k = ex.cell_begin(c); k < ex.cell_begin(c + 1); ++k)
+          CHECK(ex.elements()[k].cell == c);
       }
     }
     // With T-junctions some functions' knot lines cross cell interiors.

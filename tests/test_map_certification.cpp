@@ -10,13 +10,14 @@
 #include <limits>
 #include <random>
 
+#include "separable_maps.h"
 #include "test_support.h"
-
 #include "tspline/adaptive_parameterization.h"
 #include "tspline/io/polygon_reader.h"
 #include "tspline/map_certification.h"
 #include "tspline/map_quality.h"
 
+using test_support::separable_cubic_map;
 using tspline::BernsteinPoly;
 using tspline::BezierElement;
 using tspline::ElementStatus;
@@ -30,12 +31,6 @@ BernsteinPoly random_poly(int m, int n, std::mt19937& rng) {
   BernsteinPoly p(m, n);
   for (int k = 0; k < p.size(); ++k) p.c[k] = u(rng);
   return p;
-}
-
-TMesh uniform(int level) {
-  TMesh m(level);
-  m.build_topology();
-  return m;
 }
 
 TMesh random_tmesh(int level, int splits, unsigned seed) {
@@ -53,42 +48,57 @@ TMesh random_tmesh(int level, int splits, unsigned seed) {
   return m;
 }
 
-// Value of the cubic c0 + c1 u + c2 u^2 + c3 u^3's blossom at (u1, u2, u3).
-double blossom(const std::array<double, 4>& c, double u1, double u2, double u3) {
-  return c[0] + c[1] * (u1 + u2 + u3) / 3.0 + c[2] * (u1 * u2 + u1 * u3 + u2 * u3) / 3.0 + c[3] * u1 * u2 * u3;
-}
-
-// The map S(xi, eta) = (x(xi), y(eta)) for cubics x, y, exact on a mesh without
-// T-junctions (Marsden's identity: control points are blossoms at the middle knots).
-TSplineMap separable_cubic_map(TMesh mesh, const std::array<double, 4>& x, const std::array<double, 4>& y) {
-  TSplineMap map(std::move(mesh));
-  std::vector<Eigen::Vector2d> P;
-  for (const tspline::BlendingFunction& f : map.basis().functions())
-    P.emplace_back(blossom(x, f.knots_xi[1], f.knots_xi[2], f.knots_xi[3]),
-                   blossom(y, f.knots_eta[1], f.knots_eta[2], f.knots_eta[3]));
-  map.set_control_points(P);
-  return map;
-}
-
-// Dense sampling of det J on every element: k x k points at the centres of a
-// regular grid. Returns per element (in certify order) the sampled minimum.
+// Dense sampling of det J on every element: a k x k grid including the
+// element's edges and corners. det J is evaluated directly from the B-splines
+// (cubic_bspline), independently of the Bernstein form: on the grid the sums
+// X = sum_a P_a N_a(u) M_a(v), w = sum_a N_a(u) M_a(v) and their derivatives are
+// matrix products (N diag(P) M^T), and S = X / w gives
+// det J = det(X_u w - X w_u, X_v w - X w_v) / w^4.
 struct SampledElement {
   BezierElement e;
   double min_det;
   Eigen::Vector2d at;
 };
 std::vector<SampledElement> sample_elements(const TSplineMap& map, int k) {
+  using Mat = Eigen::MatrixXd;
   std::vector<SampledElement> out;
+  const tspline::TSplineBasis& basis = map.basis();
   for (int c = 0; c < static_cast<int>(map.mesh().num_cells()); ++c)
-    for (BezierElement& e : tspline::extract_cell(map.basis(), c)) {
+    for (BezierElement& e : tspline::extract_cell(basis, c)) {
       SampledElement s{std::move(e), std::numeric_limits<double>::infinity(), {}};
+      const std::vector<int>& fs = basis.functions_on_cell(c);
+      const Eigen::Index nf = static_cast<Eigen::Index>(fs.size());
+      Mat Nu(k, nf), Du(k, nf), Nv(k, nf), Dv(k, nf);
+      Eigen::VectorXd px(nf), py(nf);
+      std::vector<double> u(k), v(k);
+      for (int i = 0; i < k; ++i) {
+        u[i] = s.e.lo.x() + i * (s.e.hi.x() - s.e.lo.x()) / (k - 1);
+        v[i] = s.e.lo.y() + i * (s.e.hi.y() - s.e.lo.y()) / (k - 1);
+      }
+      for (Eigen::Index a = 0; a < nf; ++a) {
+        const tspline::BlendingFunction& f = basis.function(fs[a]);
+        px[a] = map.control_points()[fs[a]].x();
+        py[a] = map.control_points()[fs[a]].y();
+        for (int i = 0; i < k; ++i) {
+          Nu(i, a) = tspline::cubic_bspline(f.knots_xi, u[i], &Du(i, a));
+          Nv(i, a) = tspline::cubic_bspline(f.knots_eta, v[i], &Dv(i, a));
+        }
+      }
+      const Mat W = Nu * Nv.transpose(), Wu = Du * Nv.transpose(), Wv = Nu * Dv.transpose();
+      const Mat X = Nu * px.asDiagonal() * Nv.transpose(), Xu = Du * px.asDiagonal() * Nv.transpose(),
+                Xv = Nu * px.asDiagonal() * Dv.transpose();
+      const Mat Y = Nu * py.asDiagonal() * Nv.transpose(), Yu = Du * py.asDiagonal() * Nv.transpose(),
+                Yv = Nu * py.asDiagonal() * Dv.transpose();
       for (int j = 0; j < k; ++j)
         for (int i = 0; i < k; ++i) {
-          const Eigen::Vector2d uv(s.e.lo.x() + (i + 0.5) / k * (s.e.hi.x() - s.e.lo.x()),
-                                   s.e.lo.y() + (j + 0.5) / k * (s.e.hi.y() - s.e.lo.y()));
-          const double d = map.derivatives(uv, 1, c).J.determinant();
-          if (d < s.min_det) s.min_det = d, s.at = uv;
+          const double w = W(i, j);
+          const double su_x = Xu(i, j) * w - X(i, j) * Wu(i, j), su_y = Yu(i, j) * w - Y(i, j) * Wu(i, j);
+          const double sv_x = Xv(i, j) * w - X(i, j) * Wv(i, j), sv_y = Yv(i, j) * w - Y(i, j) * Wv(i, j);
+          const double d = (su_x * sv_y - su_y * sv_x) / (w * w * w * w);
+          if (d < s.min_det) s.min_det = d, s.at = {u[i], v[j]};
         }
+      // The sampler itself against the map's own evaluation at the minimum.
+      CHECK(s.min_det == doctest::Approx(map.derivatives(s.at, 1, c).J.determinant()).epsilon(1e-9));
       out.push_back(std::move(s));
     }
   return out;
@@ -96,10 +106,12 @@ std::vector<SampledElement> sample_elements(const TSplineMap& map, int k) {
 
 // Certification agrees with dense sampling element by element: certified =>
 // no sampled negative, and the certified lower bound is below every sample;
-// a sampled negative => proven invalid. Returns the number of elements.
-std::size_t check_agreement(const TSplineMap& map, int k, std::size_t* sampled_negative = nullptr) {
+// a sampled negative => proven invalid; proven invalid => det J < 0 at the
+// reported point (direct evaluation). Returns the number of elements.
+std::size_t check_agreement(const TSplineMap& map, int k, std::size_t* sampled_negative = nullptr,
+                            std::size_t* proven_invalid = nullptr) {
   const std::vector<SampledElement> samples = sample_elements(map, k);
-  std::size_t negatives = 0, certified = 0;
+  std::size_t negatives = 0, certified = 0, invalid = 0;
   for (const SampledElement& s : samples) {
     const tspline::ElementCertificate cert = tspline::certify_element(s.e, map.control_points());
     CAPTURE(s.e.cell);
@@ -113,13 +125,49 @@ std::size_t check_agreement(const TSplineMap& map, int k, std::size_t* sampled_n
       ++negatives;
       CHECK(cert.status == ElementStatus::Invalid);
     }
+    if (cert.status == ElementStatus::Invalid) {
+      ++invalid;
+      const Eigen::Vector2d& at = cert.negative_at;
+      CHECK(at.x() >= s.e.lo.x());
+      CHECK(at.x() <= s.e.hi.x());
+      CHECK(at.y() >= s.e.lo.y());
+      CHECK(at.y() <= s.e.hi.y());
+      CHECK(map.derivatives(at, 1, s.e.cell).J.determinant() < 0.0);
+    }
   }
   if (sampled_negative) *sampled_negative = negatives;
+  if (proven_invalid) *proven_invalid = invalid;
   const tspline::MapCertification mc = tspline::certify_map(map);
   CHECK(mc.elements == samples.size());
   CHECK(mc.certified == certified);
   CHECK(mc.certified_valid() == (certified == samples.size()));
   return samples.size();
+}
+
+// Runs the parameterization of each domain with default options and checks the
+// agreement on the map of every adaptive iteration; the final map must be
+// certified. Returns the number of elements proven invalid (all iterations).
+std::size_t domain_agreement(const std::vector<std::string>& names) {
+  std::size_t total_invalid = 0;
+  for (const std::string& name : names) {
+    CAPTURE(name);
+    const auto poly = tspline::io::read_polygon(test_support::polygon_file(name));
+    std::size_t elements = 0, negatives = 0, invalid = 0;
+    const tspline::ParameterizationResult r = tspline::run_parameterization(
+        poly, {}, {},
+        [&](int, const TMesh&, const std::vector<Eigen::Vector2d>&, const TSplineMap& map,
+            const std::vector<tspline::CellMapQuality>&) {
+          std::size_t neg = 0, inv = 0;
+          elements += check_agreement(map, 50, &neg, &inv);
+          negatives += neg;
+          invalid += inv;
+        });
+    CHECK(r.certified_valid());
+    MESSAGE(name << ": " << r.iterations.size() << " iterations, " << elements << " elements sampled, "
+                 << negatives << " with a sampled det J < 0, " << invalid << " proven invalid");
+    total_invalid += invalid;
+  }
+  return total_invalid;
 }
 
 }  // namespace
@@ -152,14 +200,16 @@ TEST_SUITE("map_certification") {
     }
   }
 
-  TEST_CASE("the (8,8) numerator D / w^3 is det J of the map at random points (T-mesh with hanging vertices)") {
+  TEST_CASE(
+      "the (8,8) numerator D / w^3 is det J of the map at random points (T-mesh with hanging vertices)") {
     for (unsigned seed : {2u, 9u}) {
       TSplineMap map = tspline::greville_identity_map(random_tmesh(2, 10, seed));
       REQUIRE(map.mesh().num_hanging_vertices() > 0);
       std::vector<Eigen::Vector2d> P = map.control_points();
       // A nonlinear map far from the origin (the element centres the control points).
       for (Eigen::Vector2d& p : P)
-        p = Eigen::Vector2d(1e4 + 3.0 * p.x() + 0.4 * std::sin(4.0 * p.y()), -2e3 + p.y() + 0.3 * p.x() * p.y());
+        p = Eigen::Vector2d(1e4 + 3.0 * p.x() + 0.4 * std::sin(4.0 * p.y()),
+                            -2e3 + p.y() + 0.3 * p.x() * p.y());
       map.set_control_points(P);
       std::mt19937 rng(seed);
       std::uniform_real_distribution<double> u01(0.0, 1.0);
@@ -174,7 +224,8 @@ TEST_SUITE("map_certification") {
           CHECK(J.numerator.n == 8);
           for (int k = 0; k < 5; ++k) {
             const double s = u01(rng), t = u01(rng);
-            const Eigen::Vector2d uv(e.lo.x() + s * (e.hi.x() - e.lo.x()), e.lo.y() + t * (e.hi.y() - e.lo.y()));
+            const Eigen::Vector2d uv(e.lo.x() + s * (e.hi.x() - e.lo.x()),
+                                     e.lo.y() + t * (e.hi.y() - e.lo.y()));
             const double direct = map.derivatives(uv, 1, c).J.determinant();
             max_rel = std::max(max_rel, std::abs(J.det_param(e, s, t) - direct) / std::abs(direct));
           }
@@ -186,10 +237,8 @@ TEST_SUITE("map_certification") {
   }
 
   TEST_CASE("a map folded between the 16 Gauss points is proven invalid, at the fold") {
-    // S = (x(xi), eta) with x' = 30 (xi - 1/2)^2 - 0.3: det J = x' < 0 exactly for
-    // |xi - 1/2| < 0.1, a strip between the Gauss abscissae 0.33 and 0.67 of the
-    // single cell, where x' >= 0.56.
-    const TSplineMap map = separable_cubic_map(uniform(0), {-1.25, 7.2, -15.0, 10.0}, {0.0, 1.0, 0.0, 0.0});
+    // S = (x(xi), eta), det J = x' < 0 exactly in the strip |xi - 1/2| < 0.1 (separable_maps.h).
+    const TSplineMap map = test_support::fold_between_gauss_points();
     const tspline::MapQualityStats q = tspline::map_quality(map, 4);
     CHECK(q.nonpositive_det == 0);
     CHECK(q.min_det > 0.5);
@@ -209,8 +258,9 @@ TEST_SUITE("map_certification") {
     CHECK(cert.det_lower_bound <= -0.3);
     // The same fold inside one cell of a finer mesh: only that cell fails.
     // x'(xi) = 120 (xi - 1/4)^2 - 0.3 on [0, 1/2]: negative for |xi - 1/4| < 0.05.
-    const TSplineMap fine = separable_cubic_map(uniform(1), {-0.25 * 0.25 * 0.25 * 40.0, 7.5 - 0.3, -30.0, 40.0},
-                                                {0.0, 1.0, 0.0, 0.0});
+    const TSplineMap fine =
+        separable_cubic_map(test_support::uniform_mesh(1),
+                            {-0.25 * 0.25 * 0.25 * 40.0, 7.5 - 0.3, -30.0, 40.0}, {0.0, 1.0, 0.0, 0.0});
     CHECK(tspline::map_quality(fine, 4).nonpositive_det == 0);
     const tspline::MapCertification mf = tspline::certify_map(fine);
     CHECK(mf.elements == 4);
@@ -219,12 +269,13 @@ TEST_SUITE("map_certification") {
   }
 
   TEST_CASE("a slightly distorted square is certified, with a lower bound below every sample") {
-    TSplineMap map = tspline::greville_identity_map(uniform(2));
+    TSplineMap map = tspline::greville_identity_map(test_support::uniform_mesh(2));
     std::vector<Eigen::Vector2d> P = map.control_points();
     std::mt19937 rng(17);
     std::uniform_real_distribution<double> u(-0.03, 0.03);
     for (std::size_t a = 0; a < P.size(); ++a)
-      if (P[a].x() > 0.0 && P[a].x() < 1.0 && P[a].y() > 0.0 && P[a].y() < 1.0) P[a] += Eigen::Vector2d(u(rng), u(rng));
+      if (P[a].x() > 0.0 && P[a].x() < 1.0 && P[a].y() > 0.0 && P[a].y() < 1.0)
+        P[a] += Eigen::Vector2d(u(rng), u(rng));
     map.set_control_points(P);
     const tspline::MapCertification mc = tspline::certify_map(map);
     CHECK(mc.elements == 16);
@@ -236,14 +287,16 @@ TEST_SUITE("map_certification") {
     for (char ok : mc.cell_certified) CHECK(ok == 1);
     check_agreement(map, 50);
     // The identity: det J = 1 everywhere, so the bound is exactly 1.
-    const tspline::MapCertification id = tspline::certify_map(tspline::greville_identity_map(uniform(2)));
+    const tspline::MapCertification id =
+        tspline::certify_map(tspline::greville_identity_map(test_support::uniform_mesh(2)));
     CHECK(id.certified_valid());
     CHECK(id.min_relative_lower_bound == doctest::Approx(1.0).epsilon(1e-12));
   }
 
   TEST_CASE("det J touching zero: undecided at the depth limit, not certified") {
     // S = (xi, eta^3): det J = 3 eta^2 >= 0, zero on the edge eta = 0.
-    const TSplineMap map = separable_cubic_map(uniform(0), {0.0, 1.0, 0.0, 0.0}, {0.0, 0.0, 0.0, 1.0});
+    const TSplineMap map =
+        separable_cubic_map(test_support::uniform_mesh(0), {0.0, 1.0, 0.0, 0.0}, {0.0, 0.0, 0.0, 1.0});
     tspline::CertificationOptions opt;
     opt.max_depth = 4;
     const tspline::MapCertification mc = tspline::certify_map(map, opt);
@@ -256,15 +309,25 @@ TEST_SUITE("map_certification") {
     CHECK(mc.failures[0].certificate.det_lower_bound <= 0.0);
   }
 
-  TEST_CASE("certification agrees with 50 x 50 sampling per element on the test domains") {
-    for (const std::string name : {"square.txt", "lshape_cw.txt", "disk.txt", "cshape.txt"}) {
-      CAPTURE(name);
-      const auto poly = tspline::io::read_polygon(test_support::polygon_file(name));
-      const tspline::ParameterizationResult r = tspline::run_parameterization(poly, {}, {});
-      const std::size_t n = check_agreement(*r.map, 50);
-      MESSAGE(name << ": " << n << " elements");
-    }
-    // An invalid map: the gear without control point repair and adaptive rounds.
+  TEST_CASE("certification agrees with 50 x 50 sampling per element: square, L-shape, disk, flower") {
+    // The disk's first map is folded between its Gauss points near the corners.
+    CHECK(domain_agreement({"square.txt", "lshape_cw.txt", "disk.txt", "flower.txt"}) > 0);
+  }
+
+  TEST_CASE("certification agrees with 50 x 50 sampling per element: C-shape, blob bay") {
+    domain_agreement({"cshape.txt", "blob_bay.txt"});
+  }
+
+  TEST_CASE("certification agrees with 50 x 50 sampling per element: gear") {
+    domain_agreement({"gear.txt"});
+  }
+
+  TEST_CASE("certification agrees with 50 x 50 sampling per element: fjords") {
+    // Its first map is folded in one element, between the Gauss points.
+    CHECK(domain_agreement({"fjords.txt"}) > 0);
+  }
+
+  TEST_CASE("certification agrees with sampling on an invalid map (gear, no repair, no adaptive rounds)") {
     const auto gear = tspline::io::read_polygon(test_support::polygon_file("gear.txt"));
     tspline::AdaptiveOptions ad;
     ad.optimize_control_points = false;
@@ -273,5 +336,7 @@ TEST_SUITE("map_certification") {
     std::size_t negatives = 0;
     check_agreement(*r.map, 20, &negatives);
     CHECK(negatives > 0);
+    CHECK_FALSE(r.certified_valid());
+    CHECK(r.certification.invalid >= negatives);
   }
 }

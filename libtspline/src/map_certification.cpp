@@ -127,7 +127,8 @@ BernsteinPoly bernstein_axpy(const BernsteinPoly& a, double f, const BernsteinPo
 std::array<BernsteinPoly, 4> bernstein_subdivide(const BernsteinPoly& p) {
   // Split in s row by row into left/right, then each in t column by column.
   BernsteinPoly ls(p.m, p.n), rs(p.m, p.n);
-  for (int j = 0; j <= p.n; ++j) split_row(&p.c[(p.m + 1) * j], p.m, 1, &ls.c[(p.m + 1) * j], &rs.c[(p.m + 1) * j]);
+  for (int j = 0; j <= p.n; ++j)
+    split_row(&p.c[(p.m + 1) * j], p.m, 1, &ls.c[(p.m + 1) * j], &rs.c[(p.m + 1) * j]);
   std::array<BernsteinPoly, 4> q = {BernsteinPoly(p.m, p.n), BernsteinPoly(p.m, p.n), BernsteinPoly(p.m, p.n),
                                     BernsteinPoly(p.m, p.n)};
   for (int i = 0; i <= p.m; ++i) {
@@ -168,9 +169,8 @@ ElementJacobian element_jacobian(const BezierElement& e, const std::vector<Eigen
   const BernsteinPoly d_0t = bernstein_axpy(bernstein_product(X, Yt), -1.0, bernstein_product(Y, Xt));
   ElementJacobian J;
   J.weight = W;
-  J.numerator = bernstein_axpy(
-      bernstein_axpy(bernstein_product(W, d_st), -1.0, bernstein_product(Wt, d_s0)), -1.0,
-      bernstein_product(Ws, d_0t));
+  J.numerator = bernstein_axpy(bernstein_axpy(bernstein_product(W, d_st), -1.0, bernstein_product(Wt, d_s0)),
+                               -1.0, bernstein_product(Ws, d_0t));
   // |D| <= the same expression with every factor replaced by its largest
   // absolute coefficient (Bernstein coefficients of a product are convex
   // combinations of products of coefficients).
@@ -185,7 +185,8 @@ ElementJacobian element_jacobian(const BezierElement& e, const std::vector<Eigen
 // ---------------------------------------------------------------------------
 ElementCertificate certify_element(const BezierElement& e, const std::vector<Eigen::Vector2d>& P,
                                    const CertificationOptions& opt) {
-  if (opt.max_depth < 0 || opt.max_depth > 20) throw std::invalid_argument("certify_element: max_depth out of range");
+  if (opt.max_depth < 0 || opt.max_depth > 20)
+    throw std::invalid_argument("certify_element: max_depth out of range");
   const ElementJacobian J = element_jacobian(e, P);
   const double area = (e.hi.x() - e.lo.x()) * (e.hi.y() - e.lo.y());
   const double tol = opt.relative_tolerance * J.scale;

@@ -27,10 +27,10 @@
 namespace tspline {
 
 struct BezierElement {
-  int cell = -1;                          ///< the T-mesh cell containing the element
+  int cell = -1;                                 ///< the T-mesh cell containing the element
   Eigen::Vector2d lo = Eigen::Vector2d::Zero();  ///< parametric lower-left corner
   Eigen::Vector2d hi = Eigen::Vector2d::Zero();  ///< parametric upper-right corner
-  std::vector<int> functions;             ///< blending functions non-zero on the element (sorted)
+  std::vector<int> functions;                    ///< blending functions non-zero on the element (sorted)
   /// functions.size() x 16: row r holds the Bernstein coefficients of
   /// N_{functions[r]} on the element, column i + 4 j for B_i(s) B_j(t).
   Eigen::Matrix<double, Eigen::Dynamic, 16, Eigen::RowMajor> C;

@@ -60,7 +60,8 @@ struct BernsteinPoly {
   double operator()(double s, double t) const;
 };
 
-/// Product: (m1+m2, n1+n2), c_ij = sum a_{i1 j1} b_{i2 j2} binom(m1,i1) binom(m2,i2) / binom(m,i) (same in j).
+/// Product: (m1+m2, n1+n2), c_ij = sum a_{i1 j1} b_{i2 j2} binom(m1,i1) binom(m2,i2) / binom(m,i) (same in
+/// j).
 BernsteinPoly bernstein_product(const BernsteinPoly& a, const BernsteinPoly& b);
 /// d/ds (degree m-1 in s): m (c_{i+1,j} - c_{i,j}). Requires m >= 1.
 BernsteinPoly bernstein_ds(const BernsteinPoly& a);
@@ -104,8 +105,8 @@ struct ElementCertificate {
   /// Invalid: parametric point where det J < 0, and det J there.
   Eigen::Vector2d negative_at = Eigen::Vector2d::Zero();
   double negative_det = 0.0;
-  int depth = 0;             ///< deepest subdivision level used
-  std::size_t patches = 0;   ///< sub-patches examined
+  int depth = 0;            ///< deepest subdivision level used
+  std::size_t patches = 0;  ///< sub-patches examined
 };
 
 ElementCertificate certify_element(const BezierElement& e, const std::vector<Eigen::Vector2d>& P,
