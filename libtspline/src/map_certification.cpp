@@ -31,8 +31,43 @@ double binom(int n, int k) {
 
 // Bernstein basis values B_i^deg(s), i = 0..deg.
 void bernstein_values(int deg, double s, double* out) {
+  // Powers by repeated multiplication (no pow calls): s^i and r^(deg-i).
   const double r = 1.0 - s;
-  for (int i = 0; i <= deg; ++i) out[i] = binom(deg, i) * std::pow(s, i) * std::pow(r, deg - i);
+  double sp[kMax + 1], rp[kMax + 1];
+  sp[0] = rp[0] = 1.0;
+  for (int i = 1; i <= deg; ++i) sp[i] = sp[i - 1] * s, rp[i] = rp[i - 1] * r;
+  for (int i = 0; i <= deg; ++i) out[i] = binom(deg, i) * sp[i] * rp[deg - i];
+}
+
+// Gauss-Legendre (5 points on [0,1]) nodes, weights and the Bernstein values of
+// degrees 3 and 8 there, for the element mean of det J.
+struct GaussBernstein {
+  std::vector<double> p, w;
+  double b3[5][4], b8[5][9];
+};
+const GaussBernstein& gauss_bernstein() {
+  static const GaussBernstein g = [] {
+    GaussBernstein t;
+    gauss_points_01(5, t.p, t.w);
+    for (int a = 0; a < 5; ++a) {
+      bernstein_values(3, t.p[a], t.b3[a]);
+      bernstein_values(8, t.p[a], t.b8[a]);
+    }
+    return t;
+  }();
+  return g;
+}
+
+// p(s_a, t_b) at Gauss nodes a, b from tabulated basis values (bidegree (d, d)).
+template <int d>
+double at_gauss(const BernsteinPoly& p, const double (&bs)[d + 1], const double (&bt)[d + 1]) {
+  double v = 0.0;
+  for (int j = 0; j <= d; ++j) {
+    double row = 0.0;
+    for (int i = 0; i <= d; ++i) row += p.c[i + (d + 1) * j] * bs[i];
+    v += row * bt[j];
+  }
+  return v;
 }
 
 // de Casteljau split of one coefficient row (stride `stride`, deg+1 values) at 1/2.
@@ -195,13 +230,12 @@ ElementCertificate certify_element(const BezierElement& e, const std::vector<Eig
 
   // Mean of det J over the element: 5x5 Gauss (exact for D when w is constant).
   {
-    std::vector<double> gp, gw;
-    gauss_points_01(5, gp, gw);
+    const GaussBernstein& g = gauss_bernstein();
     double sum = 0.0;
-    for (std::size_t a = 0; a < gp.size(); ++a)
-      for (std::size_t b = 0; b < gp.size(); ++b) {
-        const double w = J.weight(gp[a], gp[b]);
-        sum += gw[a] * gw[b] * J.numerator(gp[a], gp[b]) / (w * w * w);
+    for (int a = 0; a < 5; ++a)
+      for (int b = 0; b < 5; ++b) {
+        const double w = at_gauss<3>(J.weight, g.b3[a], g.b3[b]);
+        sum += g.w[a] * g.w[b] * at_gauss<8>(J.numerator, g.b8[a], g.b8[b]) / (w * w * w);
       }
     cert.det_mean = sum / area;
   }
