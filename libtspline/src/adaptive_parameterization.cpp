@@ -49,7 +49,7 @@ ParameterizationResult run_parameterization(const Polygon& polygon, const Parame
   ParameterizationResult r{run_front(polygon, opt), std::nullopt, {}, {}, {}, {}, 0, false, {}, {}, 0};
   FrontResult& f = r.front;
   double t_fit = 0.0, t_check = 0.0, t_refine = 0.0, t_cpo = 0.0, t_certify = 0.0;
-  // The best iteration so far: fewest det J <= 0 points, then highest min J_r.
+  // The best iteration so far (better_iteration below).
   struct Snapshot {
     TMesh mesh = TMesh(0);
     std::vector<Eigen::Vector2d> x;

@@ -23,8 +23,8 @@ struct AdaptiveOptions {
   double min_jacobian = 0.2;  ///< delta: refine cells where J_r < delta at some Gauss point
   int max_adapt = 10;         ///< adaptive rounds at most
   int gauss = 4;              ///< Gauss points per direction and cell for the check
-  /// Stop when the best iteration (fewest det J <= 0 points, then highest min
-  /// J_r) has not improved for this many rounds: refinement cannot fix
+  /// Stop when the best iteration (fewest det J <= 0 points, then certified
+  /// valid before not, then highest min J_r) has not improved for this many rounds: refinement cannot fix
   /// distortion that the corner choice imposes (a long strip mapped onto the
   /// square keeps its aspect ratio however fine the mesh).
   int stall_rounds = 2;
