@@ -7,6 +7,7 @@
 #include <random>
 
 #include "tspline/bezier_extraction.h"
+#include "tspline/map_quality.h"
 #include "tspline/tmesh.h"
 #include "tspline/tspline_map.h"
 
@@ -118,6 +119,33 @@ TSplineMap smooth_map(TMesh mesh) {
   return map;
 }
 
+// Max over the functions of |sum over cells of the quadrature of N_a - exact|,
+// relative; the exact integral of a cubic B-spline on 5 knots is (k4 - k0) / 4.
+// `quad(c, out)` gives the quadrature points of cell c.
+template <class Quad>
+double integral_error(const TSplineBasis& integrand, const TMesh& cells, Quad&& quad) {
+  std::vector<double> sum(integrand.size(), 0.0);
+  std::vector<tspline::QuadraturePoint> q;
+  for (int c = 0; c < static_cast<int>(cells.num_cells()); ++c) {
+    quad(c, q);
+    for (const auto& p : q)
+      for (std::size_t a = 0; a < integrand.size(); ++a) {
+        const auto& f = integrand.function(static_cast<int>(a));
+        if (p.uv.x() < f.knots_xi[0] || p.uv.x() > f.knots_xi[4] || p.uv.y() < f.knots_eta[0] ||
+            p.uv.y() > f.knots_eta[4])
+          continue;
+        sum[a] += p.weight * direct_value(f, p.uv);
+      }
+  }
+  double err = 0.0;
+  for (std::size_t a = 0; a < integrand.size(); ++a) {
+    const auto& f = integrand.function(static_cast<int>(a));
+    const double exact = (f.knots_xi[4] - f.knots_xi[0]) * (f.knots_eta[4] - f.knots_eta[0]) / 16.0;
+    err = std::max(err, std::abs(sum[a] - exact) / exact);
+  }
+  return err;
+}
+
 }  // namespace
 
 TEST_SUITE("bezier_extraction") {
@@ -170,5 +198,61 @@ TEST_SUITE("bezier_extraction") {
     }
     // With T-junctions some functions' knot lines cross cell interiors.
     CHECK(split_total > 0);
+  }
+
+  TEST_CASE("quadrature per Bezier element integrates every blending function exactly (not so per cell)") {
+    const TMesh mesh = random_tmesh(2, 12, 7);
+    const TSplineBasis basis(mesh);
+    REQUIRE(mesh.num_hanging_vertices() > 0);
+    // 2 x 2 Gauss points are exact for bicubics: exact on every element.
+    const double per_element = integral_error(
+        basis, mesh,
+        [&](int c, std::vector<tspline::QuadraturePoint>& q) { tspline::cell_quadrature(basis, c, 2, q); });
+    CHECK(per_element < 1e-13);
+    // The same rule on whole cells is not exact where knot lines cross cells.
+    const double per_cell = integral_error(basis, mesh, [&](int c, std::vector<tspline::QuadraturePoint>& q) {
+      std::vector<double> gp, gw;
+      tspline::gauss_points_01(2, gp, gw);
+      const Eigen::Vector2d lo = mesh.cell_min(c), len = mesh.cell_max(c) - lo;
+      q.clear();
+      for (std::size_t a = 0; a < gp.size(); ++a)
+        for (std::size_t b = 0; b < gp.size(); ++b)
+          q.push_back(
+              {{lo.x() + gp[a] * len.x(), lo.y() + gp[b] * len.y()}, gw[a] * gw[b] * len.x() * len.y()});
+    });
+    CHECK(per_cell > 1e-6);
+    // Weights of each cell add up to its area.
+    std::vector<tspline::QuadraturePoint> q;
+    for (int c = 0; c < static_cast<int>(mesh.num_cells()); ++c) {
+      tspline::cell_quadrature(basis, c, 3, q);
+      double w = 0.0;
+      for (const auto& p : q) w += p.weight;
+      CHECK(w == doctest::Approx(mesh.cell_size(c) * mesh.cell_size(c)).epsilon(1e-14));
+    }
+  }
+
+  TEST_CASE(
+      "quadrature on a finer analysis mesh, split by the geometry's knot lines too, integrates the geometry "
+      "functions exactly") {
+    const TMesh geometry_mesh = random_tmesh(2, 8, 11);
+    const TSplineBasis geometry(geometry_mesh);
+    // The analysis mesh: the geometry mesh with some cells split once more.
+    TMesh analysis_mesh = geometry_mesh;
+    for (int c = 0; c < static_cast<int>(geometry_mesh.num_cells()); c += 3)
+      analysis_mesh.refine(geometry_mesh.cell_node(c));
+    analysis_mesh.balance();
+    analysis_mesh.build_topology();
+    const TSplineBasis analysis(analysis_mesh);
+    auto geometry_cell = [&](int c) {
+      return geometry.locate(0.5 * (analysis_mesh.cell_min(c) + analysis_mesh.cell_max(c)));
+    };
+    const double with_geometry = integral_error(geometry, analysis_mesh, [&](int c, auto& q) {
+      tspline::cell_quadrature(analysis, c, 2, q, &geometry, geometry_cell(c));
+    });
+    CHECK(with_geometry < 1e-13);
+    // And the analysis functions, too.
+    CHECK(integral_error(analysis, analysis_mesh, [&](int c, auto& q) {
+            tspline::cell_quadrature(analysis, c, 2, q, &geometry, geometry_cell(c));
+          }) < 1e-13);
   }
 }

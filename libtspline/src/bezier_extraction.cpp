@@ -4,6 +4,8 @@
 #include <Eigen/LU>
 #include <algorithm>
 
+#include "tspline/map_quality.h"
+
 namespace tspline {
 
 namespace {
@@ -98,6 +100,34 @@ std::vector<BezierElement> extract_cell(const TSplineBasis& basis, int c) {
       out.push_back(std::move(e));
     }
   return out;
+}
+
+void cell_quadrature(const TSplineBasis& basis, int c, int n, std::vector<QuadraturePoint>& out,
+                     const TSplineBasis* geometry, int g) {
+  std::vector<double> xb, yb;
+  cell_element_breaks(basis, c, xb, yb);
+  if (geometry) {
+    const Eigen::Vector2d lo = basis.mesh().cell_min(c), hi = basis.mesh().cell_max(c);
+    std::vector<double> gx, gy;
+    cell_element_breaks(*geometry, g, gx, gy);
+    for (double x : gx)
+      if (x > lo.x() && x < hi.x()) xb.push_back(x);
+    for (double y : gy)
+      if (y > lo.y() && y < hi.y()) yb.push_back(y);
+    sort_unique(xb);
+    sort_unique(yb);
+  }
+  thread_local std::vector<double> gp, gw;
+  gauss_points_01(n, gp, gw);
+  out.clear();
+  out.reserve((xb.size() - 1) * (yb.size() - 1) * gp.size() * gp.size());
+  for (std::size_t j = 0; j + 1 < yb.size(); ++j)
+    for (std::size_t i = 0; i + 1 < xb.size(); ++i) {
+      const double hx = xb[i + 1] - xb[i], hy = yb[j + 1] - yb[j];
+      for (std::size_t b = 0; b < gp.size(); ++b)
+        for (std::size_t a = 0; a < gp.size(); ++a)
+          out.push_back({{xb[i] + gp[a] * hx, yb[j] + gp[b] * hy}, gw[a] * gw[b] * hx * hy});
+    }
 }
 
 BezierExtraction::BezierExtraction(const TSplineBasis& basis) {

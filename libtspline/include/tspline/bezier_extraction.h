@@ -67,6 +67,23 @@ class BezierExtraction {
   std::vector<std::size_t> cell_begin_;
 };
 
+/// A quadrature point of a cell: parametric position and weight (parametric
+/// area measure: the weights of a cell sum to its area).
+struct QuadraturePoint {
+  Eigen::Vector2d uv = Eigen::Vector2d::Zero();
+  double weight = 0.0;
+};
+
+/// n x n Gauss points (n = 1..6) on every Bezier element of cell c of `basis`.
+/// Gauss quadrature over a whole cell crossed by a knot line integrates a
+/// function with a kink in its third derivative there; per element the
+/// integrand is smooth, and n points integrate polynomials of bidegree 2n - 1
+/// exactly. If `geometry` is given (a basis whose T-mesh is coarser, the cell
+/// g of which contains c), the elements are also split by the knot lines of
+/// the functions on g that cross c, so that the geometry map is smooth on each.
+void cell_quadrature(const TSplineBasis& basis, int c, int n, std::vector<QuadraturePoint>& out,
+                     const TSplineBasis* geometry = nullptr, int g = -1);
+
 /// Values of the four cubic Bernstein polynomials at s.
 std::array<double, 4> bernstein3(double s);
 
