@@ -8,7 +8,6 @@
 #include <cmath>
 #include <sstream>
 
-#include "tspline/bezier_extraction.h"
 #include "tspline/control_point_optimization.h"
 #include "tspline/errors.h"
 #include "tspline/map_quality.h"
@@ -228,33 +227,36 @@ PoissonSolution solve_poisson(const TSplineMap& map, std::shared_ptr<const Analy
   sol.interior_dofs = static_cast<std::size_t>(ni);
 
   t0 = Clock::now();
-  std::vector<QuadraturePoint> qp;
+  std::vector<double> gp, gw;
+  gauss_points_01(4, gp, gw);
   std::vector<Eigen::Triplet<double>> trip;
   Eigen::VectorXd rhs = Eigen::VectorXd::Zero(ni);
   BasisValues bv;
   Eigen::MatrixXd G, Kloc;
   Eigen::VectorXd floc;
   for (int c = 0; c < static_cast<int>(mesh.num_cells()); ++c) {
+    const Eigen::Vector2d lo = mesh.cell_min(c), hi = mesh.cell_max(c);
+    const Eigen::Vector2d len = hi - lo;
     const std::size_t nf = basis.functions_on_cell(c).size();
     Kloc.setZero(nf, nf);
     floc.setZero(nf);
     G.resize(2, nf);
     std::vector<int> ids;
-    cell_quadrature(basis, c, 4, qp, &map.basis(), sp.geometry_cell(c));
-    for (const QuadraturePoint& q : qp) {
-      const Eigen::Vector2d& uv = q.uv;
-      basis.evaluate(c, uv, bv, 1);
-      if (ids.empty()) ids = bv.ids;
-      if (bv.ids.size() != nf) throw NumericalError("Poisson assembly: inconsistent cell function list");
-      const MapDerivatives d = map.derivatives(uv, 1, sp.geometry_cell(c));
-      const double detj = d.J.determinant();
-      const double w = q.weight * std::abs(detj);
-      const Eigen::Matrix2d JinvT = d.J.inverse().transpose();
-      for (std::size_t k = 0; k < nf; ++k) G.col(k) = JinvT * Eigen::Vector2d(bv.R_xi[k], bv.R_eta[k]);
-      Kloc.noalias() += w * (G.transpose() * G);
-      const double fv = checked(problem.f, "f", d.x.x(), d.x.y());
-      for (std::size_t k = 0; k < nf; ++k) floc[k] += w * fv * bv.R[k];
-    }
+    for (std::size_t i = 0; i < gp.size(); ++i)
+      for (std::size_t j = 0; j < gp.size(); ++j) {
+        const Eigen::Vector2d uv(lo.x() + gp[i] * len.x(), lo.y() + gp[j] * len.y());
+        basis.evaluate(c, uv, bv, 1);
+        if (ids.empty()) ids = bv.ids;
+        if (bv.ids.size() != nf) throw NumericalError("Poisson assembly: inconsistent cell function list");
+        const MapDerivatives d = map.derivatives(uv, 1, sp.geometry_cell(c));
+        const double detj = d.J.determinant();
+        const double w = gw[i] * gw[j] * len.x() * len.y() * std::abs(detj);
+        const Eigen::Matrix2d JinvT = d.J.inverse().transpose();
+        for (std::size_t k = 0; k < nf; ++k) G.col(k) = JinvT * Eigen::Vector2d(bv.R_xi[k], bv.R_eta[k]);
+        Kloc.noalias() += w * (G.transpose() * G);
+        const double fv = checked(problem.f, "f", d.x.x(), d.x.y());
+        for (std::size_t k = 0; k < nf; ++k) floc[k] += w * fv * bv.R[k];
+      }
     for (std::size_t r = 0; r < nf; ++r) {
       const int ir = dof[ids[r]];
       if (ir < 0) continue;

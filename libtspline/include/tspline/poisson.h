@@ -13,10 +13,7 @@
 //
 // Discretization (Galerkin):
 //  * stiffness K_ab = int grad R_a . grad R_b dx, load b_a = int f R_a dx, both with
-//    4x4 Gauss points per Bezier element of each analysis cell (the cell split by
-//    the knot lines of the analysis and geometry functions on it, cell_quadrature()
-//    in bezier_extraction.h, so that the integrand is smooth on each piece);
-//    grad_x R = J^{-T} grad_xi R, weight |det J|.
+//    4x4 Gauss points per analysis cell; grad_x R = J^{-T} grad_xi R, weight |det J|.
 //  * Dirichlet data by INTERPOLATION: the boundary functions are those that do not
 //    vanish on the border of [0,1]^2 (touches_border); each has its interpolation
 //    point on the border. Their coefficients solve the small sparse collocation
@@ -29,12 +26,11 @@
 //    with an incomplete Cholesky preconditioner.
 //
 // Errors (when an exact solution is given): L2 and H1-seminorm, 6x6 Gauss points per
-// Bezier element of each analysis cell. If the exact gradient is not given it is computed by central
+// analysis cell. If the exact gradient is not given it is computed by central
 // differences with the absolute step kGradientStep (error ~ step^2 |u'''|/6 plus
 // round-off ~ eps |u| / step).
 //
-// Estimator: eta_e^2 = int_{S(e)} h_e^2 (f + Laplace u_h)^2 dx (4x4 Gauss points per
-// Bezier element),
+// Estimator: eta_e^2 = int_{S(e)} h_e^2 (f + Laplace u_h)^2 dx (4x4 Gauss points),
 // h_e = physical cell diameter, taken as the longer of the two diagonals of the
 // image of the cell's corners, |S(c00) - S(c11)| and |S(c10) - S(c01)|.
 // Laplace u_h uses the physical Hessian (see physical_hessian()).
