@@ -298,7 +298,9 @@ class PoissonOutput {
                 {"cells", st.cells},
                 {"max_level", sol.space->mesh().max_level()},
                 {"marked", st.marked},
+                {"refined", st.refined},
                 {"eta", st.eta},
+                {"eta_at_roundoff", st.eta_at_roundoff},
                 {"eta_max_cell", eta.empty() ? 0.0 : *std::max_element(eta.begin(), eta.end())},
                 {"solver",
                  {{"kind", st.solver.kind},
@@ -417,7 +419,8 @@ int run_poisson(const PoissonArgs& args) {
        {{"cells", t.map.mesh().num_cells()},
         {"functions", t.map.basis().size()},
         {"hanging_vertices", t.map.mesh().num_hanging_vertices()}}},
-      {"dirichlet", "interpolation of g at the boundary functions' interpolation points"},
+      {"analysis_space", "cubic hierarchical B-splines of the analysis T-mesh"},
+      {"dirichlet", "L2 projection of g onto the boundary functions' traces on the parameter square's border"},
       {"quadrature", {{"assembly", "4x4 Gauss"}, {"errors", "6x6 Gauss"}, {"estimator", "4x4 Gauss"}}}};
   PoissonOutput output(args, t.map, setup.problem, std::move(report));
   std::vector<tspline::PoissonStep> steps;
@@ -440,6 +443,8 @@ int run_poisson(const PoissonArgs& args) {
   std::string stop;
   if (static_cast<int>(steps.size()) == args.steps)
     stop = "all " + std::to_string(args.steps) + " steps done";
+  else if (!steps.empty() && steps.back().eta_at_roundoff)
+    stop = "the estimator is at round-off (u_h solves the problem exactly): nothing to refine";
   else if (!steps.empty() && steps.back().marked == 0)
     stop = "no cell marked (eta = 0 everywhere)";
   else
@@ -460,20 +465,17 @@ void add_poisson_command(CLI::App& app, CommandAction& action) {
   auto a = std::make_shared<PoissonArgs>();
   CLI::App* cmd = app.add_subcommand(
       "poisson",
-      "Solve -Laplace(u) = f in the domain of a T-spline file, u = g on its boundary, with T-spline "
-      "isogeometric "
-      "analysis (cubic T-spline basis of an analysis T-mesh that starts as the geometry's and is refined; "
-      "the "
-      "geometry map stays fixed), and refine adaptively (residual estimator eta_e^2 = int h^2 (f + Laplace "
-      "u_h)^2, "
-      "cells with eta_e > gamma max eta split) or uniformly. Dirichlet data by interpolation on the boundary "
+      "Solve -Laplace(u) = f in the domain of a T-spline file, u = g on its boundary, with isogeometric "
+      "analysis (cubic hierarchical B-splines of an analysis T-mesh that starts as the geometry's and is refined; "
+      "the geometry map stays fixed), and refine adaptively (residual estimator eta_e^2 = int h^2 (f + Laplace "
+      "u_h)^2, cells with eta_e > gamma max eta split with their neighbours) or uniformly. Dirichlet data by L2 "
+      "projection on the boundary "
       "functions. Prints one table row per step and writes OUTDIR/convergence.csv, OUTDIR/report.json and "
       "OUTDIR/solution.pvd with OUTDIR/solution/step_NNN.vtu (point data u_h, u_exact, error = u_h - "
       "u_exact; cell "
       "data eta, level, cell). Built-in problems (f = -Laplace(u) analytic, g = u, exact gradient analytic): "
       "sinsin u = sin(pi x) sin(pi y); polynomial u = x^3 + x^2 y - 2 y^3 + x y (in the discrete space when "
-      "the "
-      "map is affine and the T-mesh has no T-junctions); gaussian u = exp(-((x-x0)^2 + (y-y0)^2)/s^2) with "
+      "the map is affine); gaussian u = exp(-((x-x0)^2 + (y-y0)^2)/s^2) with "
       "(x0, y0) the centre of the bounding box of the control points and s = 0.1 x its diagonal");
   cmd->add_option("TSPLINE", a->file, "T-spline file (tspline.json written by `tspline param`)")
       ->type_name("FILE")

@@ -10,11 +10,13 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <random>
 #include <sstream>
 #include <string>
 #include <vector>
 
 #include "tspline/polygon.h"
+#include "tspline/tmesh.h"
 
 namespace test_support {
 
@@ -84,6 +86,21 @@ inline AppRun run_app(const std::string& args, const std::filesystem::path& dir)
   r.out = slurp(out);
   r.err = slurp(err);
   return r;
+}
+
+/// A balanced T-mesh from the uniform 4x4 mesh by `rounds` splits of the leaves
+/// containing random points (leaves of level max_level are not split).
+inline tspline::TMesh random_tmesh(unsigned seed, int rounds, int max_level) {
+  std::mt19937 rng(seed);
+  tspline::TMesh m(2);
+  std::uniform_int_distribution<std::int64_t> pick(0, tspline::TMesh::kRoot - 1);
+  for (int r = 0; r < rounds; ++r) {
+    const int n = m.leaf_at_doubled(2 * pick(rng) + 1, 2 * pick(rng) + 1);
+    if (m.node(n).level < max_level) m.refine(n);
+  }
+  m.balance();
+  m.build_topology();
+  return m;
 }
 
 }  // namespace test_support

@@ -3,12 +3,10 @@
 #include <Eigen/Dense>
 #include <Eigen/IterativeLinearSolvers>
 #include <Eigen/SparseCholesky>
-#include <Eigen/SparseLU>
 #include <chrono>
 #include <cmath>
 #include <sstream>
 
-#include "tspline/control_point_optimization.h"
 #include "tspline/errors.h"
 #include "tspline/map_quality.h"
 #include "tspline/poisson.h"
@@ -42,7 +40,7 @@ double checked(const ScalarField& fn, const char* name, double x, double y) {
 AnalysisSpace::AnalysisSpace(const TSplineMap& map, TMesh analysis_mesh)
     : mesh_(std::make_unique<TMesh>(std::move(analysis_mesh))) {
   if (!mesh_->has_topology()) throw InputError("analysis T-mesh: topology not built");
-  basis_ = std::make_unique<TSplineBasis>(*mesh_);
+  basis_ = std::make_unique<HierarchicalBasis>(*mesh_);
   const TMesh& gm = map.mesh();
   geometry_cell_.resize(mesh_->num_cells());
   for (int c = 0; c < static_cast<int>(mesh_->num_cells()); ++c) {
@@ -105,44 +103,64 @@ SolutionValue evaluate_solution(const TSplineMap& map, const PoissonSolution& so
 
 namespace {
 
-/// Coefficients of the boundary functions interpolating g at their interpolation points.
-void interpolate_dirichlet(const TSplineMap& map, const AnalysisSpace& sp, const ScalarField& g,
-                           PoissonSolution& sol) {
-  const TSplineBasis& basis = sp.basis();
+/// Coefficients of the boundary functions: L2 projection of g o S onto their
+/// traces on the border of the parameter square (see poisson.h).
+void project_dirichlet(const TSplineMap& map, const AnalysisSpace& sp, const ScalarField& g, PoissonSolution& sol) {
+  const HierarchicalBasis& basis = sp.basis();
+  const TMesh& mesh = sp.mesh();
   const int n = static_cast<int>(basis.size());
   std::vector<int> bidx(n, -1);
-  std::vector<int> bfun;
+  int nb = 0;
   for (int a = 0; a < n; ++a)
-    if (touches_border(basis.function(a))) {
-      bidx[a] = static_cast<int>(bfun.size());
-      bfun.push_back(a);
+    if (basis.function(a).on_border) {
+      bidx[a] = nb++;
       sol.is_boundary[a] = true;
     }
-  const int nb = static_cast<int>(bfun.size());
   if (nb == 0) return;
+  // 5 Gauss points integrate the degree-6 products of the traces exactly.
+  std::vector<double> gp, gw;
+  gauss_points_01(5, gp, gw);
   std::vector<Eigen::Triplet<double>> trip;
-  Eigen::VectorXd rhs(nb);
+  Eigen::VectorXd rhs = Eigen::VectorXd::Zero(nb);
   BasisValues bv;
-  for (int r = 0; r < nb; ++r) {
-    const Eigen::Vector2d p = basis.function(bfun[r]).interpolation_point;
-    basis.evaluate(p, bv, 0);
-    for (std::size_t k = 0; k < bv.ids.size(); ++k)
-      if (bidx[bv.ids[k]] >= 0 && bv.R[k] != 0.0) trip.emplace_back(r, bidx[bv.ids[k]], bv.R[k]);
-    const Eigen::Vector2d x = map.point(p);
-    rhs[r] = checked(g, "g", x.x(), x.y());
+  std::vector<std::pair<int, double>> active;
+  for (int c = 0; c < static_cast<int>(mesh.num_cells()); ++c) {
+    const Eigen::Vector2d lo = mesh.cell_min(c), hi = mesh.cell_max(c);
+    // The cell's edges on the border: start point, direction (length included).
+    std::vector<std::pair<Eigen::Vector2d, Eigen::Vector2d>> edges;
+    if (lo.y() == 0.0) edges.push_back({lo, {hi.x() - lo.x(), 0.0}});
+    if (hi.y() == 1.0) edges.push_back({{lo.x(), 1.0}, {hi.x() - lo.x(), 0.0}});
+    if (lo.x() == 0.0) edges.push_back({lo, {0.0, hi.y() - lo.y()}});
+    if (hi.x() == 1.0) edges.push_back({{1.0, lo.y()}, {0.0, hi.y() - lo.y()}});
+    for (const auto& [p0, dir] : edges)
+      for (std::size_t q = 0; q < gp.size(); ++q) {
+        const Eigen::Vector2d p = p0 + gp[q] * dir;
+        const double w = gw[q] * dir.norm();
+        basis.evaluate(c, p, bv, 0);
+        active.clear();
+        for (std::size_t k = 0; k < bv.ids.size(); ++k)
+          if (bidx[bv.ids[k]] >= 0 && bv.R[k] != 0.0) active.emplace_back(bidx[bv.ids[k]], bv.R[k]);
+        const Eigen::Vector2d x = map.derivatives(p, 0, sp.geometry_cell(c)).x;
+        const double gv = checked(g, "g", x.x(), x.y());
+        for (const auto& [r, vr] : active) {
+          rhs[r] += w * gv * vr;
+          for (const auto& [s, vs] : active) trip.emplace_back(r, s, w * vr * vs);
+        }
+      }
   }
-  Eigen::SparseMatrix<double> A(nb, nb);
-  A.setFromTriplets(trip.begin(), trip.end());
-  A.makeCompressed();
-  Eigen::SparseLU<Eigen::SparseMatrix<double>> lu;
-  lu.compute(A);
-  if (lu.info() != Eigen::Success)
-    throw NumericalError("Dirichlet interpolation: the boundary collocation matrix is singular (" +
-                         std::to_string(nb) + " boundary functions)");
-  const Eigen::VectorXd c = lu.solve(rhs);
-  if (!c.allFinite() || (A * c - rhs).norm() > 1e-8 * std::max(1.0, rhs.norm()))
-    throw NumericalError("Dirichlet interpolation: the boundary collocation solve failed");
-  for (int r = 0; r < nb; ++r) sol.coefficients[bfun[r]] = c[r];
+  Eigen::SparseMatrix<double> M(nb, nb);
+  M.setFromTriplets(trip.begin(), trip.end());
+  M.makeCompressed();
+  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt;
+  ldlt.compute(M);
+  if (ldlt.info() != Eigen::Success)
+    throw NumericalError("Dirichlet projection: the boundary mass matrix is singular (" + std::to_string(nb) +
+                         " boundary functions)");
+  const Eigen::VectorXd c = ldlt.solve(rhs);
+  if (!c.allFinite() || (M * c - rhs).norm() > 1e-8 * std::max(rhs.norm(), 1e-300))
+    throw NumericalError("Dirichlet projection: the boundary mass solve failed");
+  for (int a = 0; a < n; ++a)
+    if (bidx[a] >= 0) sol.coefficients[a] = c[bidx[a]];
 }
 
 SolverStats solve_spd(const Eigen::SparseMatrix<double>& K, const Eigen::VectorXd& b, Eigen::VectorXd& u) {
@@ -209,14 +227,14 @@ PoissonSolution solve_poisson(const TSplineMap& map, std::shared_ptr<const Analy
   PoissonSolution sol;
   sol.space = std::move(space);
   const AnalysisSpace& sp = *sol.space;
-  const TSplineBasis& basis = sp.basis();
+  const HierarchicalBasis& basis = sp.basis();
   const TMesh& mesh = sp.mesh();
   const int n = static_cast<int>(basis.size());
   sol.coefficients = Eigen::VectorXd::Zero(n);
   sol.is_boundary.assign(n, false);
 
   auto t0 = Clock::now();
-  interpolate_dirichlet(map, sp, problem.g, sol);
+  project_dirichlet(map, sp, problem.g, sol);
   sol.dirichlet_seconds = seconds_since(t0);
 
   // Interior numbering.
