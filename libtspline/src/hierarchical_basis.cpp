@@ -129,20 +129,39 @@ void HierarchicalBasis::evaluate(int c, const Eigen::Vector2d& uv, BasisValues& 
   out.R_xixi.resize(d2 ? n : 0);
   out.R_xieta.resize(d2 ? n : 0);
   out.R_etaeta.resize(d2 ? n : 0);
+  // The functions of level l on the cell have ix in [a, a+3] (a = the column of
+  // the cell's level-l ancestor), so 4 + 4 univariate evaluations per level
+  // serve all of them.
+  const QuadNode& q = mesh_->node(mesh_->cell_node(c));
+  struct Univariate {
+    double v[4], d1[4], d2[4];
+  };
+  std::array<Univariate, kMaxBasisLevel + 1> ux, uy;
+  std::array<bool, kMaxBasisLevel + 1> done{};
   for (std::size_t k = 0; k < n; ++k) {
     const HierarchicalFunction& f = functions_[ids[k]];
-    double u1 = 0, u2 = 0, w1 = 0, w2 = 0;
-    const double u = cubic_bspline(f.knots_xi, uv.x(), d1 ? &u1 : nullptr, d2 ? &u2 : nullptr);
-    const double w = cubic_bspline(f.knots_eta, uv.y(), d1 ? &w1 : nullptr, d2 ? &w2 : nullptr);
+    const int l = f.level;
+    const I64 a = q.i >> (q.level - l), b = q.j >> (q.level - l);
+    if (!done[l]) {
+      done[l] = true;
+      for (int m = 0; m < 4; ++m) {
+        ux[l].v[m] = cubic_bspline(level_knots(l, a + m), uv.x(), d1 ? &ux[l].d1[m] : nullptr,
+                                   d2 ? &ux[l].d2[m] : nullptr);
+        uy[l].v[m] = cubic_bspline(level_knots(l, b + m), uv.y(), d1 ? &uy[l].d1[m] : nullptr,
+                                   d2 ? &uy[l].d2[m] : nullptr);
+      }
+    }
+    const int mx = static_cast<int>(f.ix - a), my = static_cast<int>(f.iy - b);
+    const double u = ux[l].v[mx], w = uy[l].v[my];
     out.R[k] = u * w;
     if (d1) {
-      out.R_xi[k] = u1 * w;
-      out.R_eta[k] = u * w1;
+      out.R_xi[k] = ux[l].d1[mx] * w;
+      out.R_eta[k] = u * uy[l].d1[my];
     }
     if (d2) {
-      out.R_xixi[k] = u2 * w;
-      out.R_xieta[k] = u1 * w1;
-      out.R_etaeta[k] = u * w2;
+      out.R_xixi[k] = ux[l].d2[mx] * w;
+      out.R_xieta[k] = ux[l].d1[mx] * uy[l].d1[my];
+      out.R_etaeta[k] = u * uy[l].d2[my];
     }
   }
 }
