@@ -152,6 +152,7 @@ int main(int argc, char** argv) {
   tspline_app::CommandAction command;  // set by the other subcommands when parsed (commands.h)
   tspline_app::add_tspline_file_commands(app, command);
   tspline_app::add_poisson_command(app, command);
+  tspline_app::add_render_command(app, command);
 
   try {
     app.parse(argc, argv);
