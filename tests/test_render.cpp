@@ -23,7 +23,7 @@ using tspline::io::Rgb;
 namespace {
 
 fs::path scratch(const std::string& name) { return test_support::scratch_dir("render", name); }
-std::string q(const fs::path& p) { return "'" + p.string() + "'"; }
+std::string q(const fs::path& p) { return test_support::quoted(p); }
 
 struct PngStats {
   int width = 0, height = 0;
