@@ -93,12 +93,15 @@ int run_param(const std::string& input, const std::string& out_dir, const std::s
   if (!result.valid()) {
     std::cerr << "tspline: error: the map is not valid: det J <= 0 at " << result.quality.nonpositive_det << " of "
               << result.quality.points << " quadrature points; adaptive refinement stopped: " << result.stop_reason
-              << " (files written; see surface.vtu, point data det_jacobian)" << std::endl;
+              << " (files written; see surface.vtu, point data det_jacobian, or `tspline render OUTDIR`); try "
+                 "other --corners, a smaller --tol-rel, or more --max-adapt rounds"
+              << std::endl;
     return 3;
   }
   if (!result.good(adaptive.min_jacobian) && !quiet)
     std::cout << "warning: min J_r " << result.quality.min_mean_ratio << " is below --min-jacobian "
-              << adaptive.min_jacobian << "; adaptive refinement stopped: " << result.stop_reason << std::endl;
+              << adaptive.min_jacobian << "; adaptive refinement stopped: " << result.stop_reason
+              << " (the corner choice fixes the map's aspect ratio: try other --corners)" << std::endl;
   return 0;
 }
 
