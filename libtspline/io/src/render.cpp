@@ -12,7 +12,6 @@
 #include <cstdio>
 #include <filesystem>
 #include <limits>
-#include <regex>
 
 #include "tspline/errors.h"
 #include "tspline/io/atomic_file.h"
@@ -134,12 +133,14 @@ fs::path solution_step(const fs::path& dir, int step) {
   int best = -1;
   fs::path file;
   if (fs::is_directory(sub, ec)) {
-    const std::regex name(R"(step_(\d+)\.vtu)");
     for (const auto& e : fs::directory_iterator(sub, ec)) {
-      std::smatch mm;
+      // step_NNN.vtu (std::regex would do, but draws GCC 12 warnings from its headers)
       const std::string fn = e.path().filename().string();
-      if (!std::regex_match(fn, mm, name)) continue;
-      const int k = std::stoi(mm[1].str());
+      if (fn.size() <= 9 || !fn.starts_with("step_") || !fn.ends_with(".vtu")) continue;
+      const std::string digits = fn.substr(5, fn.size() - 9);
+      if (digits.size() > 9 || !std::all_of(digits.begin(), digits.end(), [](char ch) { return ch >= '0' && ch <= '9'; }))
+        continue;
+      const int k = std::stoi(digits);
       if ((step < 0 && k > best) || k == step) {
         best = k;
         file = e.path();
