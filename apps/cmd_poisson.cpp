@@ -23,6 +23,7 @@
 #include <vector>
 
 #include "commands.h"
+#include "progress.h"
 #include "expression.h"
 #include "tspline/errors.h"
 #include "tspline/io/atomic_file.h"
@@ -57,6 +58,7 @@ struct PoissonArgs {
   std::size_t max_dofs = 200000;
   int samples = 2;
   bool quiet = false;
+  bool json = false;
   CLI::Option *f_opt = nullptr, *g_opt = nullptr, *exact_opt = nullptr, *problem_opt = nullptr;
 };
 
@@ -271,8 +273,8 @@ json rate(double e1, double e2, std::size_t n1, std::size_t n2) {
 class PoissonOutput {
  public:
   PoissonOutput(const PoissonArgs& args, const tspline::TSplineMap& map,
-                const tspline::PoissonProblem& problem, json report)
-      : args_(args), map_(map), problem_(problem), report_(std::move(report)) {
+                const tspline::PoissonProblem& problem, json report, Progress& progress)
+      : args_(args), map_(map), problem_(problem), report_(std::move(report)), progress_(progress) {
     report_["steps"] = json::array();
   }
 
@@ -285,7 +287,7 @@ class PoissonOutput {
       tspline::io::ensure_writable_directory(out.string());
       tspline::io::ensure_writable_directory((out / "solution").string());
       started_ = true;
-      if (!args_.quiet) print_header();
+      if (progress_.human()) print_header();
     }
     char name[64];
     std::snprintf(name, sizeof name, "solution/step_%03d.vtu", st.step);
@@ -298,7 +300,9 @@ class PoissonOutput {
                 {"cells", st.cells},
                 {"max_level", sol.space->mesh().max_level()},
                 {"marked", st.marked},
+                {"refined", st.refined},
                 {"eta", st.eta},
+                {"eta_at_roundoff", st.eta_at_roundoff},
                 {"eta_max_cell", eta.empty() ? 0.0 : *std::max_element(eta.begin(), eta.end())},
                 {"solver",
                  {{"kind", st.solver.kind},
@@ -330,9 +334,12 @@ class PoissonOutput {
     }
     steps_.push_back(st);
     rec["output_seconds"] = seconds_since(t0);
+    json event = rec;
+    event["event"] = "step";
     report_["steps"].push_back(std::move(rec));
     write_tables(false);
-    if (!args_.quiet) print_row(st);
+    if (progress_.human()) print_row(st);
+    progress_.event(event);
   }
 
   bool started() const { return started_; }
@@ -384,6 +391,7 @@ class PoissonOutput {
   std::vector<tspline::PoissonStep> steps_;
   std::vector<tspline::io::PvdEntry> pvd_;
   bool started_ = false;
+  Progress& progress_;
 };
 
 // ------------------------------------------------------------------ run
@@ -417,9 +425,11 @@ int run_poisson(const PoissonArgs& args) {
        {{"cells", t.map.mesh().num_cells()},
         {"functions", t.map.basis().size()},
         {"hanging_vertices", t.map.mesh().num_hanging_vertices()}}},
-      {"dirichlet", "interpolation of g at the boundary functions' interpolation points"},
+      {"analysis_space", "cubic hierarchical B-splines of the analysis T-mesh"},
+      {"dirichlet", "L2 projection of g onto the boundary functions' traces on the parameter square's border"},
       {"quadrature", {{"assembly", "4x4 Gauss"}, {"errors", "6x6 Gauss"}, {"estimator", "4x4 Gauss"}}}};
-  PoissonOutput output(args, t.map, setup.problem, std::move(report));
+  Progress progress(output_mode(args.quiet, args.json));
+  PoissonOutput output(args, t.map, setup.problem, std::move(report), progress);
   std::vector<tspline::PoissonStep> steps;
   try {
     steps = tspline::solve_adaptive(t.map, setup.problem, opt,
@@ -440,6 +450,8 @@ int run_poisson(const PoissonArgs& args) {
   std::string stop;
   if (static_cast<int>(steps.size()) == args.steps)
     stop = "all " + std::to_string(args.steps) + " steps done";
+  else if (!steps.empty() && steps.back().eta_at_roundoff)
+    stop = "the estimator is at round-off (u_h solves the problem exactly): nothing to refine";
   else if (!steps.empty() && steps.back().marked == 0)
     stop = "no cell marked (eta = 0 everywhere)";
   else
@@ -447,7 +459,12 @@ int run_poisson(const PoissonArgs& args) {
   output.report()["stop_reason"] = stop;
   output.report()["seconds_total"] = seconds_since(t_start);
   output.write_tables(true);
-  if (!args.quiet)
+  progress.event({{"event", "result"},
+                  {"steps", steps.size()},
+                  {"stop_reason", stop},
+                  {"out", args.out_dir},
+                  {"files", {"convergence.csv", "report.json", "solution.pvd", "solution/"}}});
+  if (progress.human())
     std::cout << steps.size() << " steps (" << stop
               << "); wrote convergence.csv, report.json, solution.pvd, solution/"
               << " to " << args.out_dir << std::endl;
@@ -460,20 +477,17 @@ void add_poisson_command(CLI::App& app, CommandAction& action) {
   auto a = std::make_shared<PoissonArgs>();
   CLI::App* cmd = app.add_subcommand(
       "poisson",
-      "Solve -Laplace(u) = f in the domain of a T-spline file, u = g on its boundary, with T-spline "
-      "isogeometric "
-      "analysis (cubic T-spline basis of an analysis T-mesh that starts as the geometry's and is refined; "
-      "the "
-      "geometry map stays fixed), and refine adaptively (residual estimator eta_e^2 = int h^2 (f + Laplace "
-      "u_h)^2, "
-      "cells with eta_e > gamma max eta split) or uniformly. Dirichlet data by interpolation on the boundary "
+      "Solve -Laplace(u) = f in the domain of a T-spline file, u = g on its boundary, with isogeometric "
+      "analysis (cubic hierarchical B-splines of an analysis T-mesh that starts as the geometry's and is refined; "
+      "the geometry map stays fixed), and refine adaptively (residual estimator eta_e^2 = int h^2 (f + Laplace "
+      "u_h)^2, cells with eta_e > gamma max eta split with their neighbours) or uniformly. Dirichlet data by L2 "
+      "projection on the boundary "
       "functions. Prints one table row per step and writes OUTDIR/convergence.csv, OUTDIR/report.json and "
       "OUTDIR/solution.pvd with OUTDIR/solution/step_NNN.vtu (point data u_h, u_exact, error = u_h - "
       "u_exact; cell "
       "data eta, level, cell). Built-in problems (f = -Laplace(u) analytic, g = u, exact gradient analytic): "
       "sinsin u = sin(pi x) sin(pi y); polynomial u = x^3 + x^2 y - 2 y^3 + x y (in the discrete space when "
-      "the "
-      "map is affine and the T-mesh has no T-junctions); gaussian u = exp(-((x-x0)^2 + (y-y0)^2)/s^2) with "
+      "the map is affine); gaussian u = exp(-((x-x0)^2 + (y-y0)^2)/s^2) with "
       "(x0, y0) the centre of the bounding box of the control points and s = 0.1 x its diagonal");
   cmd->add_option("TSPLINE", a->file, "T-spline file (tspline.json written by `tspline param`)")
       ->type_name("FILE")
@@ -508,6 +522,9 @@ void add_poisson_command(CLI::App& app, CommandAction& action) {
                   "solution/step_NNN.vtu: k x k sub-quads per analysis cell, k in [1, 64]")
       ->capture_default_str();
   cmd->add_flag("--quiet,-q", a->quiet, "Print errors only");
+  cmd->add_flag("--json", a->json,
+                "Print one JSON object per line instead of the table: an event 'step' per solve (the record of "
+                "report.json) and a final 'result'");
   cmd->callback([a, &action] { action = [a] { return run_poisson(*a); }; });
 }
 

@@ -25,4 +25,7 @@ void add_poisson_command(CLI::App& app, CommandAction& action);
 /// file (cmd_check.cpp); exit 3 if the map is not certified valid.
 void add_check_command(CLI::App& app, CommandAction& action);
 
+/// `tspline render`: PNG pictures of the outputs of param and poisson (cmd_render.cpp).
+void add_render_command(CLI::App& app, CommandAction& action);
+
 }  // namespace tspline_app

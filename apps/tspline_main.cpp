@@ -16,6 +16,7 @@
 #include <string>
 
 #include "commands.h"
+#include "progress.h"
 #include "tspline/errors.h"
 #include "tspline/io/atomic_file.h"
 #include "tspline/adaptive_parameterization.h"
@@ -48,25 +49,45 @@ std::array<long long, 4> parse_corners(const std::string& text) {
 
 int run_param(const std::string& input, const std::string& out_dir, const std::string& corners_text,
               tspline::ParameterizationOptions opt, const tspline::AdaptiveOptions& adaptive, int samples,
-              std::optional<std::size_t> geojson_polygon, bool quiet) {
+              std::optional<std::size_t> geojson_polygon, tspline_app::OutputMode mode) {
   if (!corners_text.empty()) opt.corners = parse_corners(corners_text);
   if (samples < 1 || samples > 64) throw tspline::InputError("--samples must be in [1, 64]");
-  if (!quiet) opt.log = [](const std::string& line) { std::cout << line << std::endl; };
+  tspline_app::Progress progress(mode);
+  const bool quiet = mode != tspline_app::OutputMode::Human;
+  opt.log = [&progress](const std::string& line) { progress.log(line); };
   // Fail on an unwritable output directory before any computation.
   tspline::io::ensure_writable_directory(out_dir);
   std::string warnings;
   tspline::io::PolygonReadOptions ropt;
   ropt.polygon_index = geojson_polygon;
   const tspline::Polygon polygon = tspline::io::read_polygon(input, ropt, &warnings);
-  if (!warnings.empty() && !quiet) std::cout << "note: " << warnings << std::endl;
+  if (!warnings.empty()) progress.log("note: " + warnings);
   tspline::io::AdaptSeriesWriter series(out_dir, samples);
   const tspline::ParameterizationResult result = tspline::run_parameterization(
       polygon, opt, adaptive,
       [&](int it, const tspline::TMesh& mesh, const std::vector<Eigen::Vector2d>& x, const tspline::TSplineMap& map,
-          const std::vector<tspline::CellMapQuality>&) { series.add(it, mesh, x, map); });
+          const std::vector<tspline::CellMapQuality>&) {
+        series.add(it, mesh, x, map);
+        progress.event({{"event", "iteration"},
+                        {"iteration", it},
+                        {"cells", mesh.num_cells()},
+                        {"functions", map.basis().size()}});
+        progress.progress("adaptive rounds", it + 1, adaptive.max_adapt + 1);
+      });
   series.finish();
   const nlohmann::json report = tspline::io::param_report(result, input, adaptive);
   tspline::io::write_param_outputs(result, out_dir, report, samples);
+  progress.settle();
+  progress.event({{"event", "result"},
+                  {"valid", result.valid()},
+                  {"good", result.good(adaptive.min_jacobian)},
+                  {"certified_valid", result.certified_valid()},
+                  {"min_mean_ratio_jacobian", result.quality.min_mean_ratio},
+                  {"cells", result.map ? result.map->mesh().num_cells() : 0},
+                  {"stop_reason", result.stop_reason},
+                  {"out", out_dir},
+                  {"files", {"tspline.json", "surface.vtu", "control_net.vtu", "adapt.pvd", "parametric_tmesh.vtu",
+                             "physical_tmesh.vtu", "boundary.vtu", "report.json"}}});
   if (!quiet)
     std::cout << "wrote tspline.json, surface.vtu, control_net.vtu, adapt.pvd, parametric_tmesh.vtu, "
                  "physical_tmesh.vtu, boundary.vtu, report.json to "
@@ -74,7 +95,9 @@ int run_param(const std::string& input, const std::string& out_dir, const std::s
   if (!result.valid()) {
     std::cerr << "tspline: error: the map is not valid: det J <= 0 at " << result.quality.nonpositive_det << " of "
               << result.quality.points << " quadrature points; adaptive refinement stopped: " << result.stop_reason
-              << " (files written; see surface.vtu, point data det_jacobian)" << std::endl;
+              << " (files written; see surface.vtu, point data det_jacobian, or `tspline render OUTDIR`); try "
+                 "other --corners, a smaller --tol-rel, or more --max-adapt rounds"
+              << std::endl;
     return 3;
   }
   if (adaptive.certify && !result.certified_valid()) {
@@ -87,7 +110,8 @@ int run_param(const std::string& input, const std::string& out_dir, const std::s
   }
   if (!result.good(adaptive.min_jacobian) && !quiet)
     std::cout << "warning: min J_r " << result.quality.min_mean_ratio << " is below --min-jacobian "
-              << adaptive.min_jacobian << "; adaptive refinement stopped: " << result.stop_reason << std::endl;
+              << adaptive.min_jacobian << "; adaptive refinement stopped: " << result.stop_reason
+              << " (the corner choice fixes the map's aspect ratio: try other --corners)" << std::endl;
   return 0;
 }
 
@@ -96,7 +120,7 @@ int run_param(const std::string& input, const std::string& out_dir, const std::s
 int main(int argc, char** argv) {
   CLI::App app{"tspline: T-spline parameterization of 2D domains for isogeometric analysis"};
   app.require_subcommand(1);
-  app.set_version_flag("--version", "tspline 0.1.0");
+  app.set_version_flag("--version", "tspline " TSPLINE_VERSION);
 
   CLI::App* param = app.add_subcommand(
       "param", "Parameterize the domain bounded by a polygon: adapted T-mesh, Coons start, untangling and smoothing, "
@@ -163,10 +187,15 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   param->add_option("--samples", samples, "surface.vtu: k x k sub-quads per T-mesh cell")->capture_default_str();
   param->add_flag("--quiet,-q", quiet, "Print errors only");
+  bool json_events = false;
+  param->add_flag("--json", json_events,
+                  "Print progress and the result as JSON lines (one object per line: events log, progress, "
+                  "iteration, result) instead of text");
   tspline_app::CommandAction command;  // set by the other subcommands when parsed (commands.h)
   tspline_app::add_tspline_file_commands(app, command);
   tspline_app::add_check_command(app, command);
   tspline_app::add_poisson_command(app, command);
+  tspline_app::add_render_command(app, command);
 
   try {
     app.parse(argc, argv);
@@ -185,7 +214,8 @@ int main(int argc, char** argv) {
       adaptive.optimize_control_points = !no_cpo;
       std::optional<std::size_t> gj;
       if (gj_opt->count() > 0) gj = geojson_polygon;
-      return run_param(input, out_dir, corners, opt, adaptive, samples, gj, quiet);
+      return run_param(input, out_dir, corners, opt, adaptive, samples, gj,
+                       tspline_app::output_mode(quiet, json_events));
     }
   } catch (const tspline::InputError& e) {
     std::cerr << "tspline: error: " << e.what() << std::endl;

@@ -3,7 +3,7 @@
 // T-mesh, control points at the Greville abscissae), u = sin(pi x) sin(pi y).
 // Prints one table row:
 //   level cells dofs space_s dirichlet_s assembly_s solve_s solver residual max_err peak_MiB
-// (space_s: analysis T-mesh + T-spline basis; solve_s: factorization + solve;
+// (space_s: analysis T-mesh + hierarchical B-spline basis; solve_s: factorization + solve;
 // max_err: max |u - u_h| at the centres of about 16 x 16 cells, a cheap check
 // that the solve is right).
 // Usage: bench_poisson LEVEL

@@ -1,13 +1,22 @@
 #!/usr/bin/env bash
 # All tests: installs what is missing, builds, runs the doctest suites in a
 # Release build, then again in an optimized build with debug info under AddressSanitizer and
-# UndefinedBehaviorSanitizer. Exits non-zero if any test fails.
+# UndefinedBehaviorSanitizer. Between the two, installs the Release build into
+# build/install and builds and runs tests/downstream against the installed
+# CMake package. Exits non-zero if any test fails.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/install_deps.sh
 echo "== Release build and tests"
 BUILD_DIR=build BUILD_TYPE=Release bash scripts/build.sh
 ./build/tests/unit_tests
+echo "== Installed package: cmake --install, then a downstream project with find_package(TSpline)"
+rm -rf build/install build/downstream
+cmake --install build --prefix "$PWD/build/install" > build/install.log
+cmake -S tests/downstream -B build/downstream -DCMAKE_BUILD_TYPE=Release -DCMAKE_PREFIX_PATH="$PWD/build/install" \
+  > build/downstream.configure.log 2>&1 || { cat build/downstream.configure.log; exit 1; }
+cmake --build build/downstream -j "$(nproc)"
+./build/downstream/downstream_check
 echo "== ASan+UBSan build and tests"
 BUILD_DIR=build-asan BUILD_TYPE=RelWithDebInfo bash scripts/build.sh -DTSPLINE_SANITIZE=ON -DTSPLINE_BUILD_BENCH=OFF
 ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \

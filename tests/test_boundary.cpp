@@ -98,8 +98,8 @@ TEST_SUITE("boundary") {
 
   TEST_CASE("error: self-intersecting bow-tie") {
     const Polygon p = make({V2(0, 0), V2(1, 1), V2(1, 0), V2(0, 1)});
-    CHECK(message_of<InputError>([&] { validate_polygon(p); }) ==
-          "polygon is not simple: edges 0-1 and 2-3 intersect near (0.5, 0.5)");
+    CHECK(message_of<InputError>([&] { validate_polygon(p); })
+              .starts_with("polygon is not simple: edges 0-1 and 2-3 intersect near (0.5, 0.5); "));
   }
 
   TEST_CASE("error: crossing between edges far apart in the numbering, named by file indices") {

@@ -10,11 +10,13 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <random>
 #include <sstream>
 #include <string>
 #include <vector>
 
 #include "tspline/polygon.h"
+#include "tspline/tmesh.h"
 
 namespace test_support {
 
@@ -67,23 +69,52 @@ inline std::size_t count_lines(const std::string& s) {
   return static_cast<std::size_t>(std::count(s.begin(), s.end(), '\n'));
 }
 
+/// The path in single quotes for the shell (built piecewise: GCC 12 warns,
+/// falsely, -Wrestrict on "'" + s + "'").
+inline std::string quoted(const std::filesystem::path& p) {
+  std::string s = "'";
+  s += p.string();
+  s += '\'';
+  return s;
+}
+
 /// One run of the built `tspline` command.
 struct AppRun {
   int exit_code = -1;
   std::string out, err;
 };
 
-/// Runs `tspline ARGS` with stdout and stderr captured in files of `dir`.
-inline AppRun run_app(const std::string& args, const std::filesystem::path& dir) {
+/// Runs the program `exe` with ARGS (shell syntax), stdout and stderr captured
+/// in files of `dir`.
+inline AppRun run_program(const std::string& exe, const std::string& args, const std::filesystem::path& dir) {
   const std::filesystem::path out = dir / "stdout.txt", err = dir / "stderr.txt";
-  const std::string cmd =
-      std::string("'") + TSPLINE_APP_PATH + "' " + args + " >'" + out.string() + "' 2>'" + err.string() + "'";
+  const std::string cmd = "'" + exe + "' " + args + " >'" + out.string() + "' 2>'" + err.string() + "'";
   const int status = std::system(cmd.c_str());
   AppRun r;
   r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
   r.out = slurp(out);
   r.err = slurp(err);
   return r;
+}
+
+/// Runs `tspline ARGS` with stdout and stderr captured in files of `dir`.
+inline AppRun run_app(const std::string& args, const std::filesystem::path& dir) {
+  return run_program(TSPLINE_APP_PATH, args, dir);
+}
+
+/// A balanced T-mesh from the uniform 4x4 mesh by `rounds` splits of the leaves
+/// containing random points (leaves of level max_level are not split).
+inline tspline::TMesh random_tmesh(unsigned seed, int rounds, int max_level) {
+  std::mt19937 rng(seed);
+  tspline::TMesh m(2);
+  std::uniform_int_distribution<std::int64_t> pick(0, tspline::TMesh::kRoot - 1);
+  for (int r = 0; r < rounds; ++r) {
+    const int n = m.leaf_at_doubled(2 * pick(rng) + 1, 2 * pick(rng) + 1);
+    if (m.node(n).level < max_level) m.refine(n);
+  }
+  m.balance();
+  m.build_topology();
+  return m;
 }
 
 }  // namespace test_support

@@ -58,18 +58,7 @@ std::vector<double> open_knots(int n) {
   return U;
 }
 
-TMesh random_mesh(unsigned seed, int rounds, int max_level) {
-  std::mt19937 rng(seed);
-  TMesh m(2);
-  std::uniform_int_distribution<std::int64_t> pick(0, TMesh::kRoot - 1);
-  for (int r = 0; r < rounds; ++r) {
-    const int n = m.leaf_at_doubled(2 * pick(rng) + 1, 2 * pick(rng) + 1);
-    if (m.node(n).level < max_level) m.refine(n);
-  }
-  m.balance();
-  m.build_topology();
-  return m;
-}
+using test_support::random_tmesh;
 
 // Cells touching the border refined `depth` more times (as boundary refinement does).
 TMesh boundary_mesh(int depth) {
@@ -247,7 +236,7 @@ TEST_SUITE("tspline_basis") {
       m.build_topology();
       check_partition_everywhere(m, 100 + level);
     }
-    const TMesh r = random_mesh(7, 120, 8);
+    const TMesh r = random_tmesh(7, 120, 8);
     REQUIRE(r.num_hanging_vertices() > 0);
     check_partition_everywhere(r, 5);
     const TMesh b = boundary_mesh(4);
@@ -256,7 +245,7 @@ TEST_SUITE("tspline_basis") {
   }
 
   TEST_CASE("derivatives of R match finite differences on a T-mesh") {
-    const TMesh m = random_mesh(21, 60, 7);
+    const TMesh m = random_tmesh(21, 60, 7);
     REQUIRE(m.num_hanging_vertices() > 0);
     const TSplineBasis B(m);
     std::mt19937 rng(4);
@@ -375,7 +364,7 @@ TEST_SUITE("tspline_basis") {
   }
 
   TEST_CASE("support lists contain every function non-zero on the cell") {
-    const TMesh m = random_mesh(9, 40, 6);
+    const TMesh m = random_tmesh(9, 40, 6);
     REQUIRE(m.num_hanging_vertices() > 0);
     const TSplineBasis B(m);
     std::mt19937 rng(8);
@@ -409,7 +398,7 @@ TEST_SUITE("tspline_basis") {
       meshes.emplace_back(level);
       meshes.back().build_topology();
     }
-    meshes.push_back(random_mesh(7, 120, 8));
+    meshes.push_back(random_tmesh(7, 120, 8));
     meshes.push_back(boundary_mesh(3));
     for (const TMesh& m : meshes) {
       const TSplineBasis B(m);
@@ -432,7 +421,7 @@ TEST_SUITE("tspline_basis") {
   }
 
   TEST_CASE("locate and evaluate conventions") {
-    const TMesh m = random_mesh(3, 30, 6);
+    const TMesh m = random_tmesh(3, 30, 6);
     const TSplineBasis B(m);
     for (int c = 0; c < static_cast<int>(m.num_cells()); ++c) {
       CHECK(B.locate(in_cell(m, c, 0.5, 0.5)) == c);

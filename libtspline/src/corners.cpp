@@ -144,7 +144,7 @@ Corners corners_from_file_indices(const Polygon& p, const std::array<long long, 
   for (int k = 0; k < 4; ++k) {
     if (f[k] < 0 || f[k] >= static_cast<long long>(n) || pos[static_cast<std::size_t>(f[k])] == kNone)
       throw InputError("corner " + std::to_string(k + 1) + ": vertex index " + std::to_string(f[k]) +
-                       " is out of range" + range);
+                       " is out of range" + range + "; indices are 0-based, in the file's own numbering");
     for (int j = 0; j < k; ++j)
       if (f[j] == f[k])
         throw InputError("corner " + std::to_string(k + 1) + ": vertex index " + std::to_string(f[k]) +

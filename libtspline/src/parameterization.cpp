@@ -270,7 +270,9 @@ FrontResult run_front(const Polygon& input, const ParameterizationOptions& opt) 
     if (!(u.x() * w.y() - u.y() * w.x() > 0.0)) {
       std::ostringstream s;
       s << "corner " << k << " (file vertex " << poly.file_index[i] << ") has an inner angle of "
-        << corners.inner_angle_deg[k] << " degrees: corners must be convex vertices (inner angle below 180)";
+        << corners.inner_angle_deg[k]
+        << " degrees: corners must be convex vertices (inner angle below 180); pick another vertex, or omit "
+           "--corners for the automatic choice";
       throw InputError(s.str());
     }
   }

@@ -54,11 +54,13 @@ PoissonErrors compute_errors(const TSplineMap& map, const PoissonSolution& sol, 
   return e;
 }
 
-std::vector<double> estimate_cells(const TSplineMap& map, const PoissonSolution& sol, const PoissonProblem& problem) {
+std::vector<double> estimate_cells(const TSplineMap& map, const PoissonSolution& sol, const PoissonProblem& problem,
+                                   std::vector<double>* eta_scale) {
   const TMesh& mesh = sol.space->mesh();
   std::vector<double> gp, gw;
   gauss_points_01(4, gp, gw);
   std::vector<double> eta(mesh.num_cells(), 0.0);
+  if (eta_scale) eta_scale->assign(mesh.num_cells(), 0.0);
   for (int c = 0; c < static_cast<int>(mesh.num_cells()); ++c) {
     const Eigen::Vector2d lo = mesh.cell_min(c), hi = mesh.cell_max(c), len = hi - lo;
     const int g = sol.space->geometry_cell(c);
@@ -67,18 +69,46 @@ std::vector<double> estimate_cells(const TSplineMap& map, const PoissonSolution&
     const Eigen::Vector2d p10 = map.derivatives({hi.x(), lo.y()}, 0, g).x;
     const Eigen::Vector2d p01 = map.derivatives({lo.x(), hi.y()}, 0, g).x;
     const double h = std::max((p11 - p00).norm(), (p01 - p10).norm());
-    double s = 0;
+    double s = 0, scale = 0;
     for (std::size_t i = 0; i < gp.size(); ++i)
       for (std::size_t j = 0; j < gp.size(); ++j) {
         const Eigen::Vector2d uv(lo.x() + gp[i] * len.x(), lo.y() + gp[j] * len.y());
         const SolutionValue v = evaluate_solution(map, sol, c, uv, 2);
         const double w = gw[i] * gw[j] * len.x() * len.y() * std::abs(v.det_j);
-        const double r = problem.f(v.x.x(), v.x.y()) + v.hessian.trace();
+        const double fv = problem.f(v.x.x(), v.x.y()), lap = v.hessian.trace();
+        const double r = fv + lap;
         s += w * r * r;
+        scale += w * (fv * fv + lap * lap);
       }
     eta[c] = h * std::sqrt(s);
+    if (eta_scale) (*eta_scale)[c] = h * std::sqrt(scale);
   }
   return eta;
+}
+
+std::vector<int> refinement_patch(const TMesh& mesh, const std::vector<int>& marked) {
+  std::vector<char> take(mesh.num_cells(), 0);
+  for (int c : marked) {
+    take[c] = 1;
+    const QuadNode& q = mesh.node(mesh.cell_node(c));
+    const IPoint lo = TMesh::node_min(q), hi = TMesh::node_max(q);
+    // Sample just outside the midpoints of the edges and the corners (doubled
+    // integer coordinates): a neighbour at least as large as c is hit by one of
+    // these samples; smaller neighbours are skipped.
+    const std::int64_t xs[3] = {2 * lo.x - 1, lo.x + hi.x, 2 * hi.x + 1};
+    const std::int64_t ys[3] = {2 * lo.y - 1, lo.y + hi.y, 2 * hi.y + 1};
+    for (std::int64_t px : xs)
+      for (std::int64_t py : ys) {
+        const int n = mesh.leaf_at_doubled(px, py);
+        if (n < 0) continue;  // outside [0,1]^2
+        const int nc = mesh.cell_of_node(n);
+        if (mesh.cell_level(nc) <= q.level) take[nc] = 1;
+      }
+  }
+  std::vector<int> out;
+  for (int c = 0; c < static_cast<int>(take.size()); ++c)
+    if (take[c]) out.push_back(c);
+  return out;
 }
 
 std::vector<int> mark_cells(const std::vector<double>& eta, double gamma) {
@@ -126,23 +156,34 @@ std::vector<PoissonStep> solve_adaptive(const TSplineMap& map, const PoissonProb
       st.has_errors = true;
       st.errors = compute_errors(map, sol, problem);
     }
-    const std::vector<double> eta = estimate_cells(map, sol, problem);
-    double s = 0;
-    for (double e : eta) s += e * e;
+    std::vector<double> scale;
+    const std::vector<double> eta = estimate_cells(map, sol, problem, &scale);
+    double s = 0, s_scale = 0;
+    for (std::size_t c = 0; c < eta.size(); ++c) {
+      s += eta[c] * eta[c];
+      s_scale += scale[c] * scale[c];
+    }
     st.eta = std::sqrt(s);
+    // The residual f + Laplace(u_h) is a difference of two terms of size ~scale:
+    // below kRoundoffResidual * scale it is round-off (u_h solves the problem
+    // exactly, e.g. a solution in the discrete space) and there is nothing to refine.
+    st.eta_at_roundoff = st.eta <= kRoundoffResidual * std::sqrt(s_scale);
     std::vector<int> marked;
     if (options.refine == AdaptiveSolveOptions::Refine::Uniform) {
       marked.resize(eta.size());
       for (int c = 0; c < static_cast<int>(eta.size()); ++c) marked[c] = c;
-    } else {
+    } else if (!st.eta_at_roundoff) {
       marked = mark_cells(eta, options.gamma);
+      st.marked = marked.size();
+      marked = refinement_patch(mesh, marked);
     }
-    st.marked = marked.size();
+    if (options.refine == AdaptiveSolveOptions::Refine::Uniform) st.marked = marked.size();
+    st.refined = marked.size();
     st.seconds = seconds_since(t0);
     steps.push_back(st);
     if (callback) callback(st, sol, eta);
     if (k + 1 < options.steps) {
-      if (marked.empty()) break;
+      if (marked.empty()) break;  // nothing to refine (estimator zero or at round-off)
       mesh = refine_cells(mesh, marked);
     }
   }

@@ -156,6 +156,8 @@ Polygon validate_polygon(Polygon p) {
                       (first.overlap ? " overlap near " : " intersect near ") +
                       fmt_point(first.where.x(), first.where.y());
     if (n_conflicts > 1) msg += " (" + std::to_string(n_conflicts - 1) + " more conflicting edge pair(s))";
+    msg += "; the domain must be bounded by one simple closed polygon: fix the vertices there (check the "
+           "vertex order, duplicated or stray points)";
     throw InputError(msg);
   }
 

@@ -4,23 +4,30 @@
 //
 //   -Laplace(u) = f in Omega = S([0,1]^2),   u = g on the boundary of Omega.
 //
-// Analysis space: the cubic T-spline blending functions (TSplineBasis) of an
+// Analysis space: cubic hierarchical B-splines (hierarchical_basis.h) on an
 // ANALYSIS T-mesh. It starts equal to the geometry's T-mesh and is refined
 // independently; the geometry map S stays the one of the parameterization, so
-// after refinement the method is NOT isoparametric (as in the paper). Every
-// analysis cell lies inside one geometry cell, located once per cell, so that S
-// and its derivatives are evaluated with the geometry cell's function list.
+// the method is NOT isoparametric (as in the paper). Every analysis cell lies
+// inside one geometry cell, located once per cell, so that S and its derivatives
+// are evaluated with the geometry cell's function list.
+// Deviation from the paper (which uses the T-spline blending functions of the
+// analysis T-mesh): on T-meshes with hanging vertices those do not reproduce
+// linear functions and are not nested under refinement, which costs the
+// convergence rates (measured: about h^2 in L2 and h in H1 on curved domains);
+// the hierarchical B-splines of the same quadtree contain all cubic polynomials
+// and converge at the optimal rates h^4 (L2) and h^3 (H1).
 //
 // Discretization (Galerkin):
 //  * stiffness K_ab = int grad R_a . grad R_b dx, load b_a = int f R_a dx, both with
 //    4x4 Gauss points per analysis cell; grad_x R = J^{-T} grad_xi R, weight |det J|.
-//  * Dirichlet data by INTERPOLATION: the boundary functions are those that do not
-//    vanish on the border of [0,1]^2 (touches_border); each has its interpolation
-//    point on the border. Their coefficients solve the small sparse collocation
-//    system  sum_{b in B} c_b R_b(p_a) = g(S(p_a)), a in B (interior functions
-//    vanish on the border, so they do not enter). Those DOFs are then eliminated
-//    (lifted into the right-hand side); the interior system is symmetric positive
-//    definite.
+//  * Dirichlet data by L2 PROJECTION on the border: the boundary functions B are
+//    those that do not vanish on the border of [0,1]^2 (HierarchicalFunction::
+//    on_border); their coefficients solve  sum_{b in B} c_b <R_b, R_a> = <g o S, R_a>,
+//    a in B, with <u, v> the integral over the border of the parameter square
+//    (parametric arc length, 5 Gauss points per border cell edge, exact for the
+//    mass matrix). Interior functions vanish on the border, so they do not
+//    enter. Those DOFs are then eliminated (lifted into the right-hand side); the
+//    interior system is symmetric positive definite.
 //  * Solve: CHOLMOD's supernodal Cholesky (SuiteSparse); if it fails, Eigen's
 //    SimplicialLDLT; if that fails too, conjugate gradients
 //    with an incomplete Cholesky preconditioner.
@@ -34,12 +41,7 @@
 // h_e = physical cell diameter, taken as the longer of the two diagonals of the
 // image of the cell's corners, |S(c00) - S(c11)| and |S(c10) - S(c01)|.
 // Laplace u_h uses the physical Hessian (see physical_hessian()).
-//
-// Known limitation (measured in tests/test_poisson.cpp): on T-meshes with hanging
-// vertices the normalized blending functions R = N / sum N do not reproduce linear
-// functions near the T-junctions, so the spaces are not nested and uniform
-// refinement of such a mesh converges at about h^2 (L2) and h (H1) instead of h^4
-// and h^3. On meshes without T-junctions the rates are optimal.
+
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
 #include <functional>
@@ -47,8 +49,8 @@
 #include <string>
 #include <vector>
 
+#include "tspline/hierarchical_basis.h"
 #include "tspline/tmesh.h"
-#include "tspline/tspline_basis.h"
 #include "tspline/tspline_map.h"
 
 namespace tspline {
@@ -73,13 +75,13 @@ class AnalysisSpace {
   /// geometry cell). \throw InputError otherwise.
   AnalysisSpace(const TSplineMap& map, TMesh analysis_mesh);
   const TMesh& mesh() const { return *mesh_; }
-  const TSplineBasis& basis() const { return *basis_; }
+  const HierarchicalBasis& basis() const { return *basis_; }
   int geometry_cell(int c) const { return geometry_cell_[c]; }
   std::size_t num_dofs() const { return basis_->size(); }
 
  private:
   std::unique_ptr<TMesh> mesh_;  // heap: the basis keeps a pointer to it
-  std::unique_ptr<TSplineBasis> basis_;
+  std::unique_ptr<HierarchicalBasis> basis_;
   std::vector<int> geometry_cell_;
 };
 
@@ -139,8 +141,21 @@ struct PoissonErrors {
 /// \throw InputError if problem.exact is missing.
 PoissonErrors compute_errors(const TSplineMap& map, const PoissonSolution& sol, const PoissonProblem& problem);
 
-/// eta_e per analysis cell (not squared).
-std::vector<double> estimate_cells(const TSplineMap& map, const PoissonSolution& sol, const PoissonProblem& problem);
+/// eta_e per analysis cell (not squared). If eta_scale is given it receives per
+/// cell h_e (||f||^2 + ||Laplace u_h||^2)^{1/2} over the cell's image: the size of
+/// the two terms whose sum is the residual, to recognize a residual at round-off.
+std::vector<double> estimate_cells(const TSplineMap& map, const PoissonSolution& sol, const PoissonProblem& problem,
+                                   std::vector<double>* eta_scale = nullptr);
+
+/// An estimator below this fraction of its scale (see estimate_cells) is round-off:
+/// the adaptive loop then refines nothing. (Discrete solutions measure ~1e-15.)
+inline constexpr double kRoundoffResidual = 1e-10;
+
+/// The cells to split for the marked cells: each marked cell and every leaf at
+/// most as fine that touches it (edge or corner). Splitting a cell alone adds no
+/// hierarchical B-spline: a level-(l+1) function needs 4x4 level-(l+1) cells, i.e.
+/// 2x2 split level-l cells; the 3x3 patch around a marked cell adds nine.
+std::vector<int> refinement_patch(const TMesh& mesh, const std::vector<int>& marked);
 
 /// Cells with eta_e > gamma * max eta (none if max eta is 0). \throw InputError unless 0 <= gamma <= 1.
 std::vector<int> mark_cells(const std::vector<double>& eta, double gamma);
@@ -166,7 +181,9 @@ struct PoissonStep {
   SolverStats solver;
   double assembly_seconds = 0.0;
   double seconds = 0.0;  ///< whole step (solve, errors, estimator)
-  std::size_t marked = 0;
+  std::size_t marked = 0;   ///< cells marked by the estimator (all cells for uniform refinement)
+  std::size_t refined = 0;  ///< cells split for the next step (marked cells and their refinement patch)
+  bool eta_at_roundoff = false;  ///< estimator below kRoundoffResidual of its scale: nothing refined
 };
 
 /// Called after each step with its record, the solution and the per-cell eta.

@@ -35,8 +35,13 @@ std::string create_temp_next_to(const fs::path& target) {
   const fs::path dir = target.parent_path();
   for (int attempt = 0; attempt < 100; ++attempt) {
     const unsigned long n = g_temp_counter.fetch_add(1, std::memory_order_relaxed);
-    const std::string tmp_name =
-        "." + name.string() + ".tmp." + std::to_string(static_cast<long>(::getpid())) + "." + std::to_string(n);
+    // Appended piecewise: GCC 12 warns (-Wrestrict, a false positive) on the chained operator+.
+    std::string tmp_name = ".";
+    tmp_name += name.string();
+    tmp_name += ".tmp.";
+    tmp_name += std::to_string(static_cast<long>(::getpid()));
+    tmp_name += '.';
+    tmp_name += std::to_string(n);
     const fs::path tmp = dir.empty() ? fs::path(tmp_name) : dir / tmp_name;
     const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
     if (fd >= 0) {

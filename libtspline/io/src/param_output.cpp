@@ -1,8 +1,10 @@
 #include "tspline/io/param_output.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <set>
 
 #include <Eigen/LU>
 
@@ -40,6 +42,26 @@ VtuMesh control_net_vtu(const TSplineMap& map) {
     out.cells.push_back({a});
     kind.push_back(static_cast<int>(map.basis().function(a).kind));
     fn.push_back(a);
+  }
+  // Lines: the T-mesh edges between anchors (the T-spline's control net), and
+  // each border/corner extra function joined to its vertex's anchor.
+  const TMesh& mesh = map.mesh();
+  std::vector<int> anchor(mesh.num_vertices(), -1);
+  for (int a = 0; a < static_cast<int>(map.basis().size()); ++a)
+    if (map.basis().function(a).kind == BlendingFunction::Kind::Anchor) anchor[map.basis().function(a).vertex] = a;
+  std::set<std::pair<int, int>> edges;
+  for (int c = 0; c < static_cast<int>(mesh.num_cells()); ++c) {
+    const std::vector<int> poly = mesh.cell_polygon(c);
+    for (std::size_t k = 0; k < poly.size(); ++k) {
+      const int u = poly[k], v = poly[(k + 1) % poly.size()];
+      edges.insert({std::min(u, v), std::max(u, v)});
+    }
+  }
+  for (const auto& [u, v] : edges)
+    if (anchor[u] >= 0 && anchor[v] >= 0) out.cells.push_back({anchor[u], anchor[v]});
+  for (int a = 0; a < static_cast<int>(map.basis().size()); ++a) {
+    const BlendingFunction& f = map.basis().function(a);
+    if (f.kind != BlendingFunction::Kind::Anchor && anchor[f.vertex] >= 0) out.cells.push_back({anchor[f.vertex], a});
   }
   out.point_ints["kind"] = std::move(kind);
   out.point_ints["function"] = std::move(fn);

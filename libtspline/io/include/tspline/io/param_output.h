@@ -16,8 +16,11 @@ namespace tspline::io {
 /// parametric (xi, eta). Cell data: cell (T-mesh cell id), level.
 VtuMesh surface_vtu(const TSplineMap& map, int samples);
 
-/// The control points as vertex cells; point data kind (0 anchor, 1 edge extra,
-/// 2 corner extra) and function (index).
+/// The control points as vertex cells (one per function, first), then the
+/// control net as line cells: T-mesh edges between the anchors of their end
+/// vertices, and each border/corner extra function joined to its vertex's
+/// anchor. Point data kind (0 anchor, 1 edge extra, 2 corner extra) and
+/// function (index).
 VtuMesh control_net_vtu(const TSplineMap& map);
 
 /// Writes adapt/mesh_NNN.vtu and adapt/surface_NNN.vtu for each iteration (the

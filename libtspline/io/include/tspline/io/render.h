@@ -1,0 +1,40 @@
+#pragma once
+// Pictures of the toolkit's outputs without ParaView: `tspline render`.
+// Reads the .vtu files that `tspline param` / `tspline poisson` wrote into a
+// directory and draws one view into a PNG with the software rasterizer
+// (raster_image.h).
+#include <string>
+
+namespace tspline::io {
+
+enum class RenderView {
+  Auto,        ///< Solution if the directory holds solution/step_*.vtu, else Jacobian
+  TMesh,       ///< image of the T-mesh cells under the map (curved edges), boundary polygon
+  Jacobian,    ///< mean ratio Jacobian J_r on [0, 1] (viridis; J_r < 0 red), T-mesh edges
+  ControlNet,  ///< control net (lines and points) over the boundary polygon
+  Solution     ///< u_h of the last (or a given) Poisson step, analysis cell edges
+};
+
+/// Parses "auto", "tmesh", "jacobian", "control-net", "solution". \throw InputError.
+RenderView parse_render_view(const std::string& name);
+
+struct RenderOptions {
+  RenderView view = RenderView::Auto;
+  int width = 1200;
+  int height = 900;
+  int step = -1;  ///< Solution: the Poisson step to draw (-1: the last)
+};
+
+struct RenderSummary {
+  RenderView view = RenderView::Auto;  ///< the view drawn (Auto resolved)
+  std::string source;                  ///< the main .vtu file read
+  double min = 0.0, max = 0.0;         ///< range of the colour-mapped field (0, 0 if none)
+};
+
+/// Draws `dir`'s outputs into the PNG `png_path` (written atomically).
+/// \throw IoError if a needed file is missing or unreadable (the message names
+/// it and the command that writes it) or the PNG cannot be written; InputError
+/// for bad options.
+RenderSummary render_png(const std::string& dir, const std::string& png_path, const RenderOptions& options);
+
+}  // namespace tspline::io

@@ -1,0 +1,16 @@
+#!/usr/bin/env bash
+# The README's pictures, made by `tspline render` from the bundled example:
+# parameterizes examples/flower.txt, solves the Gaussian-peak Poisson problem
+# adaptively on it, and draws four views into docs/images/.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+bash scripts/install_deps.sh
+bash scripts/build.sh
+T=./build/apps/tspline
+$T param examples/flower.txt --out out/flower -q
+$T poisson out/flower/tspline.json --problem gaussian --steps 8 --out out/flower_poisson -q
+mkdir -p docs/images
+for view in jacobian tmesh control-net; do
+  $T render out/flower --view "$view" --size 800x600 --png "docs/images/flower_$view.png"
+done
+$T render out/flower_poisson --view solution --size 800x600 --png docs/images/flower_poisson.png

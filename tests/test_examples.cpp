@@ -1,0 +1,112 @@
+// The examples in examples/ run and their results are right: each example
+// checks itself (exit 0 only if right), and here we also read what it printed.
+#include <doctest/doctest.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <sstream>
+
+#include "test_support.h"
+
+namespace fs = std::filesystem;
+using test_support::contains;
+using test_support::run_program;
+
+namespace {
+
+fs::path scratch(const std::string& name) { return test_support::scratch_dir("examples", name); }
+std::string q(const fs::path& p) { return test_support::quoted(p); }
+
+/// The number after "key " on the line that starts with key.
+double value_after(const std::string& out, const std::string& key) {
+  std::istringstream in(out);
+  std::string line;
+  while (std::getline(in, line))
+    if (line.rfind(key + " ", 0) == 0) return std::stod(line.substr(key.size() + 1));
+  FAIL("no line '" << key << " ...' in:\n" << out);
+  return 0.0;
+}
+
+/// tspline.json written by example 1 (run once per process).
+fs::path example1_output() {
+  static const fs::path file = [] {
+    const fs::path d = scratch("ex1");
+    const auto r = run_program(EXAMPLE_PARAMETERIZE, q(fs::path(TSPLINE_EXAMPLES_DIR) / "flower.txt") + " " +
+                                                         q(d / "out"),
+                               d);
+    CAPTURE(r.err);
+    REQUIRE(r.exit_code == 0);
+    CHECK(value_after(r.out, "valid") == 1.0);
+    CHECK(value_after(r.out, "min_jr") >= 0.2);
+    CHECK(value_after(r.out, "cells") > 100);
+    return d / "out" / "tspline.json";
+  }();
+  return file;
+}
+
+}  // namespace
+
+TEST_SUITE("examples") {
+  TEST_CASE("ex1: parameterize a polygon") { CHECK(fs::exists(example1_output())); }
+
+  TEST_CASE("ex2: corners and tolerance") {
+    const fs::path d = scratch("ex2");
+    const auto r = run_program(EXAMPLE_CORNERS_TOLERANCE, "", d);
+    CAPTURE(r.out);
+    CAPTURE(r.err);
+    REQUIRE(r.exit_code == 0);
+    // One line per tolerance; the cell count grows as the tolerance shrinks and
+    // the chosen corners are the images of the square's corners.
+    std::istringstream in(r.out);
+    std::string line;
+    std::vector<double> cells;
+    while (std::getline(in, line))
+      if (line.rfind("tol ", 0) == 0) {
+        std::istringstream l(line);
+        std::string w;
+        double tol, c, err;
+        l >> w >> tol >> w >> c >> w >> err;
+        cells.push_back(c);
+        CHECK(err <= 1e-12);
+        CHECK(contains(line, "valid 1"));
+      }
+    REQUIRE(cells.size() == 3);
+    CHECK(cells[0] < cells[1]);
+    CHECK(cells[1] < cells[2]);
+  }
+
+  TEST_CASE("ex3: read back and evaluate") {
+    const fs::path d = scratch("ex3");
+    const auto r = run_program(EXAMPLE_EVALUATE, q(example1_output()), d);
+    CAPTURE(r.out);
+    CAPTURE(r.err);
+    REQUIRE(r.exit_code == 0);
+    CHECK(value_after(r.out, "det J =") > 0.0);
+    const double jr = value_after(r.out, "J_r =");
+    CHECK(jr > 0.0);
+    CHECK(jr <= 1.0);
+    // Bad input: a clear message and exit 2.
+    const auto bad = run_program(EXAMPLE_EVALUATE, q(d / "nonesuch.json"), d);
+    CHECK(bad.exit_code == 2);
+    CHECK(contains(bad.err, "nonesuch.json"));
+  }
+
+  TEST_CASE("ex4: adaptive Poisson with user f and g") {
+    const fs::path d = scratch("ex4");
+    const auto r = run_program(EXAMPLE_POISSON, q(example1_output()), d);
+    CAPTURE(r.out);
+    CAPTURE(r.err);
+    REQUIRE(r.exit_code == 0);
+    CHECK(value_after(r.out, "H1 error reduced by") >= 2.0);
+  }
+
+  TEST_CASE("ex5: untangle a planar mesh") {
+    const fs::path d = scratch("ex5");
+    const auto r = run_program(EXAMPLE_UNTANGLE, "", d);
+    CAPTURE(r.out);
+    CAPTURE(r.err);
+    REQUIRE(r.exit_code == 0);
+    CHECK(value_after(r.out, "before: inverted") > 10);
+    CHECK(value_after(r.out, "after: inverted") == 0.0);
+  }
+}
