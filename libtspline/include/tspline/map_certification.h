@@ -22,8 +22,12 @@
 //     coefficients converge to the values, and each quarter is examined in turn,
 //     down to a depth limit (then "undecided": not certified).
 // A coefficient counts as positive only above a round-off margin,
-// relative_tolerance times a bound of |D| (the same products of the largest
-// absolute coefficients), so the proof is robust to floating-point error.
+// relative_tolerance (1e-10) times a bound of |D| (the same products of the
+// largest absolute coefficients), and a corner value as negative only below
+// minus that margin. The arithmetic is ordinary floating point, not interval
+// arithmetic: the margin is some 1e3-1e4 times the accumulated round-off of the
+// extraction and the products, and an element is left uncertified only where
+// det J comes within about 1e-10 of its scale of zero (a degenerate map).
 //
 // Lower bound: with d_min the smallest coefficient over the final sub-patches
 // and w_min <= w <= w_max the extremes of w's Bernstein coefficients,
@@ -31,7 +35,8 @@
 // in local coordinates; dividing by the element's mean of det J (5x5 Gauss
 // quadrature of D / w^3, exact when w is constant, which it is away from
 // T-junctions) gives the scale-free relative lower bound reported, in (0, 1]
-// for a certified element (1 only for a constant det J).
+// for a certified element (1 only for a constant det J; up to the quadrature
+// error of the mean where w varies).
 #include <Eigen/Core>
 #include <array>
 #include <cstddef>
