@@ -21,6 +21,10 @@ void add_tspline_file_commands(CLI::App& app, CommandAction& action);
 /// refinement on the domain of a T-spline file (cmd_poisson.cpp).
 void add_poisson_command(CLI::App& app, CommandAction& action);
 
+/// `tspline check`: certify det J > 0 on every Bezier element of a T-spline
+/// file (cmd_check.cpp); exit 3 if the map is not certified valid.
+void add_check_command(CLI::App& app, CommandAction& action);
+
 /// `tspline render`: PNG pictures of the outputs of param and poisson (cmd_render.cpp).
 void add_render_command(CLI::App& app, CommandAction& action);
 

@@ -3,7 +3,8 @@
 //   exit 0  success
 //   exit 1  invalid input (polygon, corners, options)
 //   exit 2  file could not be read or written
-//   exit 3  the run finished but the map is not valid (det J <= 0 somewhere),
+//   exit 3  the run finished but the map is not valid (det J <= 0 somewhere,
+//           or det J > 0 not certified on every element; `tspline check`),
 //           or a numerical step failed (e.g. a singular interpolation system)
 //   exit 4  unexpected internal error
 #include <CLI/CLI.hpp>
@@ -80,6 +81,7 @@ int run_param(const std::string& input, const std::string& out_dir, const std::s
   progress.event({{"event", "result"},
                   {"valid", result.valid()},
                   {"good", result.good(adaptive.min_jacobian)},
+                  {"certified_valid", result.certified_valid()},
                   {"min_mean_ratio_jacobian", result.quality.min_mean_ratio},
                   {"cells", result.map ? result.map->mesh().num_cells() : 0},
                   {"stop_reason", result.stop_reason},
@@ -96,6 +98,14 @@ int run_param(const std::string& input, const std::string& out_dir, const std::s
               << " (files written; see surface.vtu, point data det_jacobian, or `tspline render OUTDIR`); try "
                  "other --corners, a smaller --tol-rel, or more --max-adapt rounds"
               << std::endl;
+    return 3;
+  }
+  if (adaptive.certify && !result.certified_valid()) {
+    const tspline::MapCertification& c = result.certification;
+    std::cerr << "tspline: error: the map is not certified valid: " << c.elements - c.certified << " of " << c.elements
+              << " elements not certified (" << c.invalid << " with det J < 0 proven, " << c.undecided
+              << " undecided); adaptive refinement stopped: " << result.stop_reason
+              << " (files written; run 'tspline check' on tspline.json for the elements)" << std::endl;
     return 3;
   }
   if (!result.good(adaptive.min_jacobian) && !quiet)
@@ -170,6 +180,11 @@ int main(int argc, char** argv) {
                     "Exponent p of the control point optimization's objective sum (1/J_r)^p: larger p raises the "
                     "minimum J_r")
       ->capture_default_str();
+  param->add_option("--cert-depth", adaptive.certification.max_depth,
+                    "Certification of det J > 0 on every Bezier element: de Casteljau subdivision levels at most "
+                    "(an element still undecided there is refined like one with J_r below --min-jacobian)")
+      ->check(CLI::Range(0, 20))
+      ->capture_default_str();
   param->add_option("--samples", samples, "surface.vtu: k x k sub-quads per T-mesh cell")->capture_default_str();
   param->add_flag("--quiet,-q", quiet, "Print errors only");
   bool json_events = false;
@@ -178,6 +193,7 @@ int main(int argc, char** argv) {
                   "iteration, result) instead of text");
   tspline_app::CommandAction command;  // set by the other subcommands when parsed (commands.h)
   tspline_app::add_tspline_file_commands(app, command);
+  tspline_app::add_check_command(app, command);
   tspline_app::add_poisson_command(app, command);
   tspline_app::add_render_command(app, command);
 

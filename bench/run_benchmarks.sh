@@ -22,6 +22,11 @@ printf "%9s %9s %9s %9s %9s %9s %9s %8s\n" cells functions basis fit check cpo20
 for level in 5 7 9; do
   ./build/bench/bench_fit "$POLY" "$level" 1e-6
 done
+echo "Certified validity (Bezier elements, (8,8) Bernstein numerator) on $POLY (initial level 5, 7, 8; tol-rel 1e-6)"
+printf "%9s %9s %9s %9s %9s %9s %9s %9s %9s %13s %9s\n" cells elements functions fit extract certify us_per_el check certified min_rel_bound max_depth
+for level in 5 7 8; do
+  ./build/bench/bench_certify "$POLY" "$level" 1e-6
+done
 echo "IGA Poisson on the unit square (identity map), uniform analysis T-mesh 2^L x 2^L, sin(pi x) sin(pi y)"
 printf "%5s %9s %9s %8s %11s %10s %8s %-6s %9s %9s %9s\n" level cells dofs space_s dirichlet_s assembly_s solve_s solver residual max_err peak_MiB
 for level in 7 8 9 10; do

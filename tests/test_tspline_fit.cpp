@@ -151,9 +151,15 @@ TEST_SUITE("tspline_fit") {
                    << " functions, residual " << r.fit.relative_residual << ", J_r min/mean "
                    << r.quality.min_mean_ratio << "/" << r.quality.mean_mean_ratio << ", det<=0 "
                    << r.quality.nonpositive_det << ", rounds " << r.iterations.size() - 1 << ", control points "
-                   << std::string(r.control_points_optimized ? "optimized" : "interpolating"));
+                   << std::string(r.control_points_optimized ? "optimized" : "interpolating")
+                   << ", certified " << r.certification.certified << "/" << r.certification.elements
+                   << " elements, det J >= " << r.certification.min_relative_lower_bound << " x mean, "
+                   << r.certification_rounds << " extra rounds");
       for (const auto& it : r.iterations) CHECK(it.fit.relative_residual <= 1e-10);
       CHECK(r.valid());
+      // Issue 7: det J > 0 proved on every Bezier element, not only at the Gauss points.
+      CHECK(r.certified_valid());
+      CHECK(r.certification.min_relative_lower_bound > 0.0);
       CHECK(r.quality.nonpositive_det == 0);
       CHECK(r.quality.min_mean_ratio >= 0.2);
     }
@@ -173,15 +179,19 @@ TEST_SUITE("tspline_fit") {
       CHECK(r.iterations[k + 1].cells > r.iterations[k].cells);
     }
     CHECK(r.iterations.back().refined_cells == 0);
-    // The kept iteration is the best by (det J <= 0 points, then min J_r).
+    // The kept iteration is the best by (det J <= 0 points, then certified
+    // valid before not, then min J_r).
     int best = 0;
     for (int k = 1; k < static_cast<int>(r.iterations.size()); ++k) {
       const auto& a = r.iterations[k].quality;
       const auto& b = r.iterations[best].quality;
+      const bool ca = r.iterations[k].certification.certified_valid(),
+                 cb = r.iterations[best].certification.certified_valid();
       if (a.nonpositive_det < b.nonpositive_det ||
-          (a.nonpositive_det == b.nonpositive_det && a.min_mean_ratio > b.min_mean_ratio))
+          (a.nonpositive_det == b.nonpositive_det && (ca != cb ? ca : a.min_mean_ratio > b.min_mean_ratio)))
         best = k;
     }
+    CHECK(r.certified_valid() == r.iterations[best].certification.certified_valid());
     CHECK(r.kept_iteration == best);
     CHECK(r.quality.min_mean_ratio == r.iterations[best].quality.min_mean_ratio);
     CHECK(r.front.mesh.num_cells() == r.iterations[best].cells);

@@ -46,10 +46,10 @@ ParameterizationResult run_parameterization(const Polygon& polygon, const Parame
   auto log = [&](const std::string& s) {
     if (opt.log) opt.log(s);
   };
-  ParameterizationResult r{run_front(polygon, opt), std::nullopt, {}, {}, {}, {}, 0, false, {}};
+  ParameterizationResult r{run_front(polygon, opt), std::nullopt, {}, {}, {}, {}, 0, false, {}, {}, 0};
   FrontResult& f = r.front;
-  double t_fit = 0.0, t_check = 0.0, t_refine = 0.0, t_cpo = 0.0;
-  // The best iteration so far: fewest det J <= 0 points, then highest min J_r.
+  double t_fit = 0.0, t_check = 0.0, t_refine = 0.0, t_cpo = 0.0, t_certify = 0.0;
+  // The best iteration so far (better_iteration below).
   struct Snapshot {
     TMesh mesh = TMesh(0);
     std::vector<Eigen::Vector2d> x;
@@ -59,12 +59,19 @@ ParameterizationResult run_parameterization(const Polygon& polygon, const Parame
     FitReport fit;
     MapQualityStats quality;
     std::vector<CellMapQuality> cells;
+    MapCertification certification;
   };
   std::optional<Snapshot> best;
   int best_it = 0;
   auto better = [](const MapQualityStats& a, const MapQualityStats& b) {
     return a.nonpositive_det < b.nonpositive_det ||
            (a.nonpositive_det == b.nonpositive_det && a.min_mean_ratio > b.min_mean_ratio);
+  };
+  // Iterations: fewest det J <= 0 points, then certified before not, then highest min J_r.
+  auto better_iteration = [&](const MapQualityStats& a, bool a_cert, const MapQualityStats& b, bool b_cert) {
+    if (a.nonpositive_det != b.nonpositive_det) return a.nonpositive_det < b.nonpositive_det;
+    if (a_cert != b_cert) return a_cert;
+    return a.min_mean_ratio > b.min_mean_ratio;
   };
   for (int it = 0;; ++it) {
     const auto t0 = std::chrono::steady_clock::now();
@@ -102,6 +109,24 @@ ParameterizationResult run_parameterization(const Polygon& polygon, const Parame
       log(s.str());
       t_cpo += seconds_since(t3);
     }
+    if (ad.certify) {
+      const auto t4 = std::chrono::steady_clock::now();
+      r.certification = certify_map(*r.map, ad.certification);
+      t_certify += seconds_since(t4);
+      std::ostringstream s;
+      s << "certification: " << r.certification.certified << " of " << r.certification.elements
+        << " elements certified det J > 0";
+      if (!r.certification.certified_valid())
+        s << " (" << r.certification.invalid << " proven det J < 0, " << r.certification.undecided << " undecided)";
+      else
+        s << ", det J >= " << r.certification.min_relative_lower_bound << " x element mean";
+      s << ", " << r.certification.seconds << " s";
+      log(s.str());
+    }
+    const bool certified = !ad.certify || r.certification.certified_valid();
+    rec.certification = r.certification;
+    rec.certification.cell_certified.clear();
+    rec.certification.failures.clear();
     rec.cells = f.mesh.num_cells();
     rec.vertices = f.mesh.num_vertices();
     rec.functions = r.map->basis().size();
@@ -116,23 +141,32 @@ ParameterizationResult run_parameterization(const Polygon& polygon, const Parame
       log(s.str());
     }
     if (on_iteration) on_iteration(it, f.mesh, f.optimized, *r.map, r.cell_quality);
-    if (!best || better(r.quality, best->quality)) {
-      best = Snapshot{f.mesh, f.optimized, f.quality_optimized, r.map, rec.control_points_optimized, r.fit, r.quality,
-                      r.cell_quality};
+    if (!best || better_iteration(r.quality, certified, best->quality,
+                                  !ad.certify || best->certification.certified_valid())) {
+      best = Snapshot{f.mesh,    f.optimized, f.quality_optimized, r.map,          rec.control_points_optimized,
+                      r.fit,     r.quality,   r.cell_quality,      r.certification};
       best_it = it;
     }
     std::vector<int> marked;
-    if (r.good(ad.min_jacobian)) {
-      r.stop_reason = "every quadrature point has det J > 0 and J_r >= " + std::to_string(ad.min_jacobian);
+    if (r.good(ad.min_jacobian) && certified) {
+      r.stop_reason = "every quadrature point has det J > 0 and J_r >= " + std::to_string(ad.min_jacobian) +
+                      (ad.certify ? ", and det J > 0 is certified on every element" : "");
     } else if (it >= ad.max_adapt) {
       r.stop_reason = "reached --max-adapt " + std::to_string(ad.max_adapt);
     } else if (it - best_it >= ad.stall_rounds) {
       r.stop_reason = "no improvement in the last " + std::to_string(ad.stall_rounds) +
                       " rounds (the remaining distortion is not one refinement can remove)";
     } else {
-      for (int c = 0; c < static_cast<int>(f.mesh.num_cells()); ++c)
-        if (!(r.cell_quality[c].min_mean_ratio >= ad.min_jacobian) && f.mesh.cell_level(c) < opt.max_level)
+      for (int c = 0; c < static_cast<int>(f.mesh.num_cells()); ++c) {
+        if (f.mesh.cell_level(c) >= opt.max_level) continue;
+        if (!(r.cell_quality[c].min_mean_ratio >= ad.min_jacobian)) {
           marked.push_back(c);
+        } else if (ad.certify && !r.certification.cell_certified[c]) {
+          // Not certified valid on the whole cell: refined like J_r < delta.
+          marked.push_back(c);
+          ++rec.certification_marked_cells;
+        }
+      }
       if (marked.empty())
         r.stop_reason = "the cells to refine are at --max-level";
       else if (f.mesh.num_cells() + 3 * marked.size() > ad.max_cells) {
@@ -142,6 +176,7 @@ ParameterizationResult run_parameterization(const Polygon& polygon, const Parame
       }
     }
     rec.refined_cells = marked.size();
+    if (!marked.empty() && r.good(ad.min_jacobian)) ++r.certification_rounds;
     if (marked.empty()) {
       rec.seconds = seconds_since(t0);
       r.iterations.push_back(rec);
@@ -162,7 +197,11 @@ ParameterizationResult run_parameterization(const Polygon& polygon, const Parame
     f.total_sweeps += f.smoothing.sweeps;
     f.quality_optimized = mesh_quality(f.mesh, f.optimized);
     log("adaptive refinement " + std::to_string(it + 1) + ": refined " + std::to_string(marked.size()) +
-        " cells with J_r < " + std::to_string(ad.min_jacobian) + ", now " + std::to_string(f.mesh.num_cells()) +
+        " cells with J_r < " + std::to_string(ad.min_jacobian) +
+        (rec.certification_marked_cells > 0
+             ? " or not certified (" + std::to_string(rec.certification_marked_cells) + " only for that)"
+             : std::string()) +
+        ", now " + std::to_string(f.mesh.num_cells()) +
         " cells, " + std::to_string(f.smoothing.sweeps) + " sweeps, " +
         std::to_string(f.quality_optimized.inverted_cells) + " inverted cells");
     t_refine += seconds_since(t2);
@@ -178,6 +217,7 @@ ParameterizationResult run_parameterization(const Polygon& polygon, const Parame
     r.fit = best->fit;
     r.quality = best->quality;
     r.cell_quality = std::move(best->cells);
+    r.certification = std::move(best->certification);
   }
   r.control_points_optimized = best->control_points_optimized;
   log("adaptive refinement stopped: " + r.stop_reason + "; kept iteration " + std::to_string(best_it));
@@ -185,6 +225,7 @@ ParameterizationResult run_parameterization(const Polygon& polygon, const Parame
   f.times.push_back({"jacobian_check", t_check});
   f.times.push_back({"adaptive_refinement", t_refine});
   f.times.push_back({"control_point_optimization", t_cpo});
+  f.times.push_back({"certification", t_certify});
   return r;
 }
 

@@ -1,6 +1,7 @@
 #include "tspline/io/param_output.h"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <set>
@@ -100,6 +101,19 @@ nlohmann::json map_quality_json(const MapQualityStats& q) {
           {"min_scaled_jacobian", q.min_scaled}};
 }
 
+// Certification counts and bounds (non-finite bounds are written as null).
+nlohmann::json certification_json(const MapCertification& c) {
+  auto finite = [](double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); };
+  return {{"elements", c.elements},
+          {"elements_certified", c.certified},
+          {"elements_invalid", c.invalid},
+          {"elements_undecided", c.undecided},
+          {"min_relative_det_lower_bound", finite(c.min_relative_lower_bound)},
+          {"min_det_lower_bound", finite(c.min_det_lower_bound)},
+          {"max_subdivision_depth", c.max_depth_used},
+          {"seconds", c.seconds}};
+}
+
 }  // namespace
 
 nlohmann::json param_report(const ParameterizationResult& r, const std::string& input_path,
@@ -123,6 +137,12 @@ nlohmann::json param_report(const ParameterizationResult& r, const std::string& 
   rep["tspline"]["control_points_optimized"] = r.control_points_optimized;
   rep["valid"] = r.valid();
   rep["good"] = r.good(ad.min_jacobian);
+  if (ad.certify) {
+    rep["certified_valid"] = r.certified_valid();
+    rep["certification"] = certification_json(r.certification);
+    rep["certification"]["depth_limit"] = ad.certification.max_depth;
+    rep["certification"]["extra_refinement_rounds"] = r.certification_rounds;
+  }
   json its = json::array();
   for (const AdaptIteration& it : r.iterations)
     its.push_back({{"cells", it.cells},
@@ -134,6 +154,11 @@ nlohmann::json param_report(const ParameterizationResult& r, const std::string& 
                    {"control_points_optimized", it.control_points_optimized},
                    {"jacobian", map_quality_json(it.quality)},
                    {"seconds", it.seconds}});
+  if (ad.certify)
+    for (std::size_t k = 0; k < r.iterations.size(); ++k) {
+      its[k]["certification"] = certification_json(r.iterations[k].certification);
+      its[k]["certification"]["cells_marked_only_for_certification"] = r.iterations[k].certification_marked_cells;
+    }
   rep["adaptive"] = {{"max_rounds", ad.max_adapt},
                      {"stall_rounds", ad.stall_rounds},
                      {"max_cells", ad.max_cells},
