@@ -25,6 +25,9 @@ void add_poisson_command(CLI::App& app, CommandAction& action);
 /// file (cmd_check.cpp); exit 3 if the map is not certified valid.
 void add_check_command(CLI::App& app, CommandAction& action);
 
+/// `tspline export --bezier`: Bezier extraction export (cmd_export.cpp).
+void add_export_command(CLI::App& app, CommandAction& action);
+
 /// `tspline render`: PNG pictures of the outputs of param and poisson (cmd_render.cpp).
 void add_render_command(CLI::App& app, CommandAction& action);
 

@@ -196,6 +196,7 @@ int main(int argc, char** argv) {
   tspline_app::add_check_command(app, command);
   tspline_app::add_poisson_command(app, command);
   tspline_app::add_render_command(app, command);
+  tspline_app::add_export_command(app, command);
 
   try {
     app.parse(argc, argv);

@@ -1,0 +1,39 @@
+// `tspline export TSPLINE.json --bezier OUT.json`: Bezier extraction export
+// (docs/bezier_format.md).
+#include <iostream>
+#include <memory>
+
+#include "commands.h"
+#include "tspline/errors.h"
+#include "tspline/io/atomic_file.h"
+#include "tspline/io/bezier_export.h"
+#include "tspline/io/tspline_file.h"
+
+namespace tspline_app {
+
+void add_export_command(CLI::App& app, CommandAction& action) {
+  struct Args {
+    std::string file, bezier;
+    bool quiet = false;
+  };
+  auto a = std::make_shared<Args>();
+  CLI::App* cmd = app.add_subcommand(
+      "export", "Write the T-spline as rational Bezier elements with their extraction operators (Scott et al. "
+                "2011), the interchange form for T-spline IGA in finite element codes (docs/bezier_format.md)");
+  cmd->add_option("TSPLINE", a->file, "T-spline file written by `tspline param`")->required();
+  cmd->add_option("--bezier", a->bezier, "Output JSON file of Bezier elements")->required();
+  cmd->add_flag("--quiet,-q", a->quiet, "Print errors only");
+  cmd->callback([a, &action] {
+    action = [a] {
+      const tspline::io::LoadedTSpline t = tspline::io::read_tspline_file(a->file);
+      const nlohmann::json doc = tspline::io::bezier_document(t.map, a->file);
+      tspline::io::write_text_atomic(a->bezier, doc.dump() + "\n");
+      if (!a->quiet)
+        std::cout << "wrote " << a->bezier << ": " << doc["elements"].size() << " Bezier elements on "
+                  << t.map.mesh().num_cells() << " cells, " << t.map.basis().size() << " functions" << std::endl;
+      return 0;
+    };
+  });
+}
+
+}  // namespace tspline_app
