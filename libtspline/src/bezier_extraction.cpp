@@ -102,21 +102,23 @@ std::vector<BezierElement> extract_cell(const TSplineBasis& basis, int c) {
   return out;
 }
 
-void cell_quadrature(const TSplineBasis& basis, int c, int n, std::vector<QuadraturePoint>& out,
-                     const TSplineBasis* geometry, int g) {
-  std::vector<double> xb, yb;
-  cell_element_breaks(basis, c, xb, yb);
-  if (geometry) {
-    const Eigen::Vector2d lo = basis.mesh().cell_min(c), hi = basis.mesh().cell_max(c);
-    std::vector<double> gx, gy;
-    cell_element_breaks(*geometry, g, gx, gy);
-    for (double x : gx)
-      if (x > lo.x() && x < hi.x()) xb.push_back(x);
-    for (double y : gy)
-      if (y > lo.y() && y < hi.y()) yb.push_back(y);
-    sort_unique(xb);
-    sort_unique(yb);
-  }
+namespace {
+
+/// Adds the breaks of the geometry's cell g strictly inside [lo, hi].
+void add_geometry_breaks(const TSplineBasis& geometry, int g, const Eigen::Vector2d& lo, const Eigen::Vector2d& hi,
+                         std::vector<double>& xb, std::vector<double>& yb) {
+  thread_local std::vector<double> gx, gy;
+  cell_element_breaks(geometry, g, gx, gy);
+  for (double x : gx)
+    if (x > lo.x() && x < hi.x()) xb.push_back(x);
+  for (double y : gy)
+    if (y > lo.y() && y < hi.y()) yb.push_back(y);
+  sort_unique(xb);
+  sort_unique(yb);
+}
+
+void tensor_gauss(const std::vector<double>& xb, const std::vector<double>& yb, int n,
+                  std::vector<QuadraturePoint>& out) {
   thread_local std::vector<double> gp, gw;
   gauss_points_01(n, gp, gw);
   out.clear();
@@ -128,6 +130,25 @@ void cell_quadrature(const TSplineBasis& basis, int c, int n, std::vector<Quadra
         for (std::size_t a = 0; a < gp.size(); ++a)
           out.push_back({{xb[i] + gp[a] * hx, yb[j] + gp[b] * hy}, gw[a] * gw[b] * hx * hy});
     }
+}
+
+}  // namespace
+
+void cell_quadrature(const TSplineBasis& basis, int c, int n, std::vector<QuadraturePoint>& out,
+                     const TSplineBasis* geometry, int g) {
+  std::vector<double> xb, yb;
+  cell_element_breaks(basis, c, xb, yb);
+  if (geometry) add_geometry_breaks(*geometry, g, basis.mesh().cell_min(c), basis.mesh().cell_max(c), xb, yb);
+  tensor_gauss(xb, yb, n, out);
+}
+
+void box_quadrature(const Eigen::Vector2d& lo, const Eigen::Vector2d& hi, int n, std::vector<QuadraturePoint>& out,
+                    const TSplineBasis& geometry, int g) {
+  thread_local std::vector<double> xb, yb;
+  xb.assign({lo.x(), hi.x()});
+  yb.assign({lo.y(), hi.y()});
+  add_geometry_breaks(geometry, g, lo, hi, xb, yb);
+  tensor_gauss(xb, yb, n, out);
 }
 
 BezierExtraction::BezierExtraction(const TSplineBasis& basis) {

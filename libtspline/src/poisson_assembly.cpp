@@ -8,6 +8,7 @@
 #include <span>
 #include <sstream>
 
+#include "tspline/bezier_extraction.h"
 #include "tspline/errors.h"
 #include "tspline/map_quality.h"
 #include "tspline/poisson.h"
@@ -270,35 +271,33 @@ Eigen::SparseMatrix<double> assemble_stiffness(const TSplineMap& map, const Anal
   const int* inner = K.innerIndexPtr();
   double* values = K.valuePtr();
   rhs = Eigen::VectorXd::Zero(ni);
-  std::vector<double> gp, gw;
-  gauss_points_01(4, gp, gw);
+  std::vector<QuadraturePoint> qp;
   BasisValues bv;
   Eigen::MatrixXd G, Kloc;
   Eigen::VectorXd floc;
   for (int c = 0; c < static_cast<int>(mesh.num_cells()); ++c) {
     const Eigen::Vector2d lo = mesh.cell_min(c), hi = mesh.cell_max(c);
-    const Eigen::Vector2d len = hi - lo;
     const std::span<const int> ids = basis.functions_on_cell(c);
     const std::size_t nf = ids.size();
     Kloc.setZero(static_cast<Eigen::Index>(nf), static_cast<Eigen::Index>(nf));
     floc.setZero(static_cast<Eigen::Index>(nf));
     G.resize(2, static_cast<Eigen::Index>(nf));
-    for (std::size_t i = 0; i < gp.size(); ++i)
-      for (std::size_t j = 0; j < gp.size(); ++j) {
-        const Eigen::Vector2d uv(lo.x() + gp[i] * len.x(), lo.y() + gp[j] * len.y());
-        basis.evaluate(c, uv, bv, 1);
-        const MapDerivatives d = map.derivatives(uv, 1, sp.geometry_cell(c));
-        const double w = gw[i] * gw[j] * len.x() * len.y() * std::abs(d.J.determinant());
-        const Eigen::Matrix2d JinvT = d.J.inverse().transpose();
-        for (std::size_t k = 0; k < nf; ++k) {  // physical gradient J^{-T} grad_xi (scalar form)
-          const Eigen::Index col = static_cast<Eigen::Index>(k);
-          G(0, col) = JinvT(0, 0) * bv.R_xi[k] + JinvT(0, 1) * bv.R_eta[k];
-          G(1, col) = JinvT(1, 0) * bv.R_xi[k] + JinvT(1, 1) * bv.R_eta[k];
-        }
-        Kloc.selfadjointView<Eigen::Lower>().rankUpdate(G.transpose(), w);  // Kloc += w G^T G (lower)
-        const double fv = checked(f, "f", d.x.x(), d.x.y());
-        floc.noalias() += (w * fv) * Eigen::Map<const Eigen::VectorXd>(bv.R.data(), static_cast<Eigen::Index>(nf));
+    box_quadrature(lo, hi, 4, qp, map.basis(), sp.geometry_cell(c));
+    for (const QuadraturePoint& q : qp) {
+      const Eigen::Vector2d& uv = q.uv;
+      basis.evaluate(c, uv, bv, 1);
+      const MapDerivatives d = map.derivatives(uv, 1, sp.geometry_cell(c));
+      const double w = q.weight * std::abs(d.J.determinant());
+      const Eigen::Matrix2d JinvT = d.J.inverse().transpose();
+      for (std::size_t k = 0; k < nf; ++k) {  // physical gradient J^{-T} grad_xi (scalar form)
+        const Eigen::Index col = static_cast<Eigen::Index>(k);
+        G(0, col) = JinvT(0, 0) * bv.R_xi[k] + JinvT(0, 1) * bv.R_eta[k];
+        G(1, col) = JinvT(1, 0) * bv.R_xi[k] + JinvT(1, 1) * bv.R_eta[k];
       }
+      Kloc.selfadjointView<Eigen::Lower>().rankUpdate(G.transpose(), w);  // Kloc += w G^T G (lower)
+      const double fv = checked(f, "f", d.x.x(), d.x.y());
+      floc.noalias() += (w * fv) * Eigen::Map<const Eigen::VectorXd>(bv.R.data(), static_cast<Eigen::Index>(nf));
+    }
     // ids ascending => interior DOF numbers ascending, like the rows of a column.
     for (std::size_t s = 0; s < nf; ++s) {
       const int js = dof[ids[s]];

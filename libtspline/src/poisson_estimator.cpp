@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cmath>
 
+#include "tspline/bezier_extraction.h"
 #include "tspline/errors.h"
 #include "tspline/map_quality.h"
 #include "tspline/poisson.h"
@@ -27,25 +28,22 @@ Eigen::Vector2d exact_gradient(const PoissonProblem& p, double x, double y) {
 PoissonErrors compute_errors(const TSplineMap& map, const PoissonSolution& sol, const PoissonProblem& problem) {
   if (!problem.exact) throw InputError("Poisson errors: no exact solution given");
   const TMesh& mesh = sol.space->mesh();
-  std::vector<double> gp, gw;
-  gauss_points_01(6, gp, gw);
+  std::vector<QuadraturePoint> qp;
   PoissonErrors e;
   double l2 = 0, h1 = 0, l2u = 0, h1u = 0;
   for (int c = 0; c < static_cast<int>(mesh.num_cells()); ++c) {
-    const Eigen::Vector2d lo = mesh.cell_min(c), len = mesh.cell_max(c) - lo;
-    for (std::size_t i = 0; i < gp.size(); ++i)
-      for (std::size_t j = 0; j < gp.size(); ++j) {
-        const Eigen::Vector2d uv(lo.x() + gp[i] * len.x(), lo.y() + gp[j] * len.y());
-        const SolutionValue v = evaluate_solution(map, sol, c, uv, 1);
-        const double w = gw[i] * gw[j] * len.x() * len.y() * std::abs(v.det_j);
-        const double ue = problem.exact(v.x.x(), v.x.y());
-        const Eigen::Vector2d ge = exact_gradient(problem, v.x.x(), v.x.y());
-        l2 += w * (ue - v.u) * (ue - v.u);
-        h1 += w * (ge - v.grad).squaredNorm();
-        l2u += w * ue * ue;
-        h1u += w * ge.squaredNorm();
-        e.max_abs_at_qp = std::max(e.max_abs_at_qp, std::abs(ue - v.u));
-      }
+    box_quadrature(mesh.cell_min(c), mesh.cell_max(c), 6, qp, map.basis(), sol.space->geometry_cell(c));
+    for (const QuadraturePoint& q : qp) {
+      const SolutionValue v = evaluate_solution(map, sol, c, q.uv, 1);
+      const double w = q.weight * std::abs(v.det_j);
+      const double ue = problem.exact(v.x.x(), v.x.y());
+      const Eigen::Vector2d ge = exact_gradient(problem, v.x.x(), v.x.y());
+      l2 += w * (ue - v.u) * (ue - v.u);
+      h1 += w * (ge - v.grad).squaredNorm();
+      l2u += w * ue * ue;
+      h1u += w * ge.squaredNorm();
+      e.max_abs_at_qp = std::max(e.max_abs_at_qp, std::abs(ue - v.u));
+    }
   }
   e.l2 = std::sqrt(l2);
   e.h1 = std::sqrt(h1);
@@ -57,12 +55,11 @@ PoissonErrors compute_errors(const TSplineMap& map, const PoissonSolution& sol, 
 std::vector<double> estimate_cells(const TSplineMap& map, const PoissonSolution& sol, const PoissonProblem& problem,
                                    std::vector<double>* eta_scale) {
   const TMesh& mesh = sol.space->mesh();
-  std::vector<double> gp, gw;
-  gauss_points_01(4, gp, gw);
+  std::vector<QuadraturePoint> qp;
   std::vector<double> eta(mesh.num_cells(), 0.0);
   if (eta_scale) eta_scale->assign(mesh.num_cells(), 0.0);
   for (int c = 0; c < static_cast<int>(mesh.num_cells()); ++c) {
-    const Eigen::Vector2d lo = mesh.cell_min(c), hi = mesh.cell_max(c), len = hi - lo;
+    const Eigen::Vector2d lo = mesh.cell_min(c), hi = mesh.cell_max(c);
     const int g = sol.space->geometry_cell(c);
     // h_e: the longer diagonal of the image of the cell's corners.
     const Eigen::Vector2d p00 = map.derivatives(lo, 0, g).x, p11 = map.derivatives(hi, 0, g).x;
@@ -70,16 +67,15 @@ std::vector<double> estimate_cells(const TSplineMap& map, const PoissonSolution&
     const Eigen::Vector2d p01 = map.derivatives({lo.x(), hi.y()}, 0, g).x;
     const double h = std::max((p11 - p00).norm(), (p01 - p10).norm());
     double s = 0, scale = 0;
-    for (std::size_t i = 0; i < gp.size(); ++i)
-      for (std::size_t j = 0; j < gp.size(); ++j) {
-        const Eigen::Vector2d uv(lo.x() + gp[i] * len.x(), lo.y() + gp[j] * len.y());
-        const SolutionValue v = evaluate_solution(map, sol, c, uv, 2);
-        const double w = gw[i] * gw[j] * len.x() * len.y() * std::abs(v.det_j);
-        const double fv = problem.f(v.x.x(), v.x.y()), lap = v.hessian.trace();
-        const double r = fv + lap;
-        s += w * r * r;
-        scale += w * (fv * fv + lap * lap);
-      }
+    box_quadrature(lo, hi, 4, qp, map.basis(), g);
+    for (const QuadraturePoint& q : qp) {
+      const SolutionValue v = evaluate_solution(map, sol, c, q.uv, 2);
+      const double w = q.weight * std::abs(v.det_j);
+      const double fv = problem.f(v.x.x(), v.x.y()), lap = v.hessian.trace();
+      const double r = fv + lap;
+      s += w * r * r;
+      scale += w * (fv * fv + lap * lap);
+    }
     eta[c] = h * std::sqrt(s);
     if (eta_scale) (*eta_scale)[c] = h * std::sqrt(scale);
   }

@@ -84,6 +84,13 @@ struct QuadraturePoint {
 void cell_quadrature(const TSplineBasis& basis, int c, int n, std::vector<QuadraturePoint>& out,
                      const TSplineBasis* geometry = nullptr, int g = -1);
 
+/// n x n Gauss points on the box [lo, hi] (a cell of an analysis space that is
+/// polynomial on it, e.g. hierarchical B-splines) split by the knot lines of the
+/// geometry's functions on its cell g (which contains the box) that cross it,
+/// so that the geometry map is smooth on every piece.
+void box_quadrature(const Eigen::Vector2d& lo, const Eigen::Vector2d& hi, int n, std::vector<QuadraturePoint>& out,
+                    const TSplineBasis& geometry, int g);
+
 /// Values of the four cubic Bernstein polynomials at s.
 std::array<double, 4> bernstein3(double s);
 

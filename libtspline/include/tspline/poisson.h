@@ -19,7 +19,11 @@
 //
 // Discretization (Galerkin):
 //  * stiffness K_ab = int grad R_a . grad R_b dx, load b_a = int f R_a dx, both with
-//    4x4 Gauss points per analysis cell; grad_x R = J^{-T} grad_xi R, weight |det J|.
+//    4x4 Gauss points per piece of each analysis cell: the cell split by the knot
+//    lines of the geometry's functions that cross it (box_quadrature() in
+//    bezier_extraction.h), so that S is smooth on every piece; the analysis
+//    functions are polynomial on the whole cell. grad_x R = J^{-T} grad_xi R,
+//    weight |det J|.
 //  * Dirichlet data by L2 PROJECTION on the border: the boundary functions B are
 //    those that do not vanish on the border of [0,1]^2 (HierarchicalFunction::
 //    on_border); their coefficients solve  sum_{b in B} c_b <R_b, R_a> = <g o S, R_a>,
@@ -33,11 +37,11 @@
 //    with an incomplete Cholesky preconditioner.
 //
 // Errors (when an exact solution is given): L2 and H1-seminorm, 6x6 Gauss points per
-// analysis cell. If the exact gradient is not given it is computed by central
+// piece of each analysis cell (as above). If the exact gradient is not given it is computed by central
 // differences with the absolute step kGradientStep (error ~ step^2 |u'''|/6 plus
 // round-off ~ eps |u| / step).
 //
-// Estimator: eta_e^2 = int_{S(e)} h_e^2 (f + Laplace u_h)^2 dx (4x4 Gauss points),
+// Estimator: eta_e^2 = int_{S(e)} h_e^2 (f + Laplace u_h)^2 dx (4x4 Gauss points per piece),
 // h_e = physical cell diameter, taken as the longer of the two diagonals of the
 // image of the cell's corners, |S(c00) - S(c11)| and |S(c10) - S(c01)|.
 // Laplace u_h uses the physical Hessian (see physical_hessian()).
