@@ -138,7 +138,7 @@ TEST_CASE("surface objective: gradient and full chain-rule Hessian through phi m
     std::vector<Vector3d> ring;
     for (int i = 0; i < 6; ++i)
       ring.push_back(surf.value(c + r * Vector2d(std::cos(kPi * i / 3 + 0.2 * U(rng)), std::sin(kPi * i / 3))));
-    const Vector3d n = unit_normal(surf.evaluate(c, 1));
+    const Vector3d n = 2.0 * unit_normal(surf.evaluate(c, 1));
     for (int i = 0; i < 6; ++i) {
       SurfaceTerm t;
       t.xa = ring[i];
@@ -189,6 +189,7 @@ TEST_CASE("surface objective: on the plane (phi = identity) it is the planar obj
     s.xb = Vector3d(pos[t.b].x(), pos[t.b].y(), 0);
     s.ideal_inv = t.ideal_inv;
     s.weight = t.weight;
+    s.normal = 2.0 * Vector3d::UnitZ();
     terms.push_back(s);
   }
   for (double delta : {0.0, 0.02}) {

@@ -5,12 +5,11 @@
 // Free vertex x, fixed x1, x2:  a = x1 - x, b = x2 - x,  K = W^{-1} W^{-T}.
 //   f = K00 a.a + 2 K01 a.b + K11 b.b
 //   grad f = -2 ((K00 + K01) a + (K01 + K11) b),   Hess f = 2 (K00 + 2 K01 + K11) I.
-//   c = a x b = c(x) affine: c(x + v) = c + v x e,  e = x1 - x2,  i.e. Dc = -[e]x.
-//   |c|: grad = e x c^,  Hess = -[e]x (I - c^ c^T) [e]x / |c|   (c^ = c / |c|).
-//   sigma = gamma det(W^{-1}) |c| (gamma piecewise constant).
+//   c = a x b = c(x) affine: c(x + v) = c + v x e,  e = x1 - x2.
+//   sigma_p = det(W^{-1}) c.n^:  grad = det(W^{-1}) e x n^,  Hess = 0.
 // For eta(f, sigma):
 //   grad eta = eta_f grad f + eta_s grad sigma,
-//   Hess eta = eta_f Hess f + eta_s Hess sigma + eta_fs (grad f gs^T + gs grad f^T) + eta_ss gs gs^T.
+//   Hess eta = eta_f Hess f + eta_fs (grad f gs^T + gs grad f^T) + eta_ss gs gs^T.
 #include "meshopt/surface_measure.h"
 
 #include <Eigen/Geometry>  // cross()
@@ -23,12 +22,6 @@ namespace meshopt {
 namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
-
-Eigen::Matrix3d cross_matrix(const Eigen::Vector3d& e) {
-  Eigen::Matrix3d m;
-  m << 0.0, -e.z(), e.y(), e.z(), 0.0, -e.x(), -e.y(), e.x(), 0.0;
-  return m;
-}
 
 double gamma_of(const Eigen::Vector3d& c, const Eigen::Vector3d& n) { return c.dot(n) < 0.0 ? -1.0 : 1.0; }
 
@@ -87,13 +80,13 @@ DistortionValue distortion(SurfaceMeasure measure, double f, double sigma, doubl
 
 TriangleInvariants triangle_invariants(const Eigen::Vector3d& x0, const Eigen::Vector3d& x1,
                                        const Eigen::Vector3d& x2, const Eigen::Matrix2d& ideal_inv,
-                                       const Eigen::Vector3d& n) {
+                                       const Eigen::Vector3d& n, bool projected) {
   const Eigen::Vector3d a = x1 - x0, b = x2 - x0;
   const Eigen::Matrix2d K = ideal_inv * ideal_inv.transpose();
   const Eigen::Vector3d c = a.cross(b);
   TriangleInvariants t;
   t.f = K(0, 0) * a.squaredNorm() + 2.0 * K(0, 1) * a.dot(b) + K(1, 1) * b.squaredNorm();
-  t.sigma = gamma_of(c, n) * c.norm() * ideal_inv.determinant();
+  t.sigma = (projected ? c.dot(n) / n.norm() : gamma_of(c, n) * c.norm()) * ideal_inv.determinant();
   return t;
 }
 
@@ -112,33 +105,20 @@ DistortionInX restricted_distortion(SurfaceMeasure measure, const Eigen::Vector3
   const Eigen::Vector3d a = x1 - x, b = x2 - x, e = x1 - x2;
   const Eigen::Matrix2d K = ideal_inv * ideal_inv.transpose();
   const double f = K(0, 0) * a.squaredNorm() + 2.0 * K(0, 1) * a.dot(b) + K(1, 1) * b.squaredNorm();
-  const Eigen::Vector3d c = a.cross(b);
-  const double cn = c.norm();
-  const double gdet = gamma_of(c, n) * ideal_inv.determinant();
-  out.sigma = gdet * cn;
+  const double nn = n.norm();
+  const Eigen::Vector3d nh = nn > 0.0 ? Eigen::Vector3d(n / nn) : Eigen::Vector3d::UnitZ();
+  const double detw = ideal_inv.determinant();
+  out.sigma = detw * a.cross(b).dot(nh);
   const DistortionValue eta = distortion(measure, f, out.sigma, delta);
   out.value = eta.value;
   if (!std::isfinite(eta.value)) return out;
 
   const Eigen::Vector3d grad_f = -2.0 * ((K(0, 0) + K(0, 1)) * a + (K(0, 1) + K(1, 1)) * b);
   const double hess_f = 2.0 * (K(0, 0) + 2.0 * K(0, 1) + K(1, 1));
-  Eigen::Vector3d grad_s;
-  Eigen::Matrix3d hess_s = Eigen::Matrix3d::Zero();
-  if (cn > 0.0) {
-    const Eigen::Vector3d ch = c / cn;
-    const Eigen::Matrix3d E = cross_matrix(e);
-    grad_s = gdet * e.cross(ch);
-    hess_s = -gdet / cn * (E * (Eigen::Matrix3d::Identity() - ch * ch.transpose()) * E);
-  } else {
-    // Flat triangle: the one-sided limit along the reference normal (sigma = c.n^).
-    const double nn = n.norm();
-    const Eigen::Vector3d nh = nn > 0.0 ? Eigen::Vector3d(n / nn) : Eigen::Vector3d::UnitZ();
-    grad_s = gdet * e.cross(nh);
-  }
+  const Eigen::Vector3d grad_s = detw * e.cross(nh);  // sigma_p is affine: Hess sigma = 0
   out.gradient = eta.d_f * grad_f + eta.d_s * grad_s;
   const Eigen::Matrix3d cross_fs = grad_f * grad_s.transpose();
-  out.hessian = eta.d_f * hess_f * Eigen::Matrix3d::Identity() + eta.d_s * hess_s +
-                eta.d_fs * (cross_fs + cross_fs.transpose()) + eta.d_ss * grad_s * grad_s.transpose();
+  out.hessian = eta.d_f * hess_f * Eigen::Matrix3d::Identity() + eta.d_fs * (cross_fs + cross_fs.transpose()) + eta.d_ss * grad_s * grad_s.transpose();
   return out;
 }
 

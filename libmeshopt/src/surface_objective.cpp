@@ -14,7 +14,7 @@ double surface_min_sigma(const Eigen::Vector3d& x, std::span<const SurfaceTerm> 
   double m = kInf;
   for (const SurfaceTerm& t : terms) {
     // f is irrelevant here; triangle_invariants computes both cheaply.
-    const double s = triangle_invariants(x, t.xa, t.xb, t.ideal_inv, t.normal).sigma;
+    const double s = triangle_invariants(x, t.xa, t.xb, t.ideal_inv, t.normal, true).sigma;
     if (s < m || std::isnan(s)) m = s;
   }
   return m;
@@ -26,7 +26,7 @@ double surface_objective_value(const Eigen::Vector2d& u, const ParametricSurface
   const Eigen::Vector3d x = surface.value(u);
   double value = 0.0;
   for (const SurfaceTerm& t : terms) {
-    const TriangleInvariants inv = triangle_invariants(x, t.xa, t.xb, t.ideal_inv, t.normal);
+    const TriangleInvariants inv = triangle_invariants(x, t.xa, t.xb, t.ideal_inv, t.normal, true);
     const double eta = distortion(measure, inv.f, inv.sigma, delta).value;
     if (!std::isfinite(eta)) return kInf;
     value += t.weight * eta;

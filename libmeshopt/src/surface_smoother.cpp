@@ -22,14 +22,20 @@ struct SurfaceNodeObjective {
   const ParametricSurface& surface;
   std::span<const SurfaceTerm> terms;
   SurfaceMeasure measure;
+  // A submesh whose smallest sigma is positive but numerically flat (below 1e-10 of
+  // the mean |sigma|, e.g. a free node on a straight boundary between two fixed ones)
+  // counts as sigma* = 0: the regularized measure (delta > 0) then moves it, where
+  // Newton on the barrier 1/sigma would only multiply sigma by 1.5 per step.
   double min_sigma(const Eigen::Vector2d& u) const {
     if (!surface.contains(u)) return -kInf;
-    return surface_min_sigma(surface.value(u), terms);
+    const double m = surface_min_sigma(surface.value(u), terms);
+    return m > 0.0 && m < 1e-10 * mean_abs_sigma(u) ? 0.0 : m;
   }
   double mean_abs_sigma(const Eigen::Vector2d& u) const {
     const Eigen::Vector3d x = surface.value(u);
     double s = 0.0;
-    for (const SurfaceTerm& t : terms) s += std::abs(triangle_invariants(x, t.xa, t.xb, t.ideal_inv, t.normal).sigma);
+    for (const SurfaceTerm& t : terms)
+      s += std::abs(triangle_invariants(x, t.xa, t.xb, t.ideal_inv, t.normal, true).sigma);
     return s / static_cast<double>(terms.size());
   }
   ObjectiveValue full(const Eigen::Vector2d& u, double delta) const {
@@ -78,7 +84,7 @@ double build_terms(const SurfaceMesh& m, const std::vector<Corner>& corners, con
       t.xb = m.x[el.v[lb]];
       t.ideal_inv = ideal_inverse(ct.ideal[j], ct.ideal[(j + 1) % 3], ct.ideal[(j + 2) % 3]);
       const std::size_t base = 4 * static_cast<std::size_t>(c.element);
-      t.normal = normals[base + c.local] + normals[base + la] + normals[base + lb];
+      t.normal = (normals[base + c.local] + normals[base + la] + normals[base + lb]).normalized();
       t.weight = ct.weight;
       terms.push_back(t);
     }
@@ -149,9 +155,14 @@ SurfaceSmoothingReport smooth_surface(SurfaceMesh& m, const SurfaceSmoothingOpti
                                            .eigenvalues()
                                            .maxCoeff());
       if (!(stretch > 0.0) || !std::isfinite(stretch)) continue;
-      const Eigen::Vector2d un =
-          detail::newton_descent(m.u[i], SurfaceNodeObjective{surface, terms, opt.measure}, opt.newton,
-                                 max_edge / stretch, cnt);
+      const SurfaceNodeObjective obj{surface, terms, opt.measure};
+      Eigen::Vector2d un = detail::newton_descent(m.u[i], obj, opt.newton, max_edge / stretch, cnt);
+      // Nonlinear over-relaxation (as in smooth()): taken only if the submesh stays
+      // valid and the node inside its face there.
+      if (opt.newton.over_relaxation != 1.0) {
+        const Eigen::Vector2d ur = m.u[i] + opt.newton.over_relaxation * (un - m.u[i]);
+        if (obj.min_sigma(un) > 0.0 && obj.min_sigma(ur) > 0.0) un = ur;
+      }
       if (un == m.u[i]) continue;
       const SurfacePoint q = surface.evaluate(un, 1);
       const Eigen::Vector3d n = unit_normal(q);

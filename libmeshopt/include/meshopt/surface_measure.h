@@ -16,6 +16,19 @@
 // with h = sigma_delta of Eq. 28 (h = sigma for delta = 0) and
 //   mu*(s) = e/2 (s e^{-s} + s^{-1} e^{-1/s})               (Eq. 31).
 // The quality is q = 1 / eta in [0, 1] (0 for tangled or flat triangles).
+//
+// The optimizer (restricted_distortion) uses sigma_p = (c . n^) det W^{-1},
+// c = (x1 - x0) x (x2 - x0), the area of the triangle projected on the plane
+// normal to a unit vector n^ fixed during a node's visit (the mean surface normal
+// of the triangle's corners), instead of gamma |c|: our choice, not the paper's.
+// gamma |c| jumps from -|c| to +|c| where a triangle turns through perpendicular to
+// n (|c| > 0 there on a curved surface), so the objective drops towards a wall and
+// nodes jam against it (tested: random untangling on a revolution surface stopped
+// at a valid min quality 0.07; a cylinder notch stayed tangled). sigma_p is affine
+// in the free vertex, vanishes on perpendicular triangles, and equals gamma |c|
+// (up to a factor cos(angle to n^) = 1 - O((h kappa)^2)) on a smooth surface; it is
+// as independent of the parameterization as the normal is. Reported qualities
+// (triangle_quality, element_qualities) use the paper's gamma |c|.
 #include <Eigen/Core>
 
 namespace meshopt {
@@ -44,21 +57,23 @@ MuStar mu_star(double s);
 DistortionValue distortion(SurfaceMeasure measure, double f, double sigma, double delta);
 
 /// f = |S|^2 and sigma = det S of the triangle (x0, x1, x2) with W^{-1} = ideal_inv,
-/// oriented by the normal n (need not be unit; sigma >= 0 if n == 0).
+/// oriented by the normal n (need not be unit; sigma >= 0 if n == 0); with
+/// `projected`, sigma_p of the projection on the plane normal to n (n != 0).
 struct TriangleInvariants {
   double f = 0.0;
   double sigma = 0.0;
 };
 TriangleInvariants triangle_invariants(const Eigen::Vector3d& x0, const Eigen::Vector3d& x1,
                                        const Eigen::Vector3d& x2, const Eigen::Matrix2d& ideal_inv,
-                                       const Eigen::Vector3d& n);
+                                       const Eigen::Vector3d& n, bool projected = false);
 
 /// Quality 1 / eta (delta = 0) of the triangle; 0 if sigma <= 0 (tangled or flat).
 double triangle_quality(SurfaceMeasure measure, const Eigen::Vector3d& x0, const Eigen::Vector3d& x1,
                         const Eigen::Vector3d& x2, const Eigen::Matrix2d& ideal_inv, const Eigen::Vector3d& n);
 
 /// The restricted distortion of the triangle (x, x1, x2) as a function of its free
-/// vertex x in R^3 (Remark 4): value, gradient and Hessian with respect to x.
+/// vertex x in R^3 (Remark 4) with sigma = sigma_p (projected on the plane normal
+/// to n != 0): value, gradient and Hessian with respect to x.
 /// value = +infinity if delta == 0 and sigma <= 0.
 struct DistortionInX {
   double value = 0.0;

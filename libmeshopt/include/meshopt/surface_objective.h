@@ -21,11 +21,14 @@ struct SurfaceTerm {
   Eigen::Vector3d xa = Eigen::Vector3d::Zero();
   Eigen::Vector3d xb = Eigen::Vector3d::Zero();
   Eigen::Matrix2d ideal_inv = Eigen::Matrix2d::Identity();
-  Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();  ///< orients the triangle (Sect. 3.2)
+  /// Unit vector orienting the triangle: the normalized sum of the unit surface
+  /// normals at its three corners at the start of the visit (Sect. 3.2; sigma_p of
+  /// surface_measure.h is the area projected on the plane normal to it).
+  Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();
   double weight = 1.0;
 };
 
-/// Smallest sigma over the terms with the free node at phi(u).
+/// Smallest sigma (sigma_p) over the terms with the free node at x.
 double surface_min_sigma(const Eigen::Vector3d& x, std::span<const SurfaceTerm> terms);
 
 /// Value only; +infinity if u is outside the surface's domain or (delta == 0) some sigma <= 0.

@@ -29,8 +29,8 @@ struct SurfaceSmoothingOptions {
   int max_sweeps = 1000;
   double tol_x = 1e-3;  ///< largest node move / largest edge of its submesh
   double tol_f = 1e-3;  ///< |F_k - F_{k+1}| / F_{k+1}
-  /// Newton/Armijo/delta settings (alpha, armijo_c, max_backtracks) and the
-  /// Newton steps per node visit (1: the paper's one damped step per sweep).
+  /// Newton/Armijo/delta settings (alpha, armijo_c, max_backtracks, over_relaxation)
+  /// and the damped Newton steps per node visit (1: the paper's one step per sweep).
   SmoothingOptions newton = [] {
     SmoothingOptions o;
     o.newton_iterations_per_visit = 1;
