@@ -73,11 +73,11 @@ struct AppRun {
   std::string out, err;
 };
 
-/// Runs `tspline ARGS` with stdout and stderr captured in files of `dir`.
-inline AppRun run_app(const std::string& args, const std::filesystem::path& dir) {
+/// Runs `tspline ARGS` (or another built program) with stdout and stderr captured in files of `dir`.
+inline AppRun run_app(const std::string& args, const std::filesystem::path& dir,
+                      const std::string& program = TSPLINE_APP_PATH) {
   const std::filesystem::path out = dir / "stdout.txt", err = dir / "stderr.txt";
-  const std::string cmd =
-      std::string("'") + TSPLINE_APP_PATH + "' " + args + " >'" + out.string() + "' 2>'" + err.string() + "'";
+  const std::string cmd = std::string("'") + program + "' " + args + " >'" + out.string() + "' 2>'" + err.string() + "'";
   const int status = std::system(cmd.c_str());
   AppRun r;
   r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;

@@ -2,6 +2,7 @@
 #include "meshopt/surface.h"
 
 #include <Eigen/Geometry>  // cross()
+#include <algorithm>
 #include <cmath>
 
 namespace meshopt {
@@ -10,7 +11,8 @@ Eigen::Vector3d unit_normal(const SurfacePoint& p) {
   const Eigen::Vector3d pu = p.d.col(0), pv = p.d.col(1);
   const Eigen::Vector3d n = pu.cross(pv);
   const double nn = n.norm();
-  if (!std::isfinite(nn) || !(nn > 1e-14 * pu.norm() * pv.norm()) || nn == 0.0) return Eigen::Vector3d::Zero();
+  const double scale = std::max(pu.squaredNorm(), pv.squaredNorm());
+  if (!std::isfinite(nn) || !(nn > 1e-12 * scale)) return Eigen::Vector3d::Zero();
   return n / nn;
 }
 

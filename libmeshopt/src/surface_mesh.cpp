@@ -55,16 +55,18 @@ void validate_surface_mesh(const SurfaceMesh& m) {
       fail("node " + std::to_string(i) + " refers to face " + std::to_string(f) + " which does not exist");
     if (f < 0) continue;
     const ParametricSurface& s = *m.faces[f];
-    if (!m.u[i].allFinite() || !s.contains(m.u[i]))
-      fail("node " + std::to_string(i) + " at u = " + uv_string(m.u[i]) + " is outside the parameter range of face " +
-           std::to_string(f));
+    if (!m.u[i].allFinite())
+      fail("node " + std::to_string(i) + " has non-finite parametric coordinates");
     const SurfacePoint p = s.evaluate(m.u[i], 1);
-    const double scale = std::max({1.0, p.x.norm(), m.x[i].norm()});
-    if (!((p.x - m.x[i]).norm() <= 1e-6 * scale))
-      fail("node " + std::to_string(i) + ": phi(u) of face " + std::to_string(f) + " is not the node's position");
     if (unit_normal(p).isZero())
       fail("node " + std::to_string(i) + " lies at a degenerate point of face " + std::to_string(f) + " (u = " +
            uv_string(m.u[i]) + ", phi_u x phi_v = 0)");
+    if (!s.contains(m.u[i]))
+      fail("node " + std::to_string(i) + " at u = " + uv_string(m.u[i]) + " is outside the parameter range of face " +
+           std::to_string(f));
+    const double scale = std::max({1.0, p.x.norm(), m.x[i].norm()});
+    if (!((p.x - m.x[i]).norm() <= 1e-6 * scale))
+      fail("node " + std::to_string(i) + ": phi(u) of face " + std::to_string(f) + " is not the node's position");
   }
   for (std::size_t e = 0; e < m.elements.size(); ++e) {
     const SurfaceElement& el = m.elements[e];
@@ -90,7 +92,9 @@ std::vector<Eigen::Vector3d> corner_normals(const SurfaceMesh& m) {
     for (int i = 0; i < el.nv; ++i) {
       const Eigen::Vector2d& uv = corner_uv_of(m, e, i);
       const Eigen::Vector3d n = unit_normal(m.faces[el.face]->evaluate(uv, 1));
-      if (n.isZero())
+      // A fixed node may sit at a degenerate point (a sphere's pole is a CAD
+      // vertex): its corner then does not take part in orienting the element.
+      if (n.isZero() && m.free_face[el.v[i]] >= 0)
         fail("element " + std::to_string(e) + ", node " + std::to_string(el.v[i]) +
              ": degenerate surface point (phi_u x phi_v = 0) at u = " + uv_string(uv) + " on face " +
              std::to_string(el.face));

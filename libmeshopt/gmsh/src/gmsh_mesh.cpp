@@ -162,12 +162,12 @@ GmshSurfaceMesh read_surface_mesh() {
       // The checks of validate_surface_mesh, named with Gmsh tags.
       const std::string where =
           cat("node ", inner_tags[i], " of surface ", tag, " at (u, v) = (", m.u[n].x(), ", ", m.u[n].y(), ")");
+      const SurfacePoint p = face.evaluate(m.u[n], 1);
+      if (unit_normal(p).isZero())
+        throw InputError(cat(where, " lies at a degenerate point of the surface (phi_u x phi_v = 0)"));
       if (!face.contains(m.u[n]))
         throw InputError(cat(where, " is outside the surface's parameter range [", face.lower().x(), ", ",
                              face.upper().x(), "] x [", face.lower().y(), ", ", face.upper().y(), "]"));
-      const SurfacePoint p = face.evaluate(m.u[n], 1);
-      if (unit_normal(p).isZero())
-        throw InputError(where + " lies at a degenerate point of the surface (phi_u x phi_v = 0)");
       const double scale = std::max(1.0, p.x.norm());
       if (!((p.x - m.x[n]).norm() <= 1e-6 * scale))
         throw InputError(cat(where, ": the surface at these parametric coordinates is ", (p.x - m.x[n]).norm(),

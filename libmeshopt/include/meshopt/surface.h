@@ -33,7 +33,8 @@ class ParametricSurface {
 };
 
 /// Unit normal phi_u x phi_v / |phi_u x phi_v|; zero vector where the surface is
-/// degenerate (|phi_u x phi_v| <= 1e-14 |phi_u| |phi_v|, or not finite).
+/// degenerate: |phi_u x phi_v| <= 1e-12 max(|phi_u|, |phi_v|)^2 (a pole, where one
+/// derivative vanishes, or parallel derivatives), or not finite.
 Eigen::Vector3d unit_normal(const SurfacePoint& p);
 
 /// The plane z = 0 with phi(u, v) = (u, v, 0) (the planar case of the same
