@@ -61,7 +61,7 @@ void validate_surface_mesh(const SurfaceMesh& m) {
     if (unit_normal(p).isZero())
       fail("node " + std::to_string(i) + " lies at a degenerate point of face " + std::to_string(f) + " (u = " +
            uv_string(m.u[i]) + ", phi_u x phi_v = 0)");
-    if (!s.contains(m.u[i]))
+    if (!s.contains_exactly(m.u[i]))
       fail("node " + std::to_string(i) + " at u = " + uv_string(m.u[i]) + " is outside the parameter range of face " +
            std::to_string(f));
     const double scale = std::max({1.0, p.x.norm(), m.x[i].norm()});

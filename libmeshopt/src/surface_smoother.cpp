@@ -163,7 +163,7 @@ SurfaceSmoothingReport smooth_surface(SurfaceMesh& m, const SurfaceSmoothingOpti
         const Eigen::Vector2d ur = m.u[i] + opt.newton.over_relaxation * (un - m.u[i]);
         if (obj.min_sigma(un) > 0.0 && obj.min_sigma(ur) > 0.0) un = ur;
       }
-      if (un == m.u[i]) continue;
+      if (un == m.u[i] || !surface.contains_exactly(un)) continue;
       const SurfacePoint q = surface.evaluate(un, 1);
       const Eigen::Vector3d n = unit_normal(q);
       if (n.isZero()) continue;  // never move a node onto a degenerate point

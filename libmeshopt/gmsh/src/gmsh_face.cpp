@@ -53,8 +53,11 @@ SurfacePoint GmshFace::evaluate(const Eigen::Vector2d& u, int order) const {
 }
 
 bool GmshFace::contains(const Eigen::Vector2d& u) const {
-  if (!((u.array() >= lo_.array()).all() && (u.array() <= hi_.array()).all())) return false;
-  return !use_is_inside_ || gmsh::model::isInside(2, tag_, {u.x(), u.y()}) > 0;
+  return (u.array() >= lo_.array()).all() && (u.array() <= hi_.array()).all();
+}
+
+bool GmshFace::contains_exactly(const Eigen::Vector2d& u) const {
+  return contains(u) && (!use_is_inside_ || gmsh::model::isInside(2, tag_, {u.x(), u.y()}) > 0);
 }
 
 }  // namespace meshopt::gmsh_io

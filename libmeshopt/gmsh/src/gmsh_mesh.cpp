@@ -165,7 +165,7 @@ GmshSurfaceMesh read_surface_mesh() {
       const SurfacePoint p = face.evaluate(m.u[n], 1);
       if (unit_normal(p).isZero())
         throw InputError(cat(where, " lies at a degenerate point of the surface (phi_u x phi_v = 0)"));
-      if (!face.contains(m.u[n]))
+      if (!face.contains_exactly(m.u[n]))
         throw InputError(cat(where, " is outside the surface's parameter range [", face.lower().x(), ", ",
                              face.upper().x(), "] x [", face.lower().y(), ", ", face.upper().y(), "]"));
       const double scale = std::max(1.0, p.x.norm());

@@ -29,7 +29,11 @@ class ParametricSurface {
   /// phi(u) with derivatives up to `order` (1: x and d; 2: also duu, duv, dvv).
   virtual SurfacePoint evaluate(const Eigen::Vector2d& u, int order) const = 0;
   /// True iff u lies in the parametric domain U (nodes must stay inside it).
+  /// Called at every line-search point: keep it cheap (e.g. a bounding box).
   virtual bool contains(const Eigen::Vector2d& u) const = 0;
+  /// The exact domain test where it is costly (a trimmed CAD face), called once
+  /// per accepted move and on input; defaults to contains().
+  virtual bool contains_exactly(const Eigen::Vector2d& u) const { return contains(u); }
 };
 
 /// Unit normal phi_u x phi_v / |phi_u x phi_v|; zero vector where the surface is
