@@ -1,6 +1,13 @@
 // Distortion measures of 3D triangles (Gargallo-Peiro Sects. 3.2, 4.4) and their
 // derivatives with respect to the free vertex (our derivation; the printed
-// Appendix C differentiates T explicitly and has errata, here T is never formed).
+// Appendix C differentiates T explicitly and has errata, here T is never formed:
+// f and sigma are invariant under the rigid map). Errata noted in Appendix C:
+// d2 sigma_delta / da db lacks the term h'(sigma) d2 sigma / da db (sigma is not
+// affine in u through phi); d2 gamma / da db repeats dD/da d(1/|D|)/db instead of
+// the symmetric pair (and gamma = +-1 has zero derivatives anyway); the formula
+// labelled d2 D / da db is that of d2 e~_{2,0} / da db. Eq. 38 of Appendix B
+// should read delta = |sigma*| sqrt(alpha^2 + alpha) (triangle_measure.h).
+// All our derivatives are checked against central differences in the tests.
 //
 // Free vertex x, fixed x1, x2:  a = x1 - x, b = x2 - x,  K = W^{-1} W^{-T}.
 //   f = K00 a.a + 2 K01 a.b + K11 b.b
