@@ -22,7 +22,6 @@ using namespace meshopt;
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
-constexpr double kAmplitude = 0.5;  // of Sigma_2 (see its test case)
 
 template <class T>
 T eps(T u, T v) {
@@ -99,18 +98,17 @@ TEST_CASE("surface smoothing: Sigma_1 with phi^1 and phi^2 gives the same mesh, 
 }
 
 TEST_CASE("surface smoothing: Sigma_2 quads with phi^1 and phi^2 give the same mesh") {
-  // Sect. 5.1: 25 x 25 nodes, 576 quads on z = A sin(pi u) cos(pi v), two poor
-  // parameterizations. With the printed amplitude A = 1 the fixed boundary
-  // (uniform in u, v) leaves boundary quads of aspect ~3 and the objective has two
-  // local minima 3e-6 apart near the valley at (-1/2, 0), reached from the two
-  // starts; with A = 1/2 the smoothed statistics match Table 1 (0.88/1.00/0.97).
+  // Sect. 5.1: 25 x 25 nodes, 576 quads on z = sin(pi u) cos(pi v), two poor
+  // parameterizations. (With the paper's signed area gamma |c| in the optimizer the
+  // two runs ended in different valid meshes, nodes jammed at the jump of gamma;
+  // see surface_measure.h.)
   const Vector2d lo(-1, -1), hi(1, 1);
   const auto phi1 = surface_test::make_surface(
       [](auto u, auto v) {
         using std::cos;
         using std::sin;
         const auto e = eps(u, v);
-        return std::array<decltype(u), 3>{u, v * e, kAmplitude * sin(kPi * u) * cos(kPi * v * e)};
+        return std::array<decltype(u), 3>{u, v * e, sin(kPi * u) * cos(kPi * v * e)};
       },
       lo, hi);
   const auto phi2 = surface_test::make_surface(
@@ -118,7 +116,7 @@ TEST_CASE("surface smoothing: Sigma_2 quads with phi^1 and phi^2 give the same m
         using std::cos;
         using std::sin;
         const auto e = eps(u, v);
-        return std::array<decltype(u), 3>{u * e, v * e, kAmplitude * sin(kPi * u * e) * cos(kPi * v * e)};
+        return std::array<decltype(u), 3>{u * e, v * e, sin(kPi * u * e) * cos(kPi * v * e)};
       },
       lo, hi);
   SurfaceMesh m1 = surface_test::grid_mesh(phi1, lo, hi, 25, 25, true);
@@ -126,8 +124,10 @@ TEST_CASE("surface smoothing: Sigma_2 quads with phi^1 and phi^2 give the same m
   REQUIRE(m1.elements.size() == 576);
   const double q1 = surface_mesh_quality(m1, SurfaceMeasure::shape).min;
   const double q2 = surface_mesh_quality(m2, SurfaceMeasure::shape).min;
-  const SurfaceSmoothingReport r1 = smooth_surface(m1, tight());
-  const SurfaceSmoothingReport r2 = smooth_surface(m2, tight());
+  SurfaceSmoothingOptions o = tight();
+  o.tol_x = 1e-6;
+  const SurfaceSmoothingReport r1 = smooth_surface(m1, o);
+  const SurfaceSmoothingReport r2 = smooth_surface(m2, o);
   CHECK(r1.converged);
   CHECK(r2.converged);
   const double dist = max_relative_node_distance(m1, m2);
@@ -139,8 +139,8 @@ TEST_CASE("surface smoothing: Sigma_2 quads with phi^1 and phi^2 give the same m
   CHECK(dist < 1e-3);
   CHECK(a.tangled == 0);
   CHECK(a.min > std::max(q1, q2));
-  CHECK(a.min > 0.85);
-  CHECK(a.mean > 0.97);
+  CHECK(a.min > 0.5);  // boundary quads of aspect ~3 (the fixed boundary nodes are uniform in u, v)
+  CHECK(a.mean > 0.9);
   CHECK(a.min == doctest::Approx(b.min).epsilon(1e-4));
   CHECK(a.mean == doctest::Approx(b.mean).epsilon(1e-4));
 }
