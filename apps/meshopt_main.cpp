@@ -23,6 +23,14 @@
 #include "tspline/io/atomic_file.h"
 #include "tspline/io/vtu_writer.h"
 
+#if defined(__SANITIZE_ADDRESS__)
+// LeakSanitizer: OpenCASCADE (libTK*, e.g. its STEP reader's static tables) and
+// Gmsh keep allocations to the end of the process; suppress leaks whose stack
+// passes through those third-party libraries only (our own code stays checked).
+extern "C" const char* __lsan_default_suppressions() { return "leak:libTK\nleak:libgmsh\n"; }
+extern "C" const char* __lsan_default_options() { return "print_suppressions=0"; }
+#endif
+
 namespace {
 
 using meshopt::ElementQualities;

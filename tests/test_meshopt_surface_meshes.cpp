@@ -44,11 +44,14 @@ double max_relative_node_distance(const SurfaceMesh& a, const SurfaceMesh& b) {
   return worst;
 }
 
+/// Tight tolerances for the parameterization-independence checks, with nonlinear
+/// over-relaxation (omega = 1.5) to reach them in fewer sweeps.
 SurfaceSmoothingOptions tight() {
   SurfaceSmoothingOptions o;
   o.tol_x = 1e-7;
   o.tol_f = 1e-12;
   o.max_sweeps = 5000;
+  o.newton.over_relaxation = 1.5;
   return o;
 }
 
