@@ -12,15 +12,16 @@ namespace tspline_app {
 struct Expression::Impl {
   // The parser keeps the addresses of x and y: Impl lives on the heap and is
   // never copied or moved.
-  double x = 0.0, y = 0.0;
+  double x = 0.0, y = 0.0, z = 0.0;
   mu::Parser parser;
 };
 
-Expression::Expression(std::string option, std::string text)
+Expression::Expression(std::string option, std::string text, bool three_d)
     : option_(std::move(option)), text_(std::move(text)), impl_(std::make_unique<Impl>()) {
   try {
     impl_->parser.DefineVar("x", &impl_->x);
     impl_->parser.DefineVar("y", &impl_->y);
+    if (three_d) impl_->parser.DefineVar("z", &impl_->z);
     impl_->parser.DefineConst("pi", std::numbers::pi);
     impl_->parser.SetExpr(text_);
     // muParser parses lazily, on the first evaluation: force it now so that a
@@ -30,7 +31,7 @@ Expression::Expression(std::string option, std::string text)
     if (results != 1)
       throw tspline::InputError(option_ + ": cannot parse '" + text_ + "': it gives " +
                                 std::to_string(results) +
-                                " comma-separated values, expected one expression in x and y");
+                                " comma-separated values, expected one expression in x and y" + (three_d ? " and z" : ""));
   } catch (const mu::Parser::exception_type& e) {
     throw tspline::InputError(option_ + ": cannot parse '" + text_ + "': " + e.GetMsg());
   }
@@ -38,14 +39,15 @@ Expression::Expression(std::string option, std::string text)
 
 Expression::~Expression() = default;
 
-double Expression::operator()(double x, double y) const {
+double Expression::operator()(double x, double y, double z) const {
   impl_->x = x;
   impl_->y = y;
+  impl_->z = z;
   try {
     return impl_->parser.Eval();
   } catch (const mu::Parser::exception_type& e) {
     throw tspline::InputError(option_ + ": cannot evaluate '" + text_ + "' at x = " + std::to_string(x) +
-                              ", y = " + std::to_string(y) + ": " + e.GetMsg());
+                              ", y = " + std::to_string(y) + ", z = " + std::to_string(z) + ": " + e.GetMsg());
   }
 }
 

@@ -32,3 +32,8 @@ printf "%5s %9s %9s %8s %11s %10s %8s %-6s %9s %9s %9s\n" level cells dofs space
 for level in 7 8 9 10; do
   ./build/bench/bench_poisson "$level"
 done
+echo "libmeshopt on surfaces: torus patch, N x N nodes randomly displaced, 20 Gauss-Seidel sweeps (smooth_surface)"
+printf "%8s %9s %8s %6s %12s %14s %8s %6s\n" nodes elements tangled sweeps s_per_sweep visits_per_s tangled min_q
+for n in 100 317; do
+  ./build/bench/bench_surface "$n" 20
+done

@@ -97,9 +97,10 @@ inline AppRun run_program(const std::string& exe, const std::string& args, const
   return r;
 }
 
-/// Runs `tspline ARGS` with stdout and stderr captured in files of `dir`.
-inline AppRun run_app(const std::string& args, const std::filesystem::path& dir) {
-  return run_program(TSPLINE_APP_PATH, args, dir);
+/// Runs `tspline ARGS` (or another built program) with stdout and stderr captured in files of `dir`.
+inline AppRun run_app(const std::string& args, const std::filesystem::path& dir,
+                      const std::string& program = TSPLINE_APP_PATH) {
+  return run_program(program, args, dir);
 }
 
 /// A balanced T-mesh from the uniform 4x4 mesh by `rounds` splits of the leaves

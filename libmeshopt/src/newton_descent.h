@@ -62,21 +62,27 @@ Eigen::Vector2d newton_descent(const Eigen::Vector2d& start, const Objective& ob
       if (!d.allFinite() || !(g.dot(d) < 0.0)) newton = false;
     }
     if (!newton) d = -g * (L / gn);  // gradient step of initial length L
-    // Trust cap: never try to move more than one local length per step.
-    const double dn = d.norm();
-    if (dn > L) d *= L / dn;
-    const double slope = g.dot(d);
-
+    // Armijo backtracking along d, capped at one local length (trust cap).
     double t = 1.0;
-    bool accepted = false;
     Eigen::Vector2d xn;
-    for (int k = 0; k <= opt.max_backtracks; ++k, t *= 0.5) {
-      xn = x + t * d;
-      const double fn = obj.value(xn, delta);
-      if (std::isfinite(fn) && fn <= ov.value + opt.armijo_c * t * slope) {
-        accepted = true;
-        break;
+    auto line_search = [&](Eigen::Vector2d dir) {
+      const double dn = dir.norm();
+      if (dn > L) dir *= L / dn;
+      const double slope = g.dot(dir);
+      t = 1.0;
+      for (int k = 0; k <= opt.max_backtracks; ++k, t *= 0.5) {
+        xn = x + t * dir;
+        const double fn = obj.value(xn, delta);
+        if (std::isfinite(fn) && fn <= ov.value + opt.armijo_c * t * slope) return true;
       }
+      return false;
+    };
+    bool accepted = line_search(d);
+    // A Newton direction can fail where the gradient does not (e.g. it leaves a
+    // constrained domain, where the value is +infinity): try the gradient once.
+    if (!accepted && newton) {
+      newton = false;
+      accepted = line_search(-g * (L / gn));
     }
     if (!accepted) break;
     ++(newton ? cnt.newton : cnt.gradient);

@@ -53,7 +53,9 @@ void check_lengths(const Map& arrays, std::size_t expected, const char* kind, co
 }
 
 void validate(const VtuMesh& mesh) {
-  const std::size_t np = mesh.points.size();
+  if (!mesh.points.empty() && !mesh.points3d.empty())
+    throw std::invalid_argument("write_vtu: both 2D and 3D points given");
+  const std::size_t np = mesh.points.size() + mesh.points3d.size();
   if (np > static_cast<std::size_t>(std::numeric_limits<int>::max()))
     throw std::invalid_argument("write_vtu: too many points");
   for (std::size_t c = 0; c < mesh.cells.size(); ++c) {
@@ -108,9 +110,11 @@ vtkNew<vtkUnstructuredGrid> build_grid(const VtuMesh& mesh) {
 
   vtkNew<vtkPoints> points;
   points->SetDataTypeToDouble();
-  points->SetNumberOfPoints(static_cast<vtkIdType>(mesh.points.size()));
+  points->SetNumberOfPoints(static_cast<vtkIdType>(mesh.points.size() + mesh.points3d.size()));
   for (std::size_t i = 0; i < mesh.points.size(); ++i)
     points->SetPoint(static_cast<vtkIdType>(i), mesh.points[i].x(), mesh.points[i].y(), 0.0);
+  for (std::size_t i = 0; i < mesh.points3d.size(); ++i)
+    points->SetPoint(static_cast<vtkIdType>(i), mesh.points3d[i].x(), mesh.points3d[i].y(), mesh.points3d[i].z());
   grid->SetPoints(points);
 
   vtkNew<vtkCellArray> cells;

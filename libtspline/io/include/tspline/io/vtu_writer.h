@@ -8,9 +8,11 @@
 
 namespace tspline::io {
 
-/// A 2D polygonal/line/vertex mesh to be written as .vtu (z = 0).
+/// A polygonal/line/vertex mesh to be written as .vtu: 2D points (z = 0), or
+/// 3D points if `points3d` is non-empty (then `points` must be empty).
 struct VtuMesh {
   std::vector<Eigen::Vector2d> points;
+  std::vector<Eigen::Vector3d> points3d;
   /// Each cell is a list of point indices. Cell type: VTK_POLYGON if >= 3
   /// indices (VTK_QUAD if exactly 4 and `quads_as_polygons` is false),
   /// VTK_LINE if 2, VTK_VERTEX if 1.

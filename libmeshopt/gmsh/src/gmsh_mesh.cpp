@@ -1,0 +1,235 @@
+// Surface meshes of CAD models through the Gmsh 4.8 C++ API.
+#include "meshopt/gmsh/gmsh_mesh.h"
+
+#include <gmsh.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <unordered_map>
+
+#include <Eigen/Geometry>
+
+namespace meshopt::gmsh_io {
+namespace fs = std::filesystem;
+
+namespace {
+
+/// Concatenates with operator<< (avoids GCC 12's false -Wrestrict on "literal" + std::string).
+template <class... T>
+std::string cat(const T&... parts) {
+  std::ostringstream s;
+  (s << ... << parts);
+  return s.str();
+}
+
+/// The message of the exception being handled: Gmsh 4.8 throws std::string
+/// (and sometimes int) besides std::exception.
+std::string gmsh_error() {
+  try {
+    throw;
+  } catch (const std::exception& e) {
+    return e.what();
+  } catch (const std::string& s) {
+    return s;
+  } catch (const char* s) {
+    return s;
+  } catch (int code) {
+    return cat("Gmsh error code ", code);
+  } catch (...) {
+    return "unknown Gmsh error";
+  }
+}
+
+void require_readable(const std::string& path, const char* what) {
+  std::ifstream f(path);
+  if (!f) throw InputError(cat("cannot read the ", what, " '", path, "'"));
+}
+
+/// Gmsh orients a face's elements by the CAD face's orientation, which may be
+/// opposite to phi_u x phi_v (a reversed OCC face); libmeshopt wants them
+/// counter-clockwise about phi_u x phi_v. Reverses the node order of the face's
+/// elements (from `first`) if most of them are clockwise; a few clockwise elements
+/// among counter-clockwise ones are tangled and stay as they are.
+void orient_like_the_normal(SurfaceMesh& m, const GmshFace& face, std::size_t first) {
+  long long balance = 0;
+  for (std::size_t e = first; e < m.elements.size(); ++e) {
+    const SurfaceElement& el = m.elements[e];
+    const Eigen::Vector3d n = unit_normal(face.evaluate(m.corner_uv[4 * e], 1));
+    const Eigen::Vector3d c = (m.x[el.v[1]] - m.x[el.v[0]]).cross(m.x[el.v[el.nv - 1]] - m.x[el.v[0]]);
+    balance += c.dot(n) > 0.0 ? 1 : -1;
+  }
+  if (balance >= 0) return;
+  for (std::size_t e = first; e < m.elements.size(); ++e) {
+    SurfaceElement& el = m.elements[e];
+    std::reverse(el.v.begin() + 1, el.v.begin() + el.nv);
+    std::reverse(m.corner_uv.begin() + 4 * e + 1, m.corner_uv.begin() + 4 * e + el.nv);
+  }
+}
+
+}  // namespace
+
+Session::Session(bool verbose) {
+  gmsh::initialize();
+  gmsh::option::setNumber("General.Terminal", verbose ? 1 : 0);
+  gmsh::option::setNumber("General.Verbosity", verbose ? 5 : 1);
+}
+
+Session::~Session() { gmsh::finalize(); }
+
+void open_model(const std::string& path) {
+  require_readable(path, "model");
+  try {
+    gmsh::open(path);
+  } catch (...) {
+    throw InputError(cat("cannot load the model '", path, "': ", gmsh_error()));
+  }
+  gmsh::vectorpair faces;
+  gmsh::model::getEntities(faces, 2);
+  if (faces.empty()) throw InputError(cat("the model '", path, "' has no surfaces"));
+}
+
+void merge_mesh(const std::string& path) {
+  require_readable(path, "mesh");
+  try {
+    gmsh::merge(path);
+  } catch (...) {
+    throw InputError(cat("cannot load the mesh '", path, "': ", gmsh_error()));
+  }
+}
+
+void generate_surface_mesh() {
+  try {
+    gmsh::model::mesh::generate(2);
+  } catch (...) {
+    throw InputError(cat("Gmsh could not mesh the model: ", gmsh_error()));
+  }
+}
+
+GmshSurfaceMesh read_surface_mesh() {
+  GmshSurfaceMesh out;
+  SurfaceMesh& m = out.mesh;
+  std::unordered_map<std::size_t, int> index_of;  // node tag -> mesh node
+  auto node_index = [&](std::size_t tag, const double* xyz) {
+    const auto [it, inserted] = index_of.emplace(tag, static_cast<int>(m.x.size()));
+    if (inserted) {
+      out.node_tags.push_back(tag);
+      m.x.emplace_back(xyz[0], xyz[1], xyz[2]);
+      m.u.emplace_back(0.0, 0.0);
+      m.free_face.push_back(-1);
+    }
+    return it->second;
+  };
+  gmsh::vectorpair faces;
+  gmsh::model::getEntities(faces, 2);
+  for (const auto& [dim, tag] : faces) {
+    std::vector<int> types;
+    std::vector<std::vector<std::size_t>> elem_tags, elem_nodes;
+    gmsh::model::mesh::getElements(types, elem_tags, elem_nodes, 2, tag);
+    std::size_t count = 0;
+    for (std::size_t k = 0; k < types.size(); ++k) {
+      if (types[k] != 2 && types[k] != 3)
+        throw InputError(cat("surface ", tag, " has elements of Gmsh type ", types[k],
+                             "; only linear triangles (2) and quadrangles (3) are supported"));
+      count += elem_tags[k].size();
+    }
+    if (count == 0) continue;
+    const int f = static_cast<int>(out.faces.size());
+    out.faces.push_back(std::make_unique<GmshFace>(tag));
+    m.faces.push_back(out.faces.back().get());
+    // All nodes of the face with parametric coordinates on it (boundary nodes
+    // reparametrized by Gmsh), and which of them are inside the face.
+    std::vector<std::size_t> tags, inner_tags;
+    std::vector<double> xyz, uv, inner_xyz, inner_uv;
+    gmsh::model::mesh::getNodes(tags, xyz, uv, 2, tag, true, true);
+    gmsh::model::mesh::getNodes(inner_tags, inner_xyz, inner_uv, 2, tag, false, true);
+    if (!inner_tags.empty() && inner_uv.size() != 2 * inner_tags.size())
+      throw InputError(cat("the mesh has no parametric coordinates for the nodes inside surface ", tag,
+                           " (save it with Mesh.SaveParametric = 1)"));
+    std::unordered_map<std::size_t, std::size_t> xyz_of;
+    for (std::size_t i = 0; i < tags.size(); ++i) xyz_of[tags[i]] = i;
+    std::unordered_map<std::size_t, Eigen::Vector2d> uv_of;
+    if (uv.size() == 2 * tags.size())
+      for (std::size_t i = 0; i < tags.size(); ++i) uv_of[tags[i]] = Eigen::Vector2d(uv[2 * i], uv[2 * i + 1]);
+    const GmshFace& face = *out.faces.back();
+    for (std::size_t i = 0; i < inner_tags.size(); ++i) {
+      const int n = node_index(inner_tags[i], &inner_xyz[3 * i]);
+      m.free_face[n] = f;
+      m.u[n] = Eigen::Vector2d(inner_uv[2 * i], inner_uv[2 * i + 1]);
+      uv_of[inner_tags[i]] = m.u[n];
+      // The checks of validate_surface_mesh, named with Gmsh tags.
+      const std::string where =
+          cat("node ", inner_tags[i], " of surface ", tag, " at (u, v) = (", m.u[n].x(), ", ", m.u[n].y(), ")");
+      const SurfacePoint p = face.evaluate(m.u[n], 1);
+      if (unit_normal(p).isZero())
+        throw InputError(cat(where, " lies at a degenerate point of the surface (phi_u x phi_v = 0)"));
+      if (!face.contains_exactly(m.u[n]))
+        throw InputError(cat(where, " is outside the surface's parameter range [", face.lower().x(), ", ",
+                             face.upper().x(), "] x [", face.lower().y(), ", ", face.upper().y(), "]"));
+      const double scale = std::max(1.0, p.x.norm());
+      if (!((p.x - m.x[n]).norm() <= 1e-6 * scale))
+        throw InputError(cat(where, ": the surface at these parametric coordinates is ", (p.x - m.x[n]).norm(),
+                             " away from the node"));
+    }
+    const std::size_t first_element = m.elements.size();
+    for (std::size_t k = 0; k < types.size(); ++k) {
+      const int nv = types[k] == 2 ? 3 : 4;
+      for (std::size_t e = 0; e < elem_tags[k].size(); ++e) {
+        SurfaceElement el;
+        el.nv = nv;
+        el.face = f;
+        for (int i = 0; i < nv; ++i) {
+          const std::size_t nt = elem_nodes[k][nv * e + i];
+          const auto xt = xyz_of.find(nt);
+          if (xt == xyz_of.end())
+            throw InputError(cat("element node ", nt, " of surface ", tag, " is not a node of that surface"));
+          el.v[i] = node_index(nt, &xyz[3 * xt->second]);
+          const auto it = uv_of.find(nt);
+          if (it == uv_of.end())
+            throw InputError(cat("node ", nt, " of surface ", tag, " has no parametric coordinates on it"));
+          m.corner_uv.push_back(it->second);
+        }
+        for (int i = nv; i < 4; ++i) m.corner_uv.push_back(Eigen::Vector2d::Zero());
+        m.elements.push_back(el);
+        out.face_tags.push_back(tag);
+      }
+    }
+    orient_like_the_normal(m, face, first_element);
+  }
+  if (m.elements.empty()) throw InputError("the mesh has no triangles or quadrangles on the model's surfaces");
+  return out;
+}
+
+void write_mesh(const std::string& path, const GmshSurfaceMesh& m) {
+  for (std::size_t i = 0; i < m.mesh.x.size(); ++i) {
+    if (m.mesh.free_face[i] < 0) continue;
+    const Eigen::Vector3d& x = m.mesh.x[i];
+    const Eigen::Vector2d& u = m.mesh.u[i];
+    gmsh::model::mesh::setNode(m.node_tags[i], {x.x(), x.y(), x.z()}, {u.x(), u.y()});
+  }
+  gmsh::option::setNumber("Mesh.SaveParametric", 1);
+  gmsh::option::setNumber("Mesh.MshFileVersion", 4.1);
+  const fs::path target(path);
+  // Gmsh picks the format from the extension: the temporary name ends in .msh.
+  const fs::path tmp =
+      target.parent_path() / cat(".", target.filename().string(), ".tmp", static_cast<long>(::getpid()), ".msh");
+  try {
+    gmsh::write(tmp.string());
+  } catch (...) {
+    const std::string why = gmsh_error();
+    std::error_code ec;
+    fs::remove(tmp, ec);
+    throw IoError(cat("cannot write '", path, "': ", why));
+  }
+  std::error_code ec;
+  if (!fs::exists(tmp, ec)) throw IoError(cat("cannot write '", path, "'"));
+  fs::rename(tmp, target, ec);
+  if (ec) {
+    fs::remove(tmp, ec);
+    throw IoError(cat("cannot write '", path, "': ", ec.message()));
+  }
+}
+
+}  // namespace meshopt::gmsh_io

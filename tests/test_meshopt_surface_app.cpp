@@ -1,0 +1,199 @@
+// End-to-end tests of `meshopt smooth` on a CAD model made with Gmsh's
+// OpenCASCADE kernel (a fused cylinder and sphere): mesh, tangle in parametric
+// space, untangle through the command; and its bad-input errors.
+#include <doctest/doctest.h>
+#include <gmsh.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "meshopt/gmsh/gmsh_mesh.h"
+#include "meshopt/surface_smoother.h"
+#include "test_support.h"
+
+#if defined(__SANITIZE_ADDRESS__)
+// LeakSanitizer: OpenCASCADE (libTK*, e.g. its STEP reader's static tables) and
+// Gmsh keep allocations to the end of the process; suppress leaks whose stack
+// passes through those third-party libraries only (our own code stays checked).
+extern "C" const char* __lsan_default_suppressions() { return "leak:libTK\nleak:libgmsh\n"; }
+extern "C" const char* __lsan_default_options() { return "print_suppressions=0"; }
+#endif
+
+namespace fs = std::filesystem;
+using namespace meshopt;
+using test_support::contains;
+
+namespace {
+
+test_support::AppRun run_meshopt(const std::string& args, const fs::path& dir) {
+  return test_support::run_app(args, dir, MESHOPT_APP_PATH);
+}
+
+/// Writes the fused cylinder (r 0.5, height 2) and sphere (r 0.8 at the top) as a
+/// BRep file and reopens it, so that its surface tags are those a reader of the
+/// file sees. \pre a gmsh_io::Session is alive.
+void make_model(const fs::path& brep) {
+  gmsh::model::add("cylinder_sphere");
+  gmsh::model::occ::addCylinder(0, 0, 0, 0, 0, 2, 0.5, 1);
+  gmsh::model::occ::addSphere(0, 0, 2, 0.8, 2);
+  gmsh::vectorpair out;
+  std::vector<gmsh::vectorpair> map;
+  gmsh::model::occ::fuse({{3, 1}}, {{3, 2}}, out, map);
+  gmsh::model::occ::synchronize();
+  gmsh::write(brep.string());
+  gmsh::clear();
+  gmsh_io::open_model(brep.string());
+}
+
+/// Moves every `stride`-th node inside each surface by a random parametric
+/// offset of up to `amount` times the face's parametric extent, keeping it inside
+/// the face (and the node's position on the surface).
+void tangle(int stride, double amount, unsigned seed) {
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> U(-1.0, 1.0);
+  gmsh::vectorpair faces;
+  gmsh::model::getEntities(faces, 2);
+  for (const auto& [dim, tag] : faces) {
+    std::vector<double> lo, hi;
+    gmsh::model::getParametrizationBounds(2, tag, lo, hi);
+    std::vector<std::size_t> tags;
+    std::vector<double> xyz, uv;
+    gmsh::model::mesh::getNodes(tags, xyz, uv, 2, tag, false, true);
+    for (std::size_t i = 0; i < tags.size(); i += stride) {
+      for (int attempt = 0; attempt < 20; ++attempt) {
+        const std::vector<double> p{uv[2 * i] + amount * (hi[0] - lo[0]) * U(rng),
+                                    uv[2 * i + 1] + amount * (hi[1] - lo[1]) * U(rng)};
+        if (p[0] <= lo[0] || p[0] >= hi[0] || p[1] <= lo[1] || p[1] >= hi[1]) continue;
+        if (gmsh::model::isInside(2, tag, p) == 0) continue;
+        std::vector<double> x;
+        gmsh::model::getValue(2, tag, p, x);
+        gmsh::model::mesh::setNode(tags[i], x, p);
+        break;
+      }
+    }
+  }
+}
+
+std::size_t tangled_elements() {
+  const gmsh_io::GmshSurfaceMesh g = gmsh_io::read_surface_mesh();
+  return surface_mesh_quality(g.mesh, SurfaceMeasure::shape).tangled;
+}
+
+void write_msh(const fs::path& path, bool parametric) {
+  gmsh::option::setNumber("Mesh.SaveParametric", parametric ? 1 : 0);
+  gmsh::write(path.string());
+}
+
+}  // namespace
+
+TEST_CASE("meshopt smooth: a tangled mesh of a fused cylinder and sphere (OpenCASCADE) is untangled") {
+  const fs::path dir = test_support::scratch_dir("meshopt_app", "cad");
+  std::size_t tangled_in = 0;
+  {
+    gmsh_io::Session session;
+    make_model(dir / "model.brep");
+    gmsh::option::setNumber("Mesh.MeshSizeMax", 0.15);
+    gmsh_io::generate_surface_mesh();
+    REQUIRE(tangled_elements() == 0);
+    tangle(3, 0.04, 17);
+    tangled_in = tangled_elements();
+    write_msh(dir / "tangled.msh", true);
+  }
+  MESSAGE("CAD model: " << tangled_in << " tangled elements before meshopt smooth");
+  REQUIRE(tangled_in >= 20);
+  const auto run = run_meshopt(std::string("smooth '") + (dir / "model.brep").string() + "' --mesh '" +
+                                   (dir / "tangled.msh").string() + "' --out '" + (dir / "out/smoothed.msh").string() +
+                                   "' --vtu '" + (dir / "out/smoothed.vtu").string() + "' --quiet",
+                               dir);
+  CAPTURE(run.out);
+  CAPTURE(run.err);
+  REQUIRE(run.exit_code == 0);
+  CHECK(contains(run.out, "tangled"));
+  const nlohmann::json rep = nlohmann::json::parse(test_support::slurp(dir / "out/smoothed.json"));
+  CHECK(rep["before"]["tangled"].get<std::size_t>() == tangled_in);
+  CHECK(rep["after"]["tangled"].get<std::size_t>() == 0);
+  CHECK(rep["after"]["min"].get<double>() > 0.3);
+  CHECK(rep["surfaces"].get<int>() >= 3);
+  CHECK(fs::file_size(dir / "out/smoothed.vtu") > 1000);
+  MESSAGE("CAD model after: min/mean quality " << rep["after"]["min"] << "/" << rep["after"]["mean"] << ", "
+                                               << rep["sweeps"] << " sweeps, " << rep["seconds"] << " s");
+  // The output opens in Gmsh with the same model, with parametric coordinates, untangled.
+  gmsh_io::Session session;
+  gmsh_io::open_model((dir / "model.brep").string());
+  gmsh_io::merge_mesh((dir / "out/smoothed.msh").string());
+  CHECK(tangled_elements() == 0);
+}
+
+TEST_CASE("meshopt smooth: bad input gives one clear error and exit 1") {
+  const fs::path dir = test_support::scratch_dir("meshopt_app", "bad");
+  const std::string out = std::string(" --out '") + (dir / "o.msh").string() + "' --quiet";
+  {
+    gmsh_io::Session session;
+    make_model(dir / "model.brep");
+    gmsh::option::setNumber("Mesh.MeshSizeMax", 0.3);
+    gmsh_io::generate_surface_mesh();
+    write_msh(dir / "no_parametric.msh", false);
+    // A node inside surface 1 moved out of the surface's parameter range.
+    std::vector<std::size_t> tags;
+    std::vector<double> xyz, uv, lo, hi;
+    gmsh::model::mesh::getNodes(tags, xyz, uv, 2, 1, false, true);
+    gmsh::model::getParametrizationBounds(2, 1, lo, hi);
+    REQUIRE(!tags.empty());
+    gmsh::model::mesh::setNode(tags[0], {xyz[0], xyz[1], xyz[2]}, {hi[0] + 1.0, uv[1]});
+    write_msh(dir / "outside.msh", true);
+  }
+  {
+    // A sphere with a node inside it moved onto its pole (phi_u = 0 there).
+    gmsh_io::Session session;
+    gmsh::model::add("sphere");
+    gmsh::model::occ::addSphere(0, 0, 0, 1.0, 1);
+    gmsh::model::occ::synchronize();
+    gmsh::write((dir / "sphere.brep").string());
+    gmsh::clear();
+    gmsh_io::open_model((dir / "sphere.brep").string());
+    gmsh::option::setNumber("Mesh.MeshSizeMax", 0.3);
+    gmsh_io::generate_surface_mesh();
+    gmsh::vectorpair faces;
+    gmsh::model::getEntities(faces, 2);
+    const int f = faces.at(0).second;
+    std::vector<std::size_t> tags;
+    std::vector<double> xyz, uv, lo, hi, pole;
+    gmsh::model::mesh::getNodes(tags, xyz, uv, 2, f, false, true);
+    gmsh::model::getParametrizationBounds(2, f, lo, hi);
+    const std::vector<double> p{0.5 * (lo[0] + hi[0]), hi[1]};
+    gmsh::model::getValue(2, f, p, pole);
+    gmsh::model::mesh::setNode(tags.at(0), pole, p);
+    write_msh(dir / "pole.msh", true);
+  }
+  std::ofstream(dir / "garbage.step") << "not a STEP file\n";
+  const std::string model = std::string("'") + (dir / "model.brep").string() + "'";
+  struct Case {
+    std::string args, message;
+  };
+  const std::vector<Case> cases = {
+      {std::string("smooth '") + (dir / "missing.step").string() + "'" + out, "cannot read the model"},
+      {std::string("smooth '") + (dir / "garbage.step").string() + "'" + out, "cannot load the model"},
+      {std::string("smooth ") + model + " --mesh '" + (dir / "no_parametric.msh").string() + "'" + out,
+       "no parametric coordinates for the nodes inside surface"},
+      {std::string("smooth ") + model + " --mesh '" + (dir / "outside.msh").string() + "'" + out,
+       "is outside the surface's parameter range"},
+      {std::string("smooth '") + (dir / "sphere.brep").string() + "' --mesh '" + (dir / "pole.msh").string() + "'" + out,
+       "lies at a degenerate point of the surface"},
+      {std::string("smooth ") + model + " --measure angle" + out, "--measure must be shape, size or size-shape"},
+      {std::string("smooth ") + model + " --measure size --size 'x+' " + out, "--size: cannot parse"},
+  };
+  for (const Case& c : cases) {
+    CAPTURE(c.args);
+    const auto r = run_meshopt(c.args, dir);
+    CAPTURE(r.err);
+    CHECK(r.exit_code == 1);
+    CHECK(contains(r.err, c.message));
+    CHECK(test_support::count_lines(r.err) == 1);
+    CHECK(!fs::exists(dir / "o.msh"));
+  }
+}
