@@ -6,6 +6,7 @@
 #include <cmath>
 #include <random>
 
+#include "test_support.h"
 #include "tspline/bezier_extraction.h"
 #include "tspline/map_quality.h"
 #include "tspline/tmesh.h"
@@ -18,21 +19,6 @@ using tspline::TSplineMap;
 
 namespace {
 
-// Uniform level-`level` mesh, then `splits` random refinements and a balance.
-TMesh random_tmesh(int level, int splits, unsigned seed) {
-  TMesh m(level);
-  std::mt19937 rng(seed);
-  for (int s = 0; s < splits; ++s) {
-    std::vector<int> leaves;
-    for (std::size_t n = 0; n < m.nodes().size(); ++n)
-      if (m.node(static_cast<int>(n)).is_leaf() && m.node(static_cast<int>(n)).level < 6)
-        leaves.push_back(static_cast<int>(n));
-    m.refine(leaves[std::uniform_int_distribution<std::size_t>(0, leaves.size() - 1)(rng)]);
-  }
-  m.balance();
-  m.build_topology();
-  return m;
-}
 
 // sum_k C(r, k) B_k(s, t)
 double bernstein_value(const BezierElement& e, int r, const Eigen::Vector2d& st) {
@@ -184,7 +170,7 @@ TEST_SUITE("bezier_extraction") {
     int split_total = 0;
     for (unsigned seed : {3u, 7u, 11u}) {
       CAPTURE(seed);
-      const TSplineMap map = smooth_map(random_tmesh(2, 12, seed));
+      const TSplineMap map = smooth_map(test_support::random_leaf_splits(2, 12, seed));
       REQUIRE(map.mesh().num_hanging_vertices() > 0);
       split_total += check_extraction(map, 4, seed);
       const tspline::BezierExtraction ex(map.basis());
@@ -201,7 +187,7 @@ TEST_SUITE("bezier_extraction") {
   }
 
   TEST_CASE("quadrature per Bezier element integrates every blending function exactly (not so per cell)") {
-    const TMesh mesh = random_tmesh(2, 12, 7);
+    const TMesh mesh = test_support::random_leaf_splits(2, 12, 7);
     const TSplineBasis basis(mesh);
     REQUIRE(mesh.num_hanging_vertices() > 0);
     // 2 x 2 Gauss points are exact for bicubics: exact on every element.
@@ -234,7 +220,7 @@ TEST_SUITE("bezier_extraction") {
   TEST_CASE(
       "quadrature on a finer analysis mesh, split by the geometry's knot lines too, integrates the geometry "
       "functions exactly") {
-    const TMesh geometry_mesh = random_tmesh(2, 8, 11);
+    const TMesh geometry_mesh = test_support::random_leaf_splits(2, 8, 11);
     const TSplineBasis geometry(geometry_mesh);
     // The analysis mesh: the geometry mesh with some cells split once more.
     TMesh analysis_mesh = geometry_mesh;

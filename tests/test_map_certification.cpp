@@ -33,20 +33,6 @@ BernsteinPoly random_poly(int m, int n, std::mt19937& rng) {
   return p;
 }
 
-TMesh random_tmesh(int level, int splits, unsigned seed) {
-  TMesh m(level);
-  std::mt19937 rng(seed);
-  for (int s = 0; s < splits; ++s) {
-    std::vector<int> leaves;
-    for (std::size_t n = 0; n < m.nodes().size(); ++n)
-      if (m.node(static_cast<int>(n)).is_leaf() && m.node(static_cast<int>(n)).level < 6)
-        leaves.push_back(static_cast<int>(n));
-    m.refine(leaves[std::uniform_int_distribution<std::size_t>(0, leaves.size() - 1)(rng)]);
-  }
-  m.balance();
-  m.build_topology();
-  return m;
-}
 
 // Dense sampling of det J on every element: a k x k grid including the
 // element's edges and corners. det J is evaluated directly from the B-splines
@@ -203,7 +189,7 @@ TEST_SUITE("map_certification") {
   TEST_CASE(
       "the (8,8) numerator D / w^3 is det J of the map at random points (T-mesh with hanging vertices)") {
     for (unsigned seed : {2u, 9u}) {
-      TSplineMap map = tspline::greville_identity_map(random_tmesh(2, 10, seed));
+      TSplineMap map = tspline::greville_identity_map(test_support::random_leaf_splits(2, 10, seed));
       REQUIRE(map.mesh().num_hanging_vertices() > 0);
       std::vector<Eigen::Vector2d> P = map.control_points();
       // A nonlinear map far from the origin (the element centres the control points).
