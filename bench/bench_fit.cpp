@@ -10,27 +10,17 @@
 #include <cstdlib>
 
 #include "tspline/control_point_optimization.h"
-#include "tspline/io/polygon_reader.h"
+#include "bench_front_args.h"
 #include "tspline/map_quality.h"
 #include "tspline/parameterization.h"
 #include "tspline/tspline_fit.h"
 
-namespace {
-double since(std::chrono::steady_clock::time_point t) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
-}
-}  // namespace
+using bench::since;
 
 int main(int argc, char** argv) {
-  if (argc < 3) {
-    std::fprintf(stderr, "usage: %s POLYGON INIT_LEVEL [TOL_REL]\n", argv[0]);
-    return 1;
-  }
-  tspline::ParameterizationOptions opt;
-  opt.initial_level = std::atoi(argv[2]);
-  opt.tolerance_relative = argc > 3 ? std::atof(argv[3]) : 1e-6;
-  opt.corner_trials = 1;
-  const tspline::FrontResult front = tspline::run_front(tspline::io::read_polygon(argv[1]), opt);
+  const std::optional<tspline::FrontResult> front_result = bench::front_from_args(argc, argv);
+  if (!front_result) return 1;
+  const tspline::FrontResult& front = *front_result;
   auto t = std::chrono::steady_clock::now();
   const tspline::TSplineBasis basis(front.mesh);
   const double t_basis = since(t);
