@@ -314,34 +314,37 @@ ElementCertificate certify_element(const BezierElement& e, const std::vector<Eig
 // The whole map
 // ---------------------------------------------------------------------------
 MapCertification certify_map(const TSplineMap& map, const CertificationOptions& opt) {
+  return certify_map(BezierExtraction(map.basis()), map.mesh().num_cells(), map.control_points(), opt);
+}
+
+MapCertification certify_map(const BezierExtraction& extraction, std::size_t num_cells,
+                             const std::vector<Eigen::Vector2d>& P, const CertificationOptions& opt) {
   const auto t0 = std::chrono::steady_clock::now();
-  const TSplineBasis& basis = map.basis();
-  const int nc = static_cast<int>(map.mesh().num_cells());
   MapCertification r;
-  r.cell_certified.assign(nc, 1);
+  r.cell_certified.assign(num_cells, 1);
   r.min_relative_lower_bound = std::numeric_limits<double>::infinity();
   r.min_det_lower_bound = std::numeric_limits<double>::infinity();
-  for (int c = 0; c < nc; ++c) {
-    for (const BezierElement& e : extract_cell(basis, c)) {
-      const ElementCertificate cert = certify_element(e, map.control_points(), opt);
-      ++r.elements;
-      r.max_depth_used = std::max(r.max_depth_used, cert.depth);
-      r.min_relative_lower_bound = std::min(r.min_relative_lower_bound, cert.relative_lower_bound);
-      r.min_det_lower_bound = std::min(r.min_det_lower_bound, cert.det_lower_bound);
-      switch (cert.status) {
-        case ElementStatus::Certified:
-          ++r.certified;
-          continue;
-        case ElementStatus::Invalid:
-          ++r.invalid;
-          break;
-        case ElementStatus::Undecided:
-          ++r.undecided;
-          break;
-      }
-      r.cell_certified[c] = 0;
-      r.failures.push_back({c, e.lo, e.hi, cert});
+  const std::vector<BezierElement>& es = extraction.elements();
+  for (std::size_t k = 0; k < es.size(); ++k) {
+    const BezierElement& e = es[k];
+    const ElementCertificate cert = certify_element(e, P, opt);
+    ++r.elements;
+    r.max_depth_used = std::max(r.max_depth_used, cert.depth);
+    r.min_relative_lower_bound = std::min(r.min_relative_lower_bound, cert.relative_lower_bound);
+    r.min_det_lower_bound = std::min(r.min_det_lower_bound, cert.det_lower_bound);
+    switch (cert.status) {
+      case ElementStatus::Certified:
+        ++r.certified;
+        continue;
+      case ElementStatus::Invalid:
+        ++r.invalid;
+        break;
+      case ElementStatus::Undecided:
+        ++r.undecided;
+        break;
     }
+    r.cell_certified[e.cell] = 0;
+    r.failures.push_back({e.cell, k, e.lo, e.hi, cert});
   }
   r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return r;

@@ -120,6 +120,7 @@ ElementCertificate certify_element(const BezierElement& e, const std::vector<Eig
 /// An element that is not certified.
 struct CertificationFailure {
   int cell = -1;
+  std::size_t element = 0;  ///< index in the map's BezierExtraction
   Eigen::Vector2d lo = Eigen::Vector2d::Zero(), hi = Eigen::Vector2d::Zero();
   ElementCertificate certificate;
 };
@@ -142,5 +143,9 @@ struct MapCertification {
 
 /// Certifies every Bezier element of every cell.
 MapCertification certify_map(const TSplineMap& map, const CertificationOptions& options = {});
+/// The same on an extraction made once (of a basis with num_cells cells) and
+/// the control points P.
+MapCertification certify_map(const BezierExtraction& extraction, std::size_t num_cells,
+                             const std::vector<Eigen::Vector2d>& P, const CertificationOptions& options = {});
 
 }  // namespace tspline
