@@ -174,12 +174,8 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   bool no_cpo = false;
   param->add_flag("--no-control-point-optimization", no_cpo,
-                  "Keep the interpolating map even where it is invalid or below --min-jacobian (by default the "
-                  "interior control points are then optimized for the Jacobian)");
-  param->add_option("--cpo-power", adaptive.control_point_power,
-                    "Exponent p of the control point optimization's objective sum (1/J_r)^p: larger p raises the "
-                    "minimum J_r")
-      ->capture_default_str();
+                  "Keep the interpolating map of the T-mesh (by default all interior control points are "
+                  "untangled and smoothed globally until det J > 0 is certified)");
   param->add_option("--cert-depth", adaptive.certification.max_depth,
                     "Certification of det J > 0 on every Bezier element: de Casteljau subdivision levels at most "
                     "(an element still undecided there is refined like one with J_r below --min-jacobian)")

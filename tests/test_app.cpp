@@ -101,7 +101,7 @@ TEST_SUITE("app") {
     CHECK(r.exit_code == 0);
     for (const char* opt : {"--out", "--corners", "--corner-trials", "--tol", "--tol-rel", "--init-level", "--max-level",
                             "--max-sweeps", "--omega", "--sweep-tol", "--polygon", "--min-jacobian", "--max-adapt",
-                            "--max-cells", "--samples", "--no-control-point-optimization", "--cpo-power", "--quiet"})
+                            "--max-cells", "--samples", "--no-control-point-optimization", "--quiet"})
       CHECK(r.out.find(opt) != std::string::npos);
   }
 

@@ -78,8 +78,14 @@ double vertex_cost(const Polygon& p, const std::vector<double>& cum, std::size_t
     const double a = scale_angle(p, cum, i, f);
     c += std::pow((a - 90.0) / 90.0, 2) + (a >= 180.0 ? 1.0 : 0.0);
   }
-  c /= std::size(kScales);
-  if (local_angle(p, i) >= 180.0) c += 10.0;
+  // The local angle, between the two polygon edges at the vertex, counts twice:
+  // the map's boundary tangents at a corner of the square follow it (J_r there is
+  // at most sin of that angle), so a vertex of 176 degrees between two straight
+  // runs would be the worst point of the map however good its angle at scale.
+  const double local = local_angle(p, i);
+  c += 2.0 * std::pow((std::min(local, 180.0) - 90.0) / 90.0, 2);
+  c /= std::size(kScales) + 2.0;
+  if (local >= 180.0) c += 10.0;
   return c;
 }
 

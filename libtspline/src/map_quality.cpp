@@ -1,5 +1,7 @@
 #include "tspline/map_quality.h"
 
+#include "tspline/bezier_extraction.h"
+
 #include <Eigen/LU>
 #include <algorithm>
 #include <cmath>
@@ -83,6 +85,27 @@ MapQualityStats map_quality(const TSplineMap& map, int gauss, std::vector<CellMa
   }
   s.mean_mean_ratio = s.points ? sum / static_cast<double>(s.points) : 0.0;
   return s;
+}
+
+DenseMapQuality dense_map_quality(const TSplineMap& map, int k) {
+  if (k < 1) throw std::invalid_argument("dense_map_quality: k must be >= 1");
+  DenseMapQuality q;
+  q.samples_per_edge = k;
+  const BezierExtraction extraction(map.basis());
+  for (const BezierElement& e : extraction.elements()) {
+    ++q.elements;
+    for (int j = 0; j <= k; ++j)
+      for (int i = 0; i <= k; ++i) {
+        const Eigen::Vector2d uv(e.lo.x() + (e.hi.x() - e.lo.x()) * i / k, e.lo.y() + (e.hi.y() - e.lo.y()) * j / k);
+        const Eigen::Matrix2d J = map.derivatives(uv, 1, e.cell).J;
+        const double jr = mean_ratio_jacobian(J);
+        ++q.points;
+        if (!(J.determinant() > 0.0)) ++q.nonpositive_det;
+        if (jr < q.min_mean_ratio) q.min_mean_ratio = jr, q.worst_at = uv;
+        q.min_scaled = std::min(q.min_scaled, scaled_jacobian(J));
+      }
+  }
+  return q;
 }
 
 }  // namespace tspline

@@ -83,6 +83,7 @@ MapUntanglingReport untangle_map(TSplineMap& map, const MapUntanglingOptions& op
   so.parameter_tolerance = 1e-14;
 
   bool resampled = false;
+  int quality_stages = 0;  // certified stages at the floor eps
   for (int stage = 0; stage < opt.max_stages; ++stage) {
     if (resampled) {
       // Finer samples can show det J <= 0 where the coarser ones had none: back
@@ -126,8 +127,13 @@ MapUntanglingReport untangle_map(TSplineMap& map, const MapUntanglingOptions& op
     }
     if (opt.progress) opt.progress({stage, eps, E, rep.iterations, st, certified_now});
     const double rel = std::abs(E_prev - E) / std::max(std::abs(E), 1e-300);
+    if (certified_now && barrier) ++quality_stages;
     if (certified_now && barrier && rel < opt.energy_tolerance) {
       rep.stop_reason = "certified, and the energy converged";
+      break;
+    }
+    if (certified_now && quality_stages >= opt.max_quality_stages) {
+      rep.stop_reason = "certified, and the quality stages done";
       break;
     }
     if (rep.iterations >= opt.max_iterations) {

@@ -215,7 +215,10 @@ FrontResult run_front(const Polygon& input, const ParameterizationOptions& opt) 
 
   std::vector<StageTime> times;
   StageClock clock(times);
-  Polygon poly = validate_polygon(input);
+  PolygonCleaning cleaning = clean_polygon(input);
+  for (const std::string& note : cleaning.notes)
+    if (opt.log) opt.log("note: " + note);
+  Polygon poly = validate_polygon(std::move(cleaning.polygon));
   Corners corners;
   std::vector<CornerTrial> trials;
   if (opt.corners) {
@@ -286,6 +289,8 @@ FrontResult run_front(const Polygon& input, const ParameterizationOptions& opt) 
   }
   clock.stop("boundary");
   FrontResult r = optimize_front(BoundaryMap(std::move(poly), std::move(corners)), opt, &clock);
+  r.removed_vertices = cleaning.removed_file_indices;
+  r.cleaning_notes = cleaning.notes;
   r.corner_trials = std::move(trials);
   r.times = std::move(times);
   return r;

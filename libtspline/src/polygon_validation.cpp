@@ -178,4 +178,72 @@ Polygon validate_polygon(Polygon p) {
   return p;
 }
 
+PolygonCleaning clean_polygon(Polygon p) {
+  const std::size_t n0 = p.vertices.size();
+  if (p.file_index.empty()) {
+    p.file_index.resize(n0);
+    for (std::size_t i = 0; i < n0; ++i) p.file_index[i] = i;
+  }
+  PolygonCleaning out;
+  for (const auto& v : p.vertices)
+    if (!std::isfinite(v.x()) || !std::isfinite(v.y())) {
+      out.polygon = std::move(p);  // validate_polygon names the vertex
+      return out;
+    }
+  // One pass over a stack: a vertex is dropped if it repeats the previous one,
+  // or if the previous edge and the next one lie on one line and double back
+  // (the vertex is the tip of a zero-area spike). Dropping a vertex can expose
+  // the next spike (a -> b -> a -> ...), which the stack handles.
+  std::vector<std::size_t> keep;
+  keep.reserve(n0);
+  auto spike = [&](std::size_t a, std::size_t b, std::size_t c) {
+    const Point pa(p.vertices[a].x(), p.vertices[a].y()), pb(p.vertices[b].x(), p.vertices[b].y()),
+        pc(p.vertices[c].x(), p.vertices[c].y());
+    return CGAL::collinear(pa, pb, pc) && !CGAL::collinear_are_ordered_along_line(pa, pb, pc);
+  };
+  auto note = [&](std::size_t dropped, const std::string& why) {
+    out.removed_file_indices.push_back(p.file_index[dropped]);
+    out.notes.push_back("removed vertex " + std::to_string(p.file_index[dropped]) + " " + why);
+  };
+  bool changed = true;
+  std::vector<std::size_t> order(n0);
+  for (std::size_t i = 0; i < n0; ++i) order[i] = i;
+  // Repeat around the closing seam until nothing changes (at most a few passes).
+  while (changed && order.size() >= 3) {
+    changed = false;
+    keep.clear();
+    for (std::size_t i : order) {
+      if (!keep.empty() && p.vertices[keep.back()] == p.vertices[i]) {
+        note(i, "(repeats vertex " + std::to_string(p.file_index[keep.back()]) + ")");
+        changed = true;
+        continue;
+      }
+      while (keep.size() >= 2 && spike(keep[keep.size() - 2], keep.back(), i)) {
+        note(keep.back(), "(tip of a zero-area spike: edges " + std::to_string(p.file_index[keep[keep.size() - 2]]) +
+                              "-" + std::to_string(p.file_index[keep.back()]) + " and " +
+                              std::to_string(p.file_index[keep.back()]) + "-" + std::to_string(p.file_index[i]) +
+                              " overlap)");
+        keep.pop_back();
+        changed = true;
+        if (!keep.empty() && p.vertices[keep.back()] == p.vertices[i]) break;
+      }
+      if (!keep.empty() && p.vertices[keep.back()] == p.vertices[i]) {
+        note(i, "(repeats vertex " + std::to_string(p.file_index[keep.back()]) + ")");
+        changed = true;
+        continue;
+      }
+      keep.push_back(i);
+    }
+    // Rotate so that the seam between the last and first vertex is looked at too.
+    if (keep.size() >= 3) std::rotate(keep.begin(), keep.begin() + static_cast<std::ptrdiff_t>(keep.size() / 2), keep.end());
+    order = keep;
+  }
+  std::sort(order.begin(), order.end());  // file order
+  Polygon q;
+  for (std::size_t i : order) q.vertices.push_back(p.vertices[i]), q.file_index.push_back(p.file_index[i]);
+  std::sort(out.removed_file_indices.begin(), out.removed_file_indices.end());
+  out.polygon = std::move(q);
+  return out;
+}
+
 }  // namespace tspline

@@ -119,12 +119,12 @@ InterpolationData interpolation_data(const TSplineBasis& basis, const std::vecto
   return d;
 }
 
-TSplineMap fit_tspline(const TMesh& mesh, const std::vector<Eigen::Vector2d>& x, const BoundaryMap& boundary,
-                       FitReport* report) {
-  const auto t0 = std::chrono::steady_clock::now();
-  TSplineMap map(mesh);
+namespace {
+
+// Solves Eq. 8 for the given interpolation data on map's basis.
+void solve_interpolation(TSplineMap& map, const InterpolationData& data, FitReport* report,
+                         std::chrono::steady_clock::time_point t0) {
   const TSplineBasis& basis = map.basis();
-  const InterpolationData data = interpolation_data(basis, x, boundary);
   const int n = static_cast<int>(basis.size());
   std::vector<Eigen::Triplet<double>> trip;
   trip.reserve(static_cast<std::size_t>(n) * 16);
@@ -174,6 +174,27 @@ TSplineMap fit_tspline(const TMesh& mesh, const std::vector<Eigen::Vector2d>& x,
     report->relative_residual = rel;
     report->solve_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   }
+}
+
+}  // namespace
+
+TSplineMap fit_tspline(const TMesh& mesh, const std::vector<Eigen::Vector2d>& x, const BoundaryMap& boundary,
+                       FitReport* report) {
+  const auto t0 = std::chrono::steady_clock::now();
+  TSplineMap map(mesh);
+  solve_interpolation(map, interpolation_data(map.basis(), x, boundary), report, t0);
+  return map;
+}
+
+TSplineMap transfer_map(const TSplineMap& source, TMesh mesh, FitReport* report) {
+  const auto t0 = std::chrono::steady_clock::now();
+  TSplineMap map(std::move(mesh));
+  InterpolationData data;
+  for (const BlendingFunction& f : map.basis().functions()) {
+    data.params.push_back(f.interpolation_point);
+    data.targets.push_back(source.point(f.interpolation_point));
+  }
+  solve_interpolation(map, data, report, t0);
   return map;
 }
 

@@ -1,18 +1,28 @@
 #pragma once
-// The whole parameterization (Brovka 2013 Sects. 3-6): the front half (T-mesh,
-// Coons, untangling and smoothing), the cubic T-spline fit, the mean ratio
-// Jacobian check, and adaptive refinement of the cells where it is poor
-// (Sect. 6.2) until the map is valid and good or the round limit is reached.
-// Validity is also certified on every Bezier element (map_certification.h): a
-// cell with an element that is not certified is refined like one with J_r < delta.
+// The whole parameterization, in named steps:
+//  1. front half (Brovka 2013 Sects. 3-4): T-mesh adapted to the boundary,
+//     Coons start, weighted K* untangling and smoothing of the T-mesh;
+//  2. first map: the cubic T-spline interpolating the T-mesh (Sect. 5). Its
+//     border control points define the boundary curve, frozen from here on;
+//     det J at the four corners of the square (the cross product of the two
+//     boundary tangents there, which no interior move changes) is checked;
+//  3. global untangling and smoothing of the map's own interior control points
+//     until det J > 0 is certified on every Bezier element (map_untangling.h);
+//  4. quality: mean ratio J_r at Gauss points (the paper's check, Sect. 6.1),
+//     over a dense sample of every element, and the certificate;
+//  5. if not certified or J_r < delta somewhere: refine those cells (the
+//     uncertified ones with a ring of neighbours), re-balance, carry the
+//     current map onto the finer T-mesh (transfer_map: the boundary curve is
+//     reproduced exactly) and go on from it at step 3 (Sect. 6.2, without
+//     re-interpolating from scratch).
 #include <functional>
 #include <optional>
 #include <string>
 #include <vector>
 
-#include "tspline/control_point_optimization.h"
 #include "tspline/map_certification.h"
 #include "tspline/map_quality.h"
+#include "tspline/map_untangling.h"
 #include "tspline/parameterization.h"
 #include "tspline/tspline_fit.h"
 #include "tspline/tspline_map.h"
@@ -30,15 +40,12 @@ struct AdaptiveOptions {
   int stall_rounds = 2;
   /// Never refine beyond this many cells.
   std::size_t max_cells = 200000;
-  /// After each fit that is not valid and good, optimize the interior control
-  /// points acting on cells with J_r < 2 min_jacobian for the Jacobian
-  /// (control_point_optimization.h) and keep the result if it is better.
+  /// Untangle and smooth the interior control points of every map globally
+  /// (map_untangling.h). false: keep the interpolating map of the T-mesh.
   bool optimize_control_points = true;
-  /// Exponent p of that optimization's objective sum_g (1/J_r)^p (regularized).
-  /// p = 1 is the paper's K* and favours the mean; larger p pushes up the
-  /// minimum J_r, which is what the threshold asks for. On the bundled domains
-  /// p = 4 raised the minimum from 0.12-0.25 to 0.21-0.45 at a few % of mean.
-  double control_point_power = 4.0;
+  MapUntanglingOptions untangling;
+  /// dense_map_quality: (k + 1)^2 samples per Bezier element.
+  int dense_samples = 8;
   /// Certify det J > 0 on every Bezier element after each fit; refine the cells
   /// that are not certified, and stop only once the map is certified.
   bool certify = true;
@@ -51,20 +58,23 @@ struct AdaptIteration {
   std::size_t functions = 0;
   std::size_t inverted_cells = 0;  ///< of the optimized T-mesh
   std::size_t refined_cells = 0;   ///< cells marked after this iteration (0 for the last)
-  FitReport fit;
+  FitReport fit;                   ///< interpolation (iteration 0) or transfer of the previous map
   bool control_points_optimized = false;
+  /// The global untangling of this iteration (no per-element data).
+  MapUntanglingReport untangling;
   MapQualityStats quality;         ///< of the map kept in this iteration
   /// Certification of that map (counts and bounds; no per-cell data).
   MapCertification certification;
   std::size_t certification_marked_cells = 0;  ///< cells marked only because they are not certified
-  double seconds = 0.0;            ///< optimization (after refinement) + fit + check
+  double seconds = 0.0;            ///< fit or transfer + untangling + checks
 };
 
 struct ParameterizationResult {
   FrontResult front;  ///< mesh/optimized/quality_optimized are those of the kept T-mesh
   std::optional<TSplineMap> map;
   FitReport fit;
-  MapQualityStats quality;
+  MapQualityStats quality;          ///< at Gauss points
+  DenseMapQuality dense_quality;    ///< over a dense sample of every Bezier element
   std::vector<CellMapQuality> cell_quality;
   std::vector<AdaptIteration> iterations;
   int kept_iteration = 0;       ///< the best iteration, whose mesh and map these are
@@ -72,6 +82,9 @@ struct ParameterizationResult {
   /// not interpolate the interior T-mesh vertices).
   bool control_points_optimized = false;
   std::string stop_reason;      ///< why the adaptive loop stopped
+  /// Empty, or why no interior move can make the map valid (det J <= 0 at a
+  /// corner of the square, decided by the frozen boundary curve alone).
+  std::string boundary_problem;
   MapCertification certification;  ///< of the kept map (empty if AdaptiveOptions::certify is off)
   /// Refinement rounds made only because of the certification: the map was
   /// valid and good at every Gauss point but not certified on every element.

@@ -39,4 +39,23 @@ std::vector<CellMapQuality> cell_map_quality(const TSplineMap& map, int gauss = 
 /// Over all cells' gauss x gauss points.
 MapQualityStats map_quality(const TSplineMap& map, int gauss = 4, std::vector<CellMapQuality>* per_cell = nullptr);
 
+/// Quality over the whole map, not only at quadrature points: a dense sample
+/// of every Bezier element (bezier_extraction.h), (k + 1) x (k + 1) points on a
+/// uniform grid that includes the element's corners and edges (where the
+/// Gauss points miss the worst values, e.g. at a corner of the square placed
+/// on a nearly straight polygon vertex). A sample, not a bound: the certified
+/// bound of det J is map_certification.h's.
+struct DenseMapQuality {
+  std::size_t elements = 0;
+  std::size_t points = 0;
+  std::size_t nonpositive_det = 0;
+  double min_mean_ratio = 1.0;
+  double min_scaled = 1.0;
+  Eigen::Vector2d worst_at = Eigen::Vector2d::Zero();  ///< parametric point of min J_r
+  int samples_per_edge = 0;                            ///< k
+};
+
+/// \pre k >= 1.
+DenseMapQuality dense_map_quality(const TSplineMap& map, int k = 8);
+
 }  // namespace tspline

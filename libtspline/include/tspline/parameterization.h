@@ -77,6 +77,9 @@ struct FrontResult {
   std::vector<std::size_t> repair_refined_cells;
   std::vector<CornerTrial> corner_trials;  ///< empty unless automatic corners were tried
   std::vector<StageTime> times;
+  /// What clean_polygon removed from the input (file numbering), one note each.
+  std::vector<std::size_t> removed_vertices;
+  std::vector<std::string> cleaning_notes;
 };
 
 /// Runs the front half on a polygon as read from a file (not yet validated).

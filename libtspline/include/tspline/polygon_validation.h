@@ -1,5 +1,8 @@
 #pragma once
 // Validation of an input polygon with CGAL's exact predicates, and orientation.
+#include <string>
+#include <vector>
+
 #include "tspline/polygon.h"
 
 namespace tspline {
@@ -15,6 +18,20 @@ namespace tspline {
 ///   near" for collinear overlaps). Runs in O(n log n + k), k = pairs of edges with
 ///   overlapping bounding boxes. An empty `file_index` is filled with 0..n-1.
 Polygon validate_polygon(Polygon p);
+
+/// What clean_polygon did.
+struct PolygonCleaning {
+  Polygon polygon;                               ///< the cleaned polygon, file numbering kept
+  std::vector<std::size_t> removed_file_indices;  ///< sorted
+  std::vector<std::string> notes;                ///< one per removed vertex, in the file's numbering
+};
+
+/// Real data is cleaned, not rejected: removes vertices that repeat their
+/// predecessor (also across the closing seam) and tips of zero-area spikes (an
+/// edge that doubles back along the previous one, exactly collinear), with a
+/// note per vertex in the file's numbering. True crossings are left for
+/// validate_polygon to reject. Non-finite coordinates are left as well.
+PolygonCleaning clean_polygon(Polygon p);
 
 /// Signed area (positive for counter-clockwise).
 double signed_area(const Polygon& p);

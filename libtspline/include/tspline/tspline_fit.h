@@ -46,4 +46,14 @@ InterpolationData interpolation_data(const TSplineBasis& basis, const std::vecto
 TSplineMap fit_tspline(const TMesh& mesh, const std::vector<Eigen::Vector2d>& vertex_x, const BoundaryMap& boundary,
                        FitReport* report = nullptr);
 
+/// The map `source` carried onto the basis of a finer T-mesh (one that refines
+/// source's): the interpolant of source at the new interpolation points. On
+/// the border of [0,1]^2 the map is a univariate cubic spline on the border
+/// vertices (the functions that vanish there drop out, the others sum to 1),
+/// and the refined border space contains the old one: interpolation reproduces
+/// the boundary curve exactly, up to round-off. Inside, where the normalized
+/// T-spline spaces need not be nested, it is the interpolant (close to source,
+/// not equal). \throw NumericalError as fit_tspline.
+TSplineMap transfer_map(const TSplineMap& source, TMesh mesh, FitReport* report = nullptr);
+
 }  // namespace tspline

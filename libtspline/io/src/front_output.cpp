@@ -108,6 +108,7 @@ nlohmann::json front_report(const FrontResult& r, const std::string& input_path)
   times["total"] = total;
   return {
       {"input", input_path},
+      {"input_cleaning", {{"removed_vertices", r.removed_vertices}, {"notes", r.cleaning_notes}}},
       {"counts",
        {{"polygon_vertices", p.vertices.size()},
         {"cells", r.mesh.num_cells()},

@@ -134,6 +134,15 @@ nlohmann::json param_report(const ParameterizationResult& r, const std::string& 
   rep["jacobian"] = map_quality_json(r.quality);
   rep["jacobian"]["gauss_points_per_direction"] = ad.gauss;
   rep["jacobian"]["threshold"] = ad.min_jacobian;
+  rep["jacobian"]["note"] = "min/mean at the Gauss points; whole_map: a dense sample of every Bezier element";
+  rep["jacobian"]["whole_map"] = {{"min_mean_ratio", r.dense_quality.min_mean_ratio},
+                                  {"min_scaled", r.dense_quality.min_scaled},
+                                  {"nonpositive_det_points", r.dense_quality.nonpositive_det},
+                                  {"points", r.dense_quality.points},
+                                  {"points_per_element", (r.dense_quality.samples_per_edge + 1) *
+                                                             (r.dense_quality.samples_per_edge + 1)},
+                                  {"worst_at", {r.dense_quality.worst_at.x(), r.dense_quality.worst_at.y()}}};
+  if (!r.boundary_problem.empty()) rep["boundary_problem"] = r.boundary_problem;
   rep["tspline"]["control_points_optimized"] = r.control_points_optimized;
   rep["valid"] = r.valid();
   rep["good"] = r.good(ad.min_jacobian);
@@ -152,6 +161,19 @@ nlohmann::json param_report(const ParameterizationResult& r, const std::string& 
                    {"cells_refined_after", it.refined_cells},
                    {"interpolation_relative_residual", it.fit.relative_residual},
                    {"control_points_optimized", it.control_points_optimized},
+                   {"untangling",
+                    {{"free_points", it.untangling.free_points},
+                     {"elements", it.untangling.elements},
+                     {"samples", it.untangling.samples},
+                     {"stages", it.untangling.stages},
+                     {"lbfgs_iterations", it.untangling.iterations},
+                     {"evaluations", it.untangling.evaluations},
+                     {"sample_refinements", it.untangling.sample_refinements},
+                     {"samples_nonpositive_before", it.untangling.before.nonpositive},
+                     {"samples_nonpositive_after", it.untangling.after.nonpositive},
+                     {"certified", it.untangling.certified},
+                     {"stop_reason", it.untangling.stop_reason},
+                     {"seconds", it.untangling.seconds}}},
                    {"jacobian", map_quality_json(it.quality)},
                    {"seconds", it.seconds}});
   if (ad.certify)
@@ -162,8 +184,7 @@ nlohmann::json param_report(const ParameterizationResult& r, const std::string& 
   rep["adaptive"] = {{"max_rounds", ad.max_adapt},
                      {"stall_rounds", ad.stall_rounds},
                      {"max_cells", ad.max_cells},
-                     {"control_point_optimization", ad.optimize_control_points},
-                     {"control_point_power", ad.control_point_power},
+                     {"map_untangling", ad.optimize_control_points},
                      {"iterations", its},
                      {"kept_iteration", r.kept_iteration},
                      {"stop_reason", r.stop_reason}};
