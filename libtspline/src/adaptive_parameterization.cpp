@@ -82,17 +82,38 @@ std::vector<int> cells_to_refine(const TMesh& mesh, const std::vector<CellMapQua
 }
 
 // The ranking of iterations: certified first, then fewest Gauss points with
-// det J <= 0, then the highest min J_r over the whole map (dense sample).
+// det J <= 0, then good (J_r >= delta at the Gauss points), then the highest
+// min J_r over the whole map (dense sample).
 struct Score {
   bool certified = false;
   std::size_t nonpositive = 0;
+  bool good = false;  // J_r >= delta at every Gauss point (the paper's criterion)
   double min_mean_ratio = -1.0;
   bool better_than(const Score& o) const {
     if (certified != o.certified) return certified;
     if (nonpositive != o.nonpositive) return nonpositive < o.nonpositive;
+    if (good != o.good) return good;
     return min_mean_ratio > o.min_mean_ratio + 1e-12;
   }
 };
+
+// Positions for a refined T-mesh: old vertices keep theirs, new boundary
+// vertices go on the polygon, new interior vertices where the map puts them.
+std::vector<Eigen::Vector2d> place_new_vertices(const TMesh& coarse, const std::vector<Eigen::Vector2d>& coarse_x,
+                                                const TMesh& fine, const TSplineMap& map,
+                                                const BoundaryMap& boundary) {
+  std::vector<Eigen::Vector2d> x(fine.num_vertices());
+  for (int v = 0; v < static_cast<int>(x.size()); ++v) {
+    const int old = coarse.find_vertex(fine.vertex_ipos(v));
+    if (old >= 0)
+      x[v] = coarse_x[old];
+    else if (fine.vertex_on_boundary(v))
+      x[v] = boundary.point_at(fine.vertex_param(v));
+    else
+      x[v] = map.point(fine.vertex_param(v));
+  }
+  return x;
+}
 
 }  // namespace
 
@@ -129,8 +150,41 @@ ParameterizationResult run_parameterization(const Polygon& polygon, const Parame
                              : transfer_map(*previous, f.mesh, &rec.fit);
     t_fit += seconds_since(t0);
     if (it == 0) {
-      r.boundary_problem = corner_problem(map, f.boundary);
+      // Before the boundary curve is frozen: where det J <= 0 at a corner of
+      // the square, the spline's end tangents overshoot the polygon's angle on
+      // the coarse border spans; refine the corner cells and fit again from the
+      // polygon (the curve then follows the polygon closer to the corner).
+      for (int round = 0; round < 8; ++round) {
+        r.boundary_problem = corner_problem(map, f.boundary);
+        if (r.boundary_problem.empty()) break;
+        const TMesh coarse = f.mesh;
+        std::size_t refined = 0;
+        for (const Eigen::Vector2d& uv : {Eigen::Vector2d(0, 0), Eigen::Vector2d(1, 0), Eigen::Vector2d(1, 1),
+                                         Eigen::Vector2d(0, 1)}) {
+          const int c = map.basis().locate(uv);
+          if (coarse.cell_level(c) >= opt.max_level) continue;
+          f.mesh.refine(coarse.cell_node(c));
+          ++refined;
+        }
+        if (refined == 0) break;
+        f.mesh.balance();
+        f.mesh.build_topology();
+        f.optimized = place_new_vertices(coarse, f.optimized, f.mesh, map, f.boundary);
+        log("boundary: det J <= 0 at a corner of the square; refined the corner cells, now " +
+            std::to_string(f.mesh.num_cells()) + " cells");
+        map = fit_tspline(f.mesh, f.optimized, f.boundary, &rec.fit);
+      }
       if (!r.boundary_problem.empty()) log("boundary: " + r.boundary_problem);
+    }
+    // The interpolant competes with its untangled version when it is certified
+    // (the untangling energy favours the mean of 1/J_r, the threshold the minimum).
+    std::optional<TSplineMap> interpolant;
+    MapCertification interpolant_cert;
+    if (ad.optimize_control_points && ad.certify) {
+      const auto t1 = std::chrono::steady_clock::now();
+      interpolant_cert = certify_map(map, ad.certification);
+      if (interpolant_cert.certified_valid()) interpolant = map;
+      t_certify += seconds_since(t1);
     }
     // Step 3: global untangling and smoothing.
     MapCertification cert;
@@ -159,7 +213,21 @@ ParameterizationResult run_parameterization(const Polygon& polygon, const Parame
     // Step 4: quality.
     const auto t2 = std::chrono::steady_clock::now();
     std::vector<CellMapQuality> cells;
-    const MapQualityStats quality = map_quality(map, ad.gauss, &cells);
+    MapQualityStats quality = map_quality(map, ad.gauss, &cells);
+    if (interpolant) {
+      std::vector<CellMapQuality> icells;
+      const MapQualityStats iq = map_quality(*interpolant, ad.gauss, &icells);
+      if (!cert.certified_valid() || iq.min_mean_ratio > quality.min_mean_ratio) {
+        log("kept the interpolating map: certified, and its min J_r at Gauss points " +
+            std::to_string(iq.min_mean_ratio) + " is higher than the untangled map's " +
+            std::to_string(quality.min_mean_ratio));
+        map = std::move(*interpolant);
+        cert = std::move(interpolant_cert);
+        quality = iq;
+        cells = std::move(icells);
+        rec.control_points_optimized = false;
+      }
+    }
     const DenseMapQuality dense = dense_map_quality(map, ad.dense_samples);
     t_check += seconds_since(t2);
     const bool certified = !ad.certify || cert.certified_valid();
@@ -186,7 +254,8 @@ ParameterizationResult run_parameterization(const Polygon& polygon, const Parame
       for (int v = 0; v < static_cast<int>(x.size()); ++v) x[v] = map.point(f.mesh.vertex_param(v));
       on_iteration(it, f.mesh, x, map, cells);
     }
-    const Score score{certified, quality.nonpositive_det, dense.min_mean_ratio};
+    const Score score{certified, quality.nonpositive_det,
+                      quality.nonpositive_det == 0 && quality.min_mean_ratio >= ad.min_jacobian, dense.min_mean_ratio};
     if (!best || score.better_than(best->score)) {
       best = Snapshot{f.mesh, map, rec.control_points_optimized, rec.fit, quality, dense, cells, cert, score};
       best_it = it;
@@ -203,9 +272,6 @@ ParameterizationResult run_parameterization(const Polygon& polygon, const Parame
       r.stop_reason = r.boundary_problem;
     } else if (it >= ad.max_adapt) {
       r.stop_reason = "reached --max-adapt " + std::to_string(ad.max_adapt);
-    } else if (certified && best->score.certified && it > best_it) {
-      r.stop_reason = "certified; refining the cells with J_r < " + std::to_string(ad.min_jacobian) +
-                      " did not raise the minimum (it is set by the boundary and the corners)";
     } else if (it - best_it >= ad.stall_rounds) {
       r.stop_reason = "no improvement in the last " + std::to_string(ad.stall_rounds) +
                       " rounds (the remaining distortion is not one refinement can remove)";

@@ -212,7 +212,8 @@ inline SampleJacobian sample_jacobian(const std::array<double, 16>& X, const std
 
 }  // namespace
 
-double MapEnergy::evaluate(const double* xv, double eps, double* gradient, std::size_t* nonpositive) const {
+double MapEnergy::evaluate(const double* xv, double eps, double* gradient, std::size_t* nonpositive,
+                           double power) const {
   const auto& es = extraction_.elements();
   const int threads = options_.threads;
   std::vector<double> energy(threads, 0.0);
@@ -248,12 +249,16 @@ double MapEnergy::evaluate(const double* xv, double eps, double* gradient, std::
         const double c1 = regularized_det(D, eps);
         const double c2 = c1 / r;  // d chi / dD = (1 + D / r) / 2 = chi / r
         const double f = n2 / c1, gA = (1.0 + D * D) / c1;
-        F += omega * ((1.0 - theta) * f + theta * gA);
+        const double term = (1.0 - theta) * f + theta * gA;
+        // With a power p: omega term^p, so dE = p term^(p-1) omega d(term).
+        const double tp = power == 1.0 ? term : std::pow(term, power);
+        F += omega * tp;
         if (!g) continue;
+        const double chain = power == 1.0 ? 1.0 : power * tp / term;
         // dE/dJ = omega [(1-theta) (2 J - f c2 cof J) + theta (2 D - g c2) cof J] / c1,
         // cof J = dD/dJ = [[J11, -J10], [-J01, J00]].
-        const double a1 = omega * (1.0 - theta) * 2.0 / c1;
-        const double a2 = omega * ((theta * (2.0 * D - gA * c2)) - (1.0 - theta) * f * c2) / c1;
+        const double a1 = chain * omega * (1.0 - theta) * 2.0 / c1;
+        const double a2 = chain * omega * ((theta * (2.0 * D - gA * c2)) - (1.0 - theta) * f * c2) / c1;
         const double G00 = a1 * s.J00 + a2 * s.J11, G01 = a1 * s.J01 - a2 * s.J10;
         const double G10 = a1 * s.J10 - a2 * s.J01, G11 = a1 * s.J11 + a2 * s.J00;
         // Back to dS/ds (= J col 0 * hx) and dS/dt, then to X, X_s, X_t.

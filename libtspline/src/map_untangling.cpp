@@ -20,12 +20,12 @@ namespace {
 // across the barrier between two samples' worth of fold.
 class EnergyFunction final : public ceres::FirstOrderFunction {
  public:
-  EnergyFunction(const MapEnergy& energy, double eps, bool barrier, int* evaluations)
-      : energy_(energy), eps_(eps), barrier_(barrier), evaluations_(evaluations) {}
+  EnergyFunction(const MapEnergy& energy, double eps, bool barrier, double power, int* evaluations)
+      : energy_(energy), eps_(eps), barrier_(barrier), power_(power), evaluations_(evaluations) {}
   bool Evaluate(const double* x, double* cost, double* gradient) const override {
     ++*evaluations_;
     std::size_t nonpositive = 0;
-    *cost = energy_.evaluate(x, eps_, gradient, &nonpositive);
+    *cost = energy_.evaluate(x, eps_, gradient, &nonpositive, power_);
     if (barrier_ && nonpositive > 0) return false;
     return std::isfinite(*cost);
   }
@@ -35,6 +35,7 @@ class EnergyFunction final : public ceres::FirstOrderFunction {
   const MapEnergy& energy_;
   double eps_;
   bool barrier_;
+  double power_;
   int* evaluations_;
 };
 
@@ -93,10 +94,12 @@ MapUntanglingReport untangle_map(TSplineMap& map, const MapUntanglingOptions& op
       resampled = false;
     }
     const bool barrier = eps <= opt.eps_floor;
-    const double E_prev = energy.evaluate(x.data(), eps, nullptr);
+    // The quality phase (barrier) raises each term to quality_power.
+    const double power = barrier ? opt.quality_power : 1.0;
+    const double E_prev = energy.evaluate(x.data(), eps, nullptr, nullptr, power);
     so.max_num_iterations = std::min(opt.max_iterations_per_stage, opt.max_iterations - rep.iterations);
     {
-      ceres::GradientProblem problem(new EnergyFunction(energy, eps, barrier, &rep.evaluations));
+      ceres::GradientProblem problem(new EnergyFunction(energy, eps, barrier, power, &rep.evaluations));
       ceres::GradientProblemSolver::Summary summary;
       Eigen::VectorXd trial = x;
       ceres::Solve(so, problem, trial.data(), &summary);
@@ -105,7 +108,7 @@ MapUntanglingReport untangle_map(TSplineMap& map, const MapUntanglingOptions& op
       if (trial.allFinite()) x = trial;
     }
     ++rep.stages;
-    const double E = energy.evaluate(x.data(), eps, nullptr);
+    const double E = energy.evaluate(x.data(), eps, nullptr, nullptr, power);
     const SampleStats st = energy.stats(x.data());
     bool certified_now = false;
     if (st.nonpositive == 0) {

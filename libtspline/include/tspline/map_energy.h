@@ -92,7 +92,10 @@ class MapEnergy {
 
   /// E_eps at x; if gradient is not null, also dE/dx (num_variables() values);
   /// if nonpositive is not null, the number of samples with det J <= 0.
-  double evaluate(const double* x, double eps, double* gradient, std::size_t* nonpositive = nullptr) const;
+  /// With power p != 1 each sample's term is raised to p (sum_q w_q term_q^p):
+  /// p > 1 weighs the worst samples more, raising the minimum J_r rather than the mean.
+  double evaluate(const double* x, double eps, double* gradient, std::size_t* nonpositive = nullptr,
+                  double power = 1.0) const;
   SampleStats stats(const double* x) const;
 
   int sample_level(std::size_t element) const { return elements_[element].level; }

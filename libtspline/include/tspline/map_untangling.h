@@ -51,6 +51,9 @@ struct MapUntanglingOptions {
   /// Stop once certified and a stage at the floor eps lowered the energy by
   /// less than this fraction.
   double energy_tolerance = 1e-3;
+  /// Exponent of each sample's term in the quality phase (at the floor eps):
+  /// 1 favours the mean of 1/J_r, larger values the minimum J_r.
+  double quality_power = 4.0;
   /// Stages at the floor eps (the quality phase) once certified, at most.
   int max_quality_stages = 5;
   double eps_floor = 1e-9;  ///< smallest eps (normalized det J units)
