@@ -12,6 +12,7 @@
 #include "tspline/errors.h"
 #include "tspline/io/tspline_file.h"
 #include "tspline/map_certification.h"
+#include "tspline/map_quality.h"
 
 namespace tspline_app {
 
@@ -43,6 +44,12 @@ int run_check(const CheckArgs& args) {
   else
     std::printf("certified lower bound of det J / element mean: none (an element has mean det J <= 0)\n");
   std::printf("certified lower bound of det J: %.6g\n", c.min_det_lower_bound);
+  const tspline::DenseMapQuality dq = tspline::dense_map_quality(t.map);
+  const tspline::MapQualityStats gq = tspline::map_quality(t.map, 4);
+  std::printf("J_r min over the whole map: %.6g (dense sample: %d x %d points per element, corners included; at "
+              "(u, v) = (%.6g, %.6g))\n",
+              dq.min_mean_ratio, dq.samples_per_edge + 1, dq.samples_per_edge + 1, dq.worst_at.x(), dq.worst_at.y());
+  std::printf("J_r min at 4 x 4 Gauss points per cell: %.6g\n", gq.min_mean_ratio);
   std::printf("seconds: %.3f\n", c.seconds);
   if (c.certified_valid()) {
     std::printf("result: certified valid (det J > 0 everywhere)\n");

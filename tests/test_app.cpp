@@ -119,6 +119,27 @@ TEST_SUITE("app") {
     CHECK(rep["optimized"]["inverted_cells"] == 0);
   }
 
+  TEST_CASE("real data is cleaned, not rejected: repeated vertices and zero-area spikes, with notes in file numbering") {
+    const fs::path d = scratch("cleaning");
+    // A 4 x 4 square (CW in the file) with a repeated vertex (2 = 1) and a spike
+    // 5 -> 6 -> 7 that doubles back along the top edge: vertices 2 and 6 go.
+    const fs::path in = write_file(d, "spiky.txt",
+                                   "0 0\n0 4\n0 4\n2 4\n3 4\n3.5 4\n4.5 4\n4 4\n4 0\n");
+    const RunResult r = run("param '" + in.string() + "' --corners 0,1,7,8 --out '" + (d / "out").string() + "'", d);
+    CAPTURE(r.err);
+    REQUIRE(r.exit_code == 0);
+    CHECK(r.out.find("note: removed vertex 2 (repeats vertex 1)") != std::string::npos);
+    CHECK(r.out.find("note: removed vertex 6 (tip of a zero-area spike: edges 5-6 and 6-7 overlap)") !=
+          std::string::npos);
+    const auto rep = nlohmann::json::parse(slurp(d / "out" / "report.json"));
+    CHECK(rep["input_cleaning"]["removed_vertices"] == nlohmann::json::array({2, 6}));
+    CHECK(rep["counts"]["polygon_vertices"] == 7);
+    std::set<int> got;
+    for (const auto& c : rep["corners"]["vertices"]) got.insert(c["file_index"].get<int>());
+    CHECK(got == std::set<int>{0, 1, 7, 8});
+    CHECK(rep["certified_valid"] == true);
+  }
+
   TEST_CASE("bad input: each case one clear error line, non-zero exit, no output") {
     const fs::path d = scratch("bad");
     const std::string out = " --out '" + (d / "out").string() + "'";
@@ -138,8 +159,9 @@ TEST_SUITE("app") {
     SUBCASE("non-numeric line") {
       expect_clean_failure(param(write_file(d, "x.txt", "0 0\n1 0\nhello world\n0 1\n")), d, ":3:", 1);
     }
-    SUBCASE("duplicate consecutive vertices") {
-      expect_clean_failure(param(write_file(d, "d.txt", "0 0\n1 0\n1 0\n1 1\n0 1\n")), d, "1 and 2", 1);
+    SUBCASE("a corner given on a vertex that the cleaning removed") {
+      expect_clean_failure(param(write_file(d, "r.txt", "0 0\n1 0\n1 0\n1 1\n0 1\n"), " --corners 0,2,3,4"), d,
+                           "2", 1);
     }
     SUBCASE("self-intersecting polygon names the crossing edges") {
       expect_clean_failure(param(write_file(d, "s.txt", "0 0\n1 1\n1 0\n0 1\n")), d, "0-1", 1);

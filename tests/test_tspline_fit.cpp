@@ -2,6 +2,8 @@
 // optimization and the adaptive loop (Sect. 6.2).
 #include <doctest/doctest.h>
 
+#include <tuple>
+
 #include <Eigen/LU>
 #include <cmath>
 #include <random>
@@ -179,18 +181,17 @@ TEST_SUITE("tspline_fit") {
       CHECK(r.iterations[k + 1].cells > r.iterations[k].cells);
     }
     CHECK(r.iterations.back().refined_cells == 0);
-    // The kept iteration is the best by (det J <= 0 points, then certified
-    // valid before not, then min J_r).
+    // The kept iteration is the best by the documented order: certified, then
+    // fewest Gauss points with det J <= 0, then good (J_r >= delta at every
+    // Gauss point), then the highest whole-map min J_r.
+    auto key = [&](const tspline::AdaptIteration& it) {
+      return std::make_tuple(it.certification.certified_valid(), -static_cast<long long>(it.quality.nonpositive_det),
+                             it.quality.nonpositive_det == 0 && it.quality.min_mean_ratio >= ad.min_jacobian,
+                             it.dense_quality.min_mean_ratio);
+    };
     int best = 0;
-    for (int k = 1; k < static_cast<int>(r.iterations.size()); ++k) {
-      const auto& a = r.iterations[k].quality;
-      const auto& b = r.iterations[best].quality;
-      const bool ca = r.iterations[k].certification.certified_valid(),
-                 cb = r.iterations[best].certification.certified_valid();
-      if (a.nonpositive_det < b.nonpositive_det ||
-          (a.nonpositive_det == b.nonpositive_det && (ca != cb ? ca : a.min_mean_ratio > b.min_mean_ratio)))
-        best = k;
-    }
+    for (int k = 1; k < static_cast<int>(r.iterations.size()); ++k)
+      if (key(r.iterations[k]) > key(r.iterations[best])) best = k;
     CHECK(r.certified_valid() == r.iterations[best].certification.certified_valid());
     CHECK(r.kept_iteration == best);
     CHECK(r.quality.min_mean_ratio == r.iterations[best].quality.min_mean_ratio);

@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "tspline/errors.h"
+#include "tspline/boundary_curve.h"
 #include "tspline/mesh_quality.h"
 
 namespace tspline {
@@ -26,6 +27,7 @@ void validate(const ParameterizationOptions& opt, const AdaptiveOptions& ad) {
   if (ad.gauss < 1 || ad.gauss > 6) fail("Gauss points per direction must be in [1, 6]");
   if (ad.dense_samples < 1 || ad.dense_samples > 64) fail("dense samples per element edge must be in [1, 64]");
   if (ad.stall_rounds < 1) fail("stall rounds must be >= 1");
+  if (!(ad.min_quality_gain >= 0.0)) fail("the minimum quality gain per round must be >= 0");
   if (ad.certification.max_depth < 0 || ad.certification.max_depth > 20)
     fail("--cert-depth must be in [0, 20], got " + std::to_string(ad.certification.max_depth));
   const meshopt::SmoothingOptions& s = opt.smoothing;
@@ -38,21 +40,24 @@ void validate(const ParameterizationOptions& opt, const AdaptiveOptions& ad) {
 
 // Step 2: det J at the corners of the square is the cross product of the two
 // boundary tangents, decided by the border control points alone.
-std::string corner_problem(const TSplineMap& map, const BoundaryMap& boundary) {
+std::string corner_problem(const TSplineMap& map, const BoundaryMap& boundary, std::vector<Eigen::Vector2d>* at) {
   const Eigen::Vector2d uv[4] = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
+  std::string first;
   for (int k = 0; k < 4; ++k) {
     const Eigen::Matrix2d J = map.jacobian(uv[k]);
     const double scale = J.col(0).norm() * J.col(1).norm();
     if (!(J.determinant() > 1e-12 * scale)) {
+      at->push_back(uv[k]);
+      if (!first.empty()) continue;
       std::ostringstream s;
       s << "det J <= 0 at the corner (" << uv[k].x() << "," << uv[k].y()
         << ") of the square: the boundary curve turns by a reflex angle at polygon vertex "
         << boundary.polygon().file_index[boundary.corners().index[k]]
         << " (file numbering); no interior move can fix this, choose other --corners";
-      return s.str();
+      first = s.str();
     }
   }
-  return {};
+  return first;
 }
 
 // Step 5: the cells to refine. Not certified: the cell and a ring of its
@@ -124,9 +129,9 @@ ParameterizationResult run_parameterization(const Polygon& polygon, const Parame
     if (opt.log) opt.log(s);
   };
   // Step 1: the front half.
-  ParameterizationResult r{run_front(polygon, opt), std::nullopt, {}, {}, {}, {}, {}, 0, false, {}, {}, {}, 0};
+  ParameterizationResult r{run_front(polygon, opt), std::nullopt, {}, {}, {}, {}, {}, 0, false, {}, {}, false, {}, 0};
   FrontResult& f = r.front;
-  double t_fit = 0.0, t_untangle = 0.0, t_check = 0.0, t_certify = 0.0, t_refine = 0.0;
+  double t_boundary = 0.0, t_fit = 0.0, t_untangle = 0.0, t_check = 0.0, t_certify = 0.0, t_refine = 0.0;
 
   struct Snapshot {
     TMesh mesh = TMesh(0);
@@ -141,6 +146,7 @@ ParameterizationResult run_parameterization(const Polygon& polygon, const Parame
   };
   std::optional<Snapshot> best;
   int best_it = 0;
+  int last_gain_it = 0;
   std::optional<TSplineMap> previous;
   for (int it = 0;; ++it) {
     const auto t0 = std::chrono::steady_clock::now();
@@ -150,31 +156,42 @@ ParameterizationResult run_parameterization(const Polygon& polygon, const Parame
                              : transfer_map(*previous, f.mesh, &rec.fit);
     t_fit += seconds_since(t0);
     if (it == 0) {
-      // Before the boundary curve is frozen: where det J <= 0 at a corner of
-      // the square, the spline's end tangents overshoot the polygon's angle on
-      // the coarse border spans; refine the corner cells and fit again from the
-      // polygon (the curve then follows the polygon closer to the corner).
-      for (int round = 0; round < 8; ++round) {
-        r.boundary_problem = corner_problem(map, f.boundary);
-        if (r.boundary_problem.empty()) break;
-        const TMesh coarse = f.mesh;
-        std::size_t refined = 0;
-        for (const Eigen::Vector2d& uv : {Eigen::Vector2d(0, 0), Eigen::Vector2d(1, 0), Eigen::Vector2d(1, 1),
-                                         Eigen::Vector2d(0, 1)}) {
-          const int c = map.basis().locate(uv);
-          if (coarse.cell_level(c) >= opt.max_level) continue;
-          f.mesh.refine(coarse.cell_node(c));
-          ++refined;
+      // Before the boundary curve is frozen: det J > 0 at the corners of the
+      // square and a simple curve. Where the spline's tangents overshoot the
+      // polygon's angle at a corner, or the curve crosses itself in a narrow
+      // inlet, its border spans are too coarse: refine those cells and fit
+      // again from the polygon (the curve then follows the polygon closer).
+      for (int round = 0;; ++round) {
+        const auto tb = std::chrono::steady_clock::now();
+        std::vector<Eigen::Vector2d> at;
+        r.boundary_problem = corner_problem(map, f.boundary, &at);
+        const BoundaryCurveCheck simple = check_boundary_curve(map);
+        r.boundary_simple = simple.simple;
+        if (!simple.simple) {
+          at.insert(at.end(), simple.conflicts.begin(), simple.conflicts.end());
+          if (r.boundary_problem.empty()) r.boundary_problem = simple.message;
         }
+        t_boundary += seconds_since(tb);
+        if (r.boundary_problem.empty() || round == 8) break;
+        const TMesh coarse = f.mesh;
+        std::vector<char> split(coarse.num_cells(), 0);
+        for (const Eigen::Vector2d& uv : at) {
+          const int c = map.basis().locate(uv);
+          if (coarse.cell_level(c) < opt.max_level) split[c] = 1;
+        }
+        std::size_t refined = 0;
+        for (int c = 0; c < static_cast<int>(split.size()); ++c)
+          if (split[c]) f.mesh.refine(coarse.cell_node(c)), ++refined;
         if (refined == 0) break;
         f.mesh.balance();
         f.mesh.build_topology();
         f.optimized = place_new_vertices(coarse, f.optimized, f.mesh, map, f.boundary);
-        log("boundary: det J <= 0 at a corner of the square; refined the corner cells, now " +
-            std::to_string(f.mesh.num_cells()) + " cells");
+        log("boundary: " + r.boundary_problem + "; refined " + std::to_string(refined) +
+            " border cells there and fitted again, now " + std::to_string(f.mesh.num_cells()) + " cells");
         map = fit_tspline(f.mesh, f.optimized, f.boundary, &rec.fit);
       }
       if (!r.boundary_problem.empty()) log("boundary: " + r.boundary_problem);
+      else log("boundary: the boundary curve is proven simple and turns by less than 180 degrees at the corners");
     }
     // The interpolant competes with its untangled version when it is certified
     // (the untangling energy favours the mean of 1/J_r, the threshold the minimum).
@@ -246,6 +263,7 @@ ParameterizationResult run_parameterization(const Polygon& polygon, const Parame
     rec.functions = map.basis().size();
     rec.inverted_cells = f.quality_optimized.inverted_cells;
     rec.quality = quality;
+    rec.dense_quality = dense;
     rec.certification = cert;
     rec.certification.cell_certified.clear();
     rec.certification.failures.clear();
@@ -256,6 +274,12 @@ ParameterizationResult run_parameterization(const Polygon& polygon, const Parame
     }
     const Score score{certified, quality.nonpositive_det,
                       quality.nonpositive_det == 0 && quality.min_mean_ratio >= ad.min_jacobian, dense.min_mean_ratio};
+    // A round that certifies, validates or makes good counts as a gain, and so
+    // does one that raises the whole-map min J_r by min_quality_gain.
+    if (!best || score.certified != best->score.certified || score.good != best->score.good ||
+        score.nonpositive < best->score.nonpositive ||
+        score.min_mean_ratio > best->score.min_mean_ratio + ad.min_quality_gain * std::abs(best->score.min_mean_ratio))
+      last_gain_it = it;
     if (!best || score.better_than(best->score)) {
       best = Snapshot{f.mesh, map, rec.control_points_optimized, rec.fit, quality, dense, cells, cert, score};
       best_it = it;
@@ -272,6 +296,11 @@ ParameterizationResult run_parameterization(const Polygon& polygon, const Parame
       r.stop_reason = r.boundary_problem;
     } else if (it >= ad.max_adapt) {
       r.stop_reason = "reached --max-adapt " + std::to_string(ad.max_adapt);
+    } else if (certified && best->score.certified && it > last_gain_it) {
+      r.stop_reason = "certified; refining the cells with J_r < " + std::to_string(ad.min_jacobian) +
+                      " raised the whole-map min J_r by less than " +
+                      std::to_string(static_cast<int>(100 * ad.min_quality_gain)) +
+                      "% (the rest is set by the boundary and the corners)";
     } else if (it - best_it >= ad.stall_rounds) {
       r.stop_reason = "no improvement in the last " + std::to_string(ad.stall_rounds) +
                       " rounds (the remaining distortion is not one refinement can remove)";
@@ -320,6 +349,7 @@ ParameterizationResult run_parameterization(const Polygon& polygon, const Parame
   for (int v = 0; v < static_cast<int>(f.mesh.num_vertices()); ++v) f.optimized[v] = r.map->point(f.mesh.vertex_param(v));
   f.quality_optimized = mesh_quality(f.mesh, f.optimized);
   log("adaptive refinement stopped: " + r.stop_reason + "; kept iteration " + std::to_string(best_it));
+  f.times.push_back({"boundary_curve_check", t_boundary});
   f.times.push_back({"tspline_fit", t_fit});
   f.times.push_back({"map_untangling", t_untangle});
   f.times.push_back({"jacobian_check", t_check});

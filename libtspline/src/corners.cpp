@@ -142,15 +142,20 @@ Corners corners_from_file_indices(const Polygon& p, const std::array<long long, 
   const std::size_t n = p.vertices.size();
   if (n < 4 || p.file_index.size() != n) throw InputError("corners: the polygon must be validated first");
   // Position in the CCW polygon of every file index.
+  // File indices can have gaps where clean_polygon removed vertices.
   constexpr std::size_t kNone = std::numeric_limits<std::size_t>::max();
-  std::vector<std::size_t> pos(n, kNone);
-  for (std::size_t i = 0; i < n; ++i)
-    if (p.file_index[i] < n) pos[p.file_index[i]] = i;
-  const std::string range = " (the file has vertices 0.." + std::to_string(n - 1) + ")";
+  const std::size_t file_n = *std::max_element(p.file_index.begin(), p.file_index.end()) + 1;
+  std::vector<std::size_t> pos(file_n, kNone);
+  for (std::size_t i = 0; i < n; ++i) pos[p.file_index[i]] = i;
+  const std::string range = " (the file has vertices 0.." + std::to_string(file_n - 1) + ")";
   for (int k = 0; k < 4; ++k) {
-    if (f[k] < 0 || f[k] >= static_cast<long long>(n) || pos[static_cast<std::size_t>(f[k])] == kNone)
+    if (f[k] < 0 || f[k] >= static_cast<long long>(file_n))
       throw InputError("corner " + std::to_string(k + 1) + ": vertex index " + std::to_string(f[k]) +
                        " is out of range" + range + "; indices are 0-based, in the file's own numbering");
+    if (pos[static_cast<std::size_t>(f[k])] == kNone)
+      throw InputError("corner " + std::to_string(k + 1) + ": vertex " + std::to_string(f[k]) +
+                       " was removed from the input (a repeated vertex or the tip of a zero-area spike); "
+                       "choose a neighbouring vertex");
     for (int j = 0; j < k; ++j)
       if (f[j] == f[k])
         throw InputError("corner " + std::to_string(k + 1) + ": vertex index " + std::to_string(f[k]) +

@@ -142,6 +142,7 @@ nlohmann::json param_report(const ParameterizationResult& r, const std::string& 
                                   {"points_per_element", (r.dense_quality.samples_per_edge + 1) *
                                                              (r.dense_quality.samples_per_edge + 1)},
                                   {"worst_at", {r.dense_quality.worst_at.x(), r.dense_quality.worst_at.y()}}};
+  rep["boundary_curve_proven_simple"] = r.boundary_simple;
   if (!r.boundary_problem.empty()) rep["boundary_problem"] = r.boundary_problem;
   rep["tspline"]["control_points_optimized"] = r.control_points_optimized;
   rep["valid"] = r.valid();
