@@ -206,6 +206,19 @@ PolygonCleaning clean_polygon(Polygon p) {
     out.notes.push_back("removed vertex " + std::to_string(p.file_index[dropped]) + " " + why);
   };
   bool changed = true;
+  // i repeats the last kept vertex: the one later in the file goes (the
+  // closing vertex of a file that repeats its first one, say).
+  auto repeats = [&](std::size_t i) {
+    if (keep.empty() || !(p.vertices[keep.back()] == p.vertices[i])) return false;
+    changed = true;
+    if (p.file_index[i] < p.file_index[keep.back()]) {
+      note(keep.back(), "(repeats vertex " + std::to_string(p.file_index[i]) + ")");
+      keep.back() = i;
+    } else {
+      note(i, "(repeats vertex " + std::to_string(p.file_index[keep.back()]) + ")");
+    }
+    return true;
+  };
   std::vector<std::size_t> order(n0);
   for (std::size_t i = 0; i < n0; ++i) order[i] = i;
   // Repeat around the closing seam until nothing changes (at most a few passes).
@@ -213,11 +226,7 @@ PolygonCleaning clean_polygon(Polygon p) {
     changed = false;
     keep.clear();
     for (std::size_t i : order) {
-      if (!keep.empty() && p.vertices[keep.back()] == p.vertices[i]) {
-        note(i, "(repeats vertex " + std::to_string(p.file_index[keep.back()]) + ")");
-        changed = true;
-        continue;
-      }
+      if (repeats(i)) continue;
       while (keep.size() >= 2 && spike(keep[keep.size() - 2], keep.back(), i)) {
         note(keep.back(), "(tip of a zero-area spike: edges " + std::to_string(p.file_index[keep[keep.size() - 2]]) +
                               "-" + std::to_string(p.file_index[keep.back()]) + " and " +
@@ -227,11 +236,7 @@ PolygonCleaning clean_polygon(Polygon p) {
         changed = true;
         if (!keep.empty() && p.vertices[keep.back()] == p.vertices[i]) break;
       }
-      if (!keep.empty() && p.vertices[keep.back()] == p.vertices[i]) {
-        note(i, "(repeats vertex " + std::to_string(p.file_index[keep.back()]) + ")");
-        changed = true;
-        continue;
-      }
+      if (repeats(i)) continue;
       keep.push_back(i);
     }
     // Rotate so that the seam between the last and first vertex is looked at too.
