@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Stage timings of the front half at about 1e3, 1e4, 1e5 (and 2.6e5) cells, Release build.
 # Usage: bash bench/run_benchmarks.sh [POLYGON]   (default: tests/data/polygons/flower.txt)
+# Whole runs of `tspline param` on the bundled coastlines: bench/bench_coastlines.sh.
 # A second table refines a boundary-dominated domain (fjords) by tolerance alone.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -18,7 +19,7 @@ for tol in 1e-5 1e-7 1e-8; do
   ./build/bench/bench_front tests/data/polygons/fjords.txt 3 "$tol"
 done
 echo "T-spline stages on $POLY (initial level 5, 7, 9; tol-rel 1e-6); fit includes its own basis build"
-printf "%9s %9s %9s %9s %9s %9s %9s %8s\n" cells functions basis fit check cpo20 peak_MiB min_Jr
+printf "%9s %9s %9s %9s %9s %9s %9s %8s\n" cells functions basis fit check dense peak_MiB min_Jr
 for level in 5 7 9; do
   ./build/bench/bench_fit "$POLY" "$level" 1e-6
 done
@@ -26,6 +27,11 @@ echo "Certified validity (Bezier elements, (8,8) Bernstein numerator) on $POLY (
 printf "%9s %9s %9s %9s %9s %9s %9s %9s %9s %13s %9s\n" cells elements functions fit extract certify us_per_el check certified min_rel_bound max_depth
 for level in 5 7 8; do
   ./build/bench/bench_certify "$POLY" "$level" 1e-6
+done
+echo "Global untangling of the map (map_untangling.h) on tests/data/coastlines/bali.txt, initial level 3, 6, 8 (default tolerance)"
+printf "%9s %9s %9s %9s %6s %7s %7s %9s %9s %13s %9s\n" cells elements free_pts samples stages lbfgs evals seconds certified min_rel_bound min_Jr
+for level in 3 6 8; do
+  ./build/bench/bench_untangle tests/data/coastlines/bali.txt "$level" | tail -n 1
 done
 echo "IGA Poisson on the unit square (identity map), uniform analysis T-mesh 2^L x 2^L, sin(pi x) sin(pi y)"
 printf "%5s %9s %9s %8s %11s %10s %8s %-6s %9s %9s %9s\n" level cells dofs space_s dirichlet_s assembly_s solve_s solver residual max_err peak_MiB

@@ -13,7 +13,6 @@
 
 #include "separable_maps.h"
 #include "test_support.h"
-#include "tspline/control_point_optimization.h"
 #include "tspline/map_certification.h"
 #include "tspline/map_energy.h"
 #include "tspline/map_untangling.h"

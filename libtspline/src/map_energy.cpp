@@ -7,7 +7,6 @@
 #include <stdexcept>
 #include <thread>
 
-#include "tspline/control_point_optimization.h"
 #include "tspline/map_quality.h"
 
 namespace tspline {

@@ -293,4 +293,11 @@ void TSplineBasis::evaluate(int c, const Eigen::Vector2d& uv, BasisValues& out, 
   }
 }
 
+bool touches_border(const BlendingFunction& f) {
+  auto open_end = [](const std::array<double, 5>& k) {
+    return (k[0] == 0.0 && k[3] == 0.0) || (k[1] == 1.0 && k[4] == 1.0);
+  };
+  return open_end(f.knots_xi) || open_end(f.knots_eta);
+}
+
 }  // namespace tspline

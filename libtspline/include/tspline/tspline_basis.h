@@ -49,6 +49,11 @@ struct BlendingFunction {
 /// used so that the basis is defined on the closed square. d1, d2 may be null.
 double cubic_bspline(const std::array<double, 5>& knots, double t, double* d1 = nullptr, double* d2 = nullptr);
 
+/// True iff blending function f is non-zero somewhere on the border of [0,1]^2
+/// (four repeated knots at 0 or 1 in some direction): the functions whose
+/// control points define the boundary curve.
+bool touches_border(const BlendingFunction& f);
+
 /// Values and derivatives of the normalized functions R_alpha = N_alpha / sum N_beta
 /// (Eq. 6) that are non-zero somewhere on a cell.
 struct BasisValues {
