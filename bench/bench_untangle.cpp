@@ -45,6 +45,7 @@ int main(int argc, char** argv) {
     uopt.energy.weighting = tspline::ElementWeighting::Area;
   if (const char* v = std::getenv("UNTANGLE_MIN_DECREASE")) uopt.min_decrease = std::atof(v);
   if (const char* v = std::getenv("UNTANGLE_GAUSS")) uopt.energy.gauss = std::atoi(v);
+  if (const char* v = std::getenv("UNTANGLE_LEGENDRE"); v && *v == '1') uopt.energy.lobatto = false;
   if (verbose)
     uopt.progress = [](const tspline::UntanglingProgress& p) {
       std::printf("  stage %3d eps %9.3g E %12.6g iters %6d samples det<=0 %7zu min det %10.3g min Jr %8.4f%s\n",

@@ -63,6 +63,8 @@ TEST_SUITE("map_untangling") {
           const TSplineMap map = perturbed_map(seed, amplitude);
           tspline::MapEnergyOptions eo;
           eo.weighting = weighting;
+          eo.lobatto = seed == 3;  // both sample rules
+          eo.gauss = eo.lobatto ? 5 : 4;
           MapEnergy energy(map, eo);
           // A finer sample level on some elements exercises the other patterns.
           for (std::size_t e = 0; e < energy.num_elements(); e += 3) energy.set_sample_level(e, 1);
@@ -134,6 +136,7 @@ TEST_SUITE("map_untangling") {
     // With 2 x 2 Gauss points per element, find a perturbed map that is valid
     // at every sample but proven folded by the certificate.
     tspline::MapUntanglingOptions uo;
+    uo.energy.lobatto = false;
     uo.energy.gauss = 2;
     std::optional<TSplineMap> found;
     for (unsigned seed = 1; seed < 400 && !found; ++seed) {

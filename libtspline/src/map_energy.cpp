@@ -20,6 +20,25 @@ double regularized_det(double D, double eps) {
 
 namespace {
 
+// Gauss-Lobatto nodes and weights on [0,1] (n = 3, 4, 5): the end points are
+// nodes, so the samples include every element's corners and edges, where maps
+// fold first (thin slivers along the border).
+void lobatto_points_01(int n, std::vector<double>& p, std::vector<double>& w) {
+  p.clear(), w.clear();
+  if (n == 3) {
+    p = {0.0, 0.5, 1.0};
+    w = {1.0 / 6, 4.0 / 6, 1.0 / 6};
+  } else if (n == 4) {
+    const double a = 0.5 / std::sqrt(5.0);
+    p = {0.0, 0.5 - a, 0.5 + a, 1.0};
+    w = {1.0 / 12, 5.0 / 12, 5.0 / 12, 1.0 / 12};
+  } else {
+    const double a = 0.5 * std::sqrt(3.0 / 7.0);
+    p = {0.0, 0.5 - a, 0.5, 0.5 + a, 1.0};
+    w = {1.0 / 20, 49.0 / 180, 16.0 / 45, 49.0 / 180, 1.0 / 20};
+  }
+}
+
 // Derivative of B_i^3 at s.
 std::array<double, 4> bernstein3_derivative(double s) {
   const double r = 1.0 - s;
@@ -47,7 +66,9 @@ void parallel_ranges(std::size_t n, int threads, Body&& body) {
 
 MapEnergy::MapEnergy(const TSplineMap& map, const MapEnergyOptions& opt)
     : options_(opt), extraction_(map.basis()) {
-  if (opt.gauss < 1 || opt.gauss > 6) throw std::invalid_argument("MapEnergy: gauss must be in [1, 6]");
+  if (!opt.lobatto && (opt.gauss < 1 || opt.gauss > 6)) throw std::invalid_argument("MapEnergy: gauss must be in [1, 6]");
+  if (opt.lobatto && (opt.gauss < 3 || opt.gauss > 5))
+    throw std::invalid_argument("MapEnergy: Gauss-Lobatto points per direction must be in [3, 5]");
   if (!(opt.theta >= 0.0 && opt.theta < 1.0)) throw std::invalid_argument("MapEnergy: theta must be in [0, 1)");
   if (opt.max_sample_level < 0 || opt.max_sample_level > 4)
     throw std::invalid_argument("MapEnergy: max_sample_level must be in [0, 4]");
@@ -56,7 +77,10 @@ MapEnergy::MapEnergy(const TSplineMap& map, const MapEnergyOptions& opt)
 
   // Sample patterns per level.
   std::vector<double> gp, gw;
-  gauss_points_01(opt.gauss, gp, gw);
+  if (opt.lobatto)
+    lobatto_points_01(opt.gauss, gp, gw);
+  else
+    gauss_points_01(opt.gauss, gp, gw);
   for (int l = 0; l <= opt.max_sample_level; ++l) {
     Pattern p;
     const int m = 1 << l;
