@@ -167,7 +167,12 @@ DomainInput read_domain(const std::string& path, const DomainReadOptions& option
   const QuietGdal quiet;
   std::unique_ptr<GDALDataset, DatasetCloser> ds(static_cast<GDALDataset*>(
       GDALOpenEx(path.c_str(), GDAL_OF_VECTOR | GDAL_OF_READONLY, nullptr, nullptr, nullptr)));
-  if (!ds) throw InputError(path + ": not a vector file that GDAL reads" + QuietGdal::last());
+  if (!ds) {
+    std::error_code ec;
+    if (fs::is_directory(path, ec))
+      throw IoError("cannot read " + path + ": a directory, and not a vector dataset that GDAL reads");
+    throw InputError(path + ": not a vector file that GDAL reads" + QuietGdal::last());
+  }
   // The layer.
   OGRLayer* layer = nullptr;
   if (options.layer) {
