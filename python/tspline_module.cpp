@@ -105,6 +105,8 @@ Map parameterize(const py::object& domain, py::kwargs kwargs) {
     polygon = std::move(d.outer);
     input = std::move(d.description);
   } else {
+    if (dopt.layer || dopt.feature || dopt.polygon_index || dopt.planar)
+      throw tspline::InputError("layer, feature, polygon and planar apply to a file, not to an array of vertices");
     const Array a = domain.cast<Array>();
     const std::size_t n = rows_of(a, "polygon");
     const double* p = a.data();

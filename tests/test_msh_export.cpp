@@ -90,6 +90,11 @@ TEST_SUITE("msh_export") {
         worst_interior = std::max(worst_interior, (x - map.point(e.lo + st.cwiseProduct(e.hi - e.lo))).norm() / diameter);
       }
     }
+    // No two nodes at the same point (Gmsh's own check merges them).
+    gmsh::model::mesh::removeDuplicateNodes();
+    std::vector<std::size_t> after;
+    gmsh::model::mesh::getNodes(after, coord, param);
+    CHECK(after.size() == node_tags.size());
     gmsh::clear();
     MESSAGE("flower: " << tags.size() << " type-36 elements, " << stats.nodes << " nodes; max |node - S| / diameter "
                        << worst << "; Lagrange geometry vs S at Gauss points: " << worst_interior

@@ -124,6 +124,8 @@ def test_errors_are_python_exceptions():
     with pytest.raises(tspline.InputError) as e:
         tspline.parameterize(bowtie)
     assert isinstance(e.value, ValueError) and "intersect" in str(e.value)
+    with pytest.raises(tspline.InputError, match="apply to a file"):
+        tspline.parameterize(np.loadtxt(FLOWER), layer="coast")
     with pytest.raises(OSError, match="nonesuch"):
         tspline.load("/nonesuch/tspline.json")
     with pytest.raises(TypeError, match="unknown keyword argument 'tolerance'"):

@@ -1,6 +1,8 @@
 #include "tspline/io/msh_export.h"
 
 #include <array>
+#include <cmath>
+#include <cstdint>
 #include <limits>
 #include <map>
 #include <sstream>
@@ -24,28 +26,34 @@ const double kQua16Local[16][2] = {
 
 namespace {
 
-/// lo + (hi - lo) k / 3 for k = 3 * local (exact at k = 0 and 3 for dyadic
-/// bounds, and the same double for two elements with the same bounds).
-double node_coordinate(double lo, double hi, double local) {
-  const int k = static_cast<int>(local * 3.0 + 0.5);
-  return lo + (hi - lo) * k / 3.0;
+/// The parametric coordinate lo + (hi - lo) k / 3 of a node, exactly, as an
+/// integer in units of 1 / (3 kRoot): element bounds are integer T-mesh
+/// coordinates / kRoot, so a point that two elements compute in different ways
+/// (the coarse element's 1/3 and a fine neighbour's 2/3 of its half) gets one key.
+std::int64_t node_key(double lo, double hi, double local) {
+  const std::int64_t k = static_cast<std::int64_t>(local * 3.0 + 0.5);
+  const auto a = static_cast<std::int64_t>(std::llround(lo * static_cast<double>(TMesh::kRoot)));
+  const auto b = static_cast<std::int64_t>(std::llround(hi * static_cast<double>(TMesh::kRoot)));
+  return 3 * a + (b - a) * k;
 }
+
+double key_coordinate(std::int64_t key) { return static_cast<double>(key) / (3.0 * static_cast<double>(TMesh::kRoot)); }
 
 }  // namespace
 
 std::string msh_document(const TSplineMap& map, MshExportStats* stats) {
   const BezierExtraction extraction(map.basis());
-  std::map<std::pair<double, double>, std::size_t> node_of;  // parametric position -> node tag
+  std::map<std::pair<std::int64_t, std::int64_t>, std::size_t> node_of;  // exact parametric position -> node tag
   std::vector<Eigen::Vector2d> nodes;
   std::vector<std::array<std::size_t, 16>> elements;
   elements.reserve(extraction.elements().size());
   for (const BezierElement& e : extraction.elements()) {
     std::array<std::size_t, 16> conn{};
     for (int k = 0; k < 16; ++k) {
-      const std::pair<double, double> uv(node_coordinate(e.lo.x(), e.hi.x(), kQua16Local[k][0]),
-                                         node_coordinate(e.lo.y(), e.hi.y(), kQua16Local[k][1]));
-      auto [it, inserted] = node_of.emplace(uv, nodes.size() + 1);
-      if (inserted) nodes.push_back(map.point({uv.first, uv.second}));
+      const std::pair<std::int64_t, std::int64_t> key(node_key(e.lo.x(), e.hi.x(), kQua16Local[k][0]),
+                                                       node_key(e.lo.y(), e.hi.y(), kQua16Local[k][1]));
+      auto [it, inserted] = node_of.emplace(key, nodes.size() + 1);
+      if (inserted) nodes.push_back(map.point({key_coordinate(key.first), key_coordinate(key.second)}));
       conn[k] = it->second;
     }
     elements.push_back(conn);

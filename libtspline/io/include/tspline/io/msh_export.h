@@ -9,10 +9,12 @@
 // Bezier control points), in Gmsh's order for type 36: the 4 corners
 // counter-clockwise from (0,0), then two nodes per edge along the edges 0-1,
 // 1-2, 2-3, 3-0, then the 4 interior nodes counter-clockwise from (1/3,1/3).
-// Nodes at the same parametric position are one node, so elements that share a
-// whole edge share its 4 nodes; at a T-junction the edge of the coarse element
-// and those of the fine elements along it have different nodes (a
-// non-conforming, "hanging" interface).
+// Nodes at the same parametric position (compared exactly, in integer T-mesh
+// units) are one node, so elements that share a whole edge share its 4 nodes;
+// at a T-junction the edge of the coarse element and those of the fine elements
+// along it share only the nodes at common positions (the ends, and where the
+// coarse edge's 1/3 and 2/3 points meet a fine node): a non-conforming,
+// "hanging" interface.
 //
 // What is lost: the T-spline is C2 (rational) inside the smooth parts of the
 // map; the Lagrange elements only interpolate it at the nodes, are C0 across
