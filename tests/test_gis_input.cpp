@@ -184,13 +184,18 @@ TEST_SUITE("gis_input") {
     CHECK(proj["lat_0"].get<double>() == doctest::Approx(42.15).epsilon(0.005));
     CHECK(dom.description["units"] == "m");
     const double polygon_area = std::abs(shoelace(dom.outer.vertices));
-    const tspline::ParameterizationResult r = tspline::run_parameterization(dom.outer, {}, {});
+    // A boundary tolerance of 1e-4 of the squared diagonal (default 1e-5): 292
+    // cells instead of ~1,500, about 1 s instead of 12 (3 min under ASan), and
+    // the area is still well within 1 %.
+    tspline::ParameterizationOptions opt;
+    opt.tolerance_relative = 1e-4;
+    const tspline::ParameterizationResult r = tspline::run_parameterization(dom.outer, opt, {});
     REQUIRE(r.map.has_value());
     CHECK(r.certified_valid());
     const double area = map_area(*r.map);
     MESSAGE("Corsica: polygon area " << polygon_area / 1e6 << " km2, map area " << area / 1e6 << " km2");
     CHECK(area / 1e6 == doctest::Approx(8665.0).epsilon(0.01));
-    CHECK(area == doctest::Approx(polygon_area).epsilon(1e-3));
+    CHECK(area == doctest::Approx(polygon_area).epsilon(5e-3));  // measured 0.09 %
     // --planar keeps the degrees.
     tspline::io::DomainReadOptions planar;
     planar.planar = true;
