@@ -1,5 +1,6 @@
-// `tspline export TSPLINE.json --bezier OUT.json`: Bezier extraction export
-// (docs/bezier_format.md).
+// `tspline export TSPLINE.json [--bezier OUT.json] [--msh OUT.msh]`: Bezier
+// extraction export (docs/bezier_format.md) and curved Lagrange elements for
+// Gmsh (msh_export.h).
 #include <iostream>
 #include <memory>
 
@@ -7,13 +8,14 @@
 #include "tspline/errors.h"
 #include "tspline/io/atomic_file.h"
 #include "tspline/io/bezier_export.h"
+#include "tspline/io/msh_export.h"
 #include "tspline/io/tspline_file.h"
 
 namespace tspline_app {
 
 void add_export_command(CLI::App& app, CommandAction& action) {
   struct Args {
-    std::string file, bezier;
+    std::string file, bezier, msh;
     bool quiet = false;
   };
   auto a = std::make_shared<Args>();
@@ -21,16 +23,28 @@ void add_export_command(CLI::App& app, CommandAction& action) {
       "export", "Write the T-spline as rational Bezier elements with their extraction operators (Scott et al. "
                 "2011), the interchange form for T-spline IGA in finite element codes (docs/bezier_format.md)");
   cmd->add_option("TSPLINE", a->file, "T-spline file written by `tspline param`")->required();
-  cmd->add_option("--bezier", a->bezier, "Output JSON file of Bezier elements")->required();
+  cmd->add_option("--bezier", a->bezier, "Output JSON file of Bezier elements");
+  cmd->add_option("--msh", a->msh,
+                  "Output Gmsh MSH 4.1 file: the Bezier elements as bicubic 16-node Lagrange quadrilaterals "
+                  "(type 36) with their nodes on the map");
   cmd->add_flag("--quiet,-q", a->quiet, "Print errors only");
   cmd->callback([a, &action] {
+    if (a->bezier.empty() && a->msh.empty()) throw CLI::ValidationError("export", "give --bezier and/or --msh");
     action = [a] {
       const tspline::io::LoadedTSpline t = tspline::io::read_tspline_file(a->file);
-      const nlohmann::json doc = tspline::io::bezier_document(t.map, a->file);
-      tspline::io::write_text_atomic(a->bezier, doc.dump() + "\n");
-      if (!a->quiet)
-        std::cout << "wrote " << a->bezier << ": " << doc["elements"].size() << " Bezier elements on "
-                  << t.map.mesh().num_cells() << " cells, " << t.map.basis().size() << " functions" << std::endl;
+      if (!a->bezier.empty()) {
+        const nlohmann::json doc = tspline::io::bezier_document(t.map, a->file);
+        tspline::io::write_text_atomic(a->bezier, doc.dump() + "\n");
+        if (!a->quiet)
+          std::cout << "wrote " << a->bezier << ": " << doc["elements"].size() << " Bezier elements on "
+                    << t.map.mesh().num_cells() << " cells, " << t.map.basis().size() << " functions" << std::endl;
+      }
+      if (!a->msh.empty()) {
+        const tspline::io::MshExportStats s = tspline::io::write_msh_file(a->msh, t.map);
+        if (!a->quiet)
+          std::cout << "wrote " << a->msh << ": " << s.elements << " bicubic quadrilaterals (Gmsh type 36), "
+                    << s.nodes << " nodes" << std::endl;
+      }
       return 0;
     };
   });

@@ -1,6 +1,6 @@
 // `tspline poisson`: solve -Laplace(u) = f, u = g on the boundary, with T-spline
 // isogeometric analysis on the domain of a T-spline file, and refine adaptively
-// or uniformly (libtspline/include/tspline/poisson.h). Writes convergence.csv,
+// or uniformly (libtspline/include/tspline/poisson.h). Writes convergence.csv, convergence.png,
 // report.json and solution.pvd + solution/step_NNN.vtu into OUTDIR.
 #include <unistd.h>
 
@@ -27,6 +27,7 @@
 #include "expression.h"
 #include "tspline/errors.h"
 #include "tspline/io/atomic_file.h"
+#include "tspline/io/convergence_plot.h"
 #include "tspline/io/tspline_file.h"
 #include "tspline/io/cell_grid.h"
 #include "tspline/io/vtu_writer.h"
@@ -360,6 +361,7 @@ class PoissonOutput {
       csv << ',' << s.solver.kind << ',' << num(s.solver.relative_residual) << ',' << num(s.seconds) << '\n';
     }
     tspline::io::write_text_atomic((out / "convergence.csv").string(), csv.str());
+    tspline::io::write_convergence_plot((out / "convergence.png").string(), steps_);
     tspline::io::write_pvd((out / "solution.pvd").string(), pvd_);
     tspline::io::write_text_atomic((out / "report.json").string(), report_.dump(2) + "\n");
   }
@@ -463,10 +465,10 @@ int run_poisson(const PoissonArgs& args) {
                   {"steps", steps.size()},
                   {"stop_reason", stop},
                   {"out", args.out_dir},
-                  {"files", {"convergence.csv", "report.json", "solution.pvd", "solution/"}}});
+                  {"files", {"convergence.csv", "convergence.png", "report.json", "solution.pvd", "solution/"}}});
   if (progress.human())
     std::cout << steps.size() << " steps (" << stop
-              << "); wrote convergence.csv, report.json, solution.pvd, solution/"
+              << "); wrote convergence.csv, convergence.png, report.json, solution.pvd, solution/"
               << " to " << args.out_dir << std::endl;
   return 0;
 }
@@ -482,7 +484,7 @@ void add_poisson_command(CLI::App& app, CommandAction& action) {
       "the geometry map stays fixed), and refine adaptively (residual estimator eta_e^2 = int h^2 (f + Laplace "
       "u_h)^2, cells with eta_e > gamma max eta split with their neighbours) or uniformly. Dirichlet data by L2 "
       "projection on the boundary "
-      "functions. Prints one table row per step and writes OUTDIR/convergence.csv, OUTDIR/report.json and "
+      "functions. Prints one table row per step and writes OUTDIR/convergence.csv, OUTDIR/convergence.png, OUTDIR/report.json and "
       "OUTDIR/solution.pvd with OUTDIR/solution/step_NNN.vtu (point data u_h, u_exact, error = u_h - "
       "u_exact; cell "
       "data eta, level, cell). Built-in problems (f = -Laplace(u) analytic, g = u, exact gradient analytic): "

@@ -48,11 +48,11 @@ void add_render_command(CLI::App& app, CommandAction& action) {
   auto a = std::make_shared<RenderArgs>();
   CLI::App* cmd = app.add_subcommand(
       "render",
-      "Draw a PNG of the outputs in DIR without ParaView or a display: the map's mean ratio Jacobian J_r "
+      "Draw a picture (PNG, SVG or PDF) of the outputs in DIR without ParaView or a display: the map's mean ratio Jacobian J_r "
       "(jacobian), the curved T-mesh (tmesh), the control net (control-net) of `tspline param`, or u_h of "
       "`tspline poisson` (solution)");
   cmd->add_option("DIR", a->dir, "Output directory of `tspline param` or `tspline poisson`")->required();
-  cmd->add_option("--png", a->png, "PNG file to write")->required();
+  cmd->add_option("--png,--image", a->png, "Picture to write: PNG, SVG or PDF by the extension")->required();
   cmd->add_option("--view", a->view,
                   "auto (solution if DIR has solution/, else jacobian), tmesh, jacobian, control-net, solution")
       ->capture_default_str();

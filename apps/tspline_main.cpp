@@ -19,10 +19,21 @@
 #include "progress.h"
 #include "tspline/errors.h"
 #include "tspline/io/atomic_file.h"
+#include "tspline/io/gis_reader.h"
 #include "tspline/adaptive_parameterization.h"
 #include "tspline/io/param_output.h"
 #include "tspline/io/polygon_reader.h"
 #include "tspline/parameterization.h"
+
+#if defined(__SANITIZE_ADDRESS__)
+// LeakSanitizer: GDAL/PROJ (driver registry, PROJ contexts) and Cairo/fontconfig
+// (font caches) keep allocations to the end of the process; suppress leaks
+// whose stack passes through those third-party libraries only.
+extern "C" const char* __lsan_default_suppressions() {
+  return "leak:libgdal\nleak:libproj\nleak:libcairo\nleak:libfontconfig\n";
+}
+extern "C" const char* __lsan_default_options() { return "print_suppressions=0"; }
+#endif
 
 namespace {
 
@@ -49,7 +60,7 @@ std::array<long long, 4> parse_corners(const std::string& text) {
 
 int run_param(const std::string& input, const std::string& out_dir, const std::string& corners_text,
               tspline::ParameterizationOptions opt, const tspline::AdaptiveOptions& adaptive, int samples,
-              std::optional<std::size_t> geojson_polygon, tspline_app::OutputMode mode) {
+              const tspline::io::DomainReadOptions& domain_options, tspline_app::OutputMode mode) {
   if (!corners_text.empty()) opt.corners = parse_corners(corners_text);
   if (samples < 1 || samples > 64) throw tspline::InputError("--samples must be in [1, 64]");
   tspline_app::Progress progress(mode);
@@ -58,9 +69,8 @@ int run_param(const std::string& input, const std::string& out_dir, const std::s
   // Fail on an unwritable output directory before any computation.
   tspline::io::ensure_writable_directory(out_dir);
   std::string warnings;
-  tspline::io::PolygonReadOptions ropt;
-  ropt.polygon_index = geojson_polygon;
-  const tspline::Polygon polygon = tspline::io::read_polygon(input, ropt, &warnings);
+  const tspline::io::DomainInput domain = tspline::io::read_domain(input, domain_options, &warnings);
+  const tspline::Polygon& polygon = domain.outer;
   if (!warnings.empty()) progress.log("note: " + warnings);
   tspline::io::AdaptSeriesWriter series(out_dir, samples);
   const tspline::ParameterizationResult result = tspline::run_parameterization(
@@ -75,7 +85,8 @@ int run_param(const std::string& input, const std::string& out_dir, const std::s
         progress.progress("adaptive rounds", it + 1, adaptive.max_adapt + 1);
       });
   series.finish();
-  const nlohmann::json report = tspline::io::param_report(result, input, adaptive);
+  nlohmann::json report = tspline::io::param_report(result, input, adaptive);
+  report["input_geometry"] = domain.description;  // format, layer, CRS, projection (gis_reader.h)
   tspline::io::write_param_outputs(result, out_dir, report, samples);
   progress.settle();
   progress.event({{"event", "result"},
@@ -131,7 +142,8 @@ int main(int argc, char** argv) {
   std::size_t geojson_polygon = 0;
   bool quiet = false;
   param->add_option("DOMAIN", input,
-                    "Polygon file: text ('x y' per line, '#' comments) or GeoJSON Polygon/MultiPolygon")
+                    "Domain file: text polygon ('x y' per line, '#' comments, planar) or any polygon layer GDAL reads "
+                    "(Shapefile, GeoPackage, KML, GML, GeoJSON, ...; longitude/latitude are projected to metres)")
       ->required();
   param->add_option("--out", out_dir, "Output directory (created if missing)")->required();
   param->add_option("--corners", corners,
@@ -161,8 +173,16 @@ int main(int argc, char** argv) {
                     "Stop when the largest node move relative to its local edge length is below this")
       ->capture_default_str();
   auto* gj_opt = param->add_option("--polygon", geojson_polygon,
-                                   "GeoJSON MultiPolygon/FeatureCollection: which polygon (0-based); default "
-                                   "the largest");
+                                   "GIS file (or GeoJSON) with several polygons (in the layer or the --feature): "
+                                   "which one (0-based, file order); default the largest");
+  tspline::io::DomainReadOptions domain_options;
+  std::string layer;
+  std::size_t feature = 0;
+  auto* layer_opt = param->add_option("--layer", layer, "GIS file: layer name or 0-based index; default the first "
+                                                        "layer with polygons");
+  auto* feature_opt = param->add_option("--feature", feature, "GIS file: only this feature (0-based, layer order)");
+  param->add_flag("--planar", domain_options.planar,
+                  "Keep the coordinates as they are (no projection of longitude/latitude to metres)");
   tspline::AdaptiveOptions adaptive;
   int samples = 4;
   param->add_option("--min-jacobian", adaptive.min_jacobian,
@@ -209,9 +229,10 @@ int main(int argc, char** argv) {
     if (param->parsed()) {
       if (tol_opt->count() > 0) opt.tolerance_absolute = tol;
       adaptive.optimize_control_points = !no_cpo;
-      std::optional<std::size_t> gj;
-      if (gj_opt->count() > 0) gj = geojson_polygon;
-      return run_param(input, out_dir, corners, opt, adaptive, samples, gj,
+      if (gj_opt->count() > 0) domain_options.polygon_index = geojson_polygon;
+      if (layer_opt->count() > 0) domain_options.layer = layer;
+      if (feature_opt->count() > 0) domain_options.feature = feature;
+      return run_param(input, out_dir, corners, opt, adaptive, samples, domain_options,
                        tspline_app::output_mode(quiet, json_events));
     }
   } catch (const tspline::InputError& e) {

@@ -1,7 +1,9 @@
 #!/usr/bin/env bash
 # The README's pictures, made by `tspline render` from the bundled example:
 # parameterizes examples/flower.txt, solves the Gaussian-peak Poisson problem
-# adaptively on it, and draws four views into docs/images/.
+# adaptively on it, and draws four views into docs/images/, with the Poisson
+# run's convergence plot; and Corsica from its longitude/latitude GeoJSON (GIS
+# input projected to metres).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/install_deps.sh
@@ -14,3 +16,6 @@ for view in jacobian tmesh control-net; do
   $T render out/flower --view "$view" --size 800x600 --png "docs/images/flower_$view.png"
 done
 $T render out/flower_poisson --view solution --size 800x600 --png docs/images/flower_poisson.png
+cp out/flower_poisson/convergence.png docs/images/flower_convergence.png
+$T param tests/data/gis/corsica_lonlat.geojson --out out/corsica -q
+$T render out/corsica --view jacobian --size 800x600 --png docs/images/corsica_jacobian.png

@@ -3,13 +3,20 @@
 # Release build, then again in an optimized build with debug info under AddressSanitizer and
 # UndefinedBehaviorSanitizer (-O1 -g1). Between the two, installs the Release build into
 # build/install and builds and runs tests/downstream against the installed
-# CMake package. Exits non-zero if any test fails.
+# CMake package (and imports the installed Python module). The Python tests
+# (pytest, tests/python) run after the Release suites, not under the sanitizers.
+# Exits non-zero if any test fails.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/install_deps.sh
 echo "== Release build and tests"
-BUILD_DIR=build BUILD_TYPE=Release bash scripts/build.sh
+# The Python module is built for, and tested with, Debian's interpreter (where
+# install_deps put numpy and pytest), whatever python3 comes first on PATH.
+PYTHON=${PYTHON:-/usr/bin/python3}
+BUILD_DIR=build BUILD_TYPE=Release bash scripts/build.sh -DPython3_EXECUTABLE="$PYTHON"
 ./build/tests/unit_tests
+echo "== Python module (pytest; build/python)"
+PYTHONPATH="$PWD/build/python" "$PYTHON" -m pytest -p no:cacheprovider tests/python
 echo "== Installed package: cmake --install, then a downstream project with find_package(TSpline)"
 rm -rf build/install build/downstream
 cmake --install build --prefix "$PWD/build/install" > build/install.log
@@ -17,6 +24,8 @@ cmake -S tests/downstream -B build/downstream -DCMAKE_BUILD_TYPE=Release -DCMAKE
   > build/downstream.configure.log 2>&1 || { cat build/downstream.configure.log; exit 1; }
 cmake --build build/downstream -j "$(nproc)"
 ./build/downstream/downstream_check
+PYTHONPATH="$PWD/build/install/lib/python3/dist-packages" "$PYTHON" -c \
+  "import tspline, numpy as np; m = tspline.parameterize(np.loadtxt('tests/data/polygons/square.txt'), init_level=2, max_adapt=1); assert m.certified_valid; print('installed Python module: ok')"
 echo "== ASan+UBSan build and tests"
 # -O1 -g1 (line tables for the sanitizer's stack traces): about half the compile
 # time of RelWithDebInfo's -O2 -g, as the sanitizers' documentation recommends.

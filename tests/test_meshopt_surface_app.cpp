@@ -17,10 +17,14 @@
 #include "test_support.h"
 
 #if defined(__SANITIZE_ADDRESS__)
-// LeakSanitizer: OpenCASCADE (libTK*, e.g. its STEP reader's static tables) and
-// Gmsh keep allocations to the end of the process; suppress leaks whose stack
-// passes through those third-party libraries only (our own code stays checked).
-extern "C" const char* __lsan_default_suppressions() { return "leak:libTK\nleak:libgmsh\n"; }
+// LeakSanitizer: OpenCASCADE (libTK*, e.g. its STEP reader's static tables),
+// Gmsh, GDAL/PROJ (driver registry, PROJ contexts) and Cairo/fontconfig (font
+// caches) keep allocations to the end of the process; suppress leaks whose
+// stack passes through those third-party libraries only (our own code stays
+// checked). One definition for the whole unit_tests binary.
+extern "C" const char* __lsan_default_suppressions() {
+  return "leak:libTK\nleak:libgmsh\nleak:libgdal\nleak:libproj\nleak:libcairo\nleak:libfontconfig\n";
+}
 extern "C" const char* __lsan_default_options() { return "print_suppressions=0"; }
 #endif
 

@@ -1,6 +1,7 @@
-// Pictures without a display: the software rasterizer (known pixel counts and
-// colours) and `tspline render` on the outputs of param and poisson (image
-// size, colour variety, drawn fraction; bad input).
+// Pictures without a display: the Cairo canvas (known pixel counts and
+// colours, antialiasing, fonts, SVG and PDF) and `tspline render` on the
+// outputs of param and poisson (image size, colour variety, drawn fraction;
+// bad input), and the convergence plot of `tspline poisson`.
 #include <doctest/doctest.h>
 
 #include <vtkImageData.h>
@@ -11,13 +12,16 @@
 
 #include <filesystem>
 #include <set>
+#include <tuple>
 
 #include "test_support.h"
-#include "tspline/io/raster_image.h"
+#include "tspline/errors.h"
+#include "tspline/io/canvas.h"
 
 namespace fs = std::filesystem;
 using test_support::run_app;
-using tspline::io::RasterImage;
+using tspline::io::Canvas;
+using tspline::io::ImageFormat;
 using tspline::io::Rgb;
 
 namespace {
@@ -61,51 +65,80 @@ PngStats png_stats(const fs::path& file) {
 }  // namespace
 
 TEST_SUITE("render") {
-  TEST_CASE("rasterizer: triangle area, interpolated colours, lines, text") {
-    RasterImage img(200, 100);
+  TEST_CASE("canvas: filled area, no seams, antialiased lines and text, SVG and PDF") {
+    const fs::path d = scratch("canvas");
+    auto count = [](const Canvas& c, auto pred) {
+      std::size_t n = 0;
+      for (int y = 0; y < c.height(); ++y)
+        for (int x = 0; x < c.width(); ++x) n += pred(c.pixel(x, y));
+      return n;
+    };
+    auto distinct = [](const Canvas& c) {
+      std::set<int> s;
+      for (int y = 0; y < c.height(); ++y)
+        for (int x = 0; x < c.width(); ++x) {
+          const Rgb p = c.pixel(x, y);
+          s.insert((p[0] << 16) | (p[1] << 8) | p[2]);
+        }
+      return s.size();
+    };
+    Canvas img(ImageFormat::Png, (d / "a.png").string(), 200, 100);
     img.set_view({0, 0}, {2, 1}, 0, 0, 200, 100);  // 100 pixels per unit, y up
     CHECK((img.to_pixel({0, 0}) - Eigen::Vector2d(0, 100)).norm() < 1e-12);
     CHECK((img.to_pixel({2, 1}) - Eigen::Vector2d(200, 0)).norm() < 1e-12);
-    // Right triangle with legs 100 px: 5000 px^2; pixel centres inside: 5000 +- the diagonal (~100).
-    img.fill_triangle({Eigen::Vector2d(0, 0), Eigen::Vector2d(1, 0), Eigen::Vector2d(0, 1)}, Rgb{0, 0, 0});
-    std::size_t black = 0;
-    for (const Rgb& p : img.pixels()) black += (p == Rgb{0, 0, 0});
+    // Right triangle with legs 100 px: 5000 px^2, +- the diagonal's pixels.
+    img.fill_polygon({Eigen::Vector2d(0, 0), Eigen::Vector2d(1, 0), Eigen::Vector2d(0, 1)}, Rgb{0, 0, 0});
+    const std::size_t black = count(img, [](Rgb p) { return p == Rgb{0, 0, 0}; });
     CHECK(black >= 4900);
     CHECK(black <= 5100);
     // Two triangles sharing an edge leave no seam: a filled unit square = 10000 pixels.
-    RasterImage sq(100, 100);
+    Canvas sq(ImageFormat::Png, (d / "b.png").string(), 100, 100);
     sq.set_view({0, 0}, {1, 1}, 0, 0, 100, 100);
-    sq.fill_triangle({Eigen::Vector2d(0, 0), Eigen::Vector2d(1, 0), Eigen::Vector2d(1, 1)}, Rgb{1, 2, 3});
-    sq.fill_triangle({Eigen::Vector2d(0, 0), Eigen::Vector2d(1, 1), Eigen::Vector2d(0, 1)}, Rgb{1, 2, 3});
-    std::size_t filled = 0;
-    for (const Rgb& p : sq.pixels()) filled += (p == Rgb{1, 2, 3});
-    CHECK(filled == 10000);
-    // Scalars interpolate linearly: s = x on the square, colour = viridis(s).
-    RasterImage grad(100, 100);
-    grad.set_view({0, 0}, {1, 1}, 0, 0, 100, 100);
-    auto col = [](double s) { return tspline::io::viridis(s); };
-    grad.fill_triangle({Eigen::Vector2d(0, 0), Eigen::Vector2d(1, 0), Eigen::Vector2d(1, 1)}, {0.0, 1.0, 1.0}, col);
-    grad.fill_triangle({Eigen::Vector2d(0, 0), Eigen::Vector2d(1, 1), Eigen::Vector2d(0, 1)}, {0.0, 1.0, 0.0}, col);
-    CHECK(grad.pixel(0, 50) == tspline::io::viridis(0.005));
-    CHECK(grad.pixel(99, 50) == tspline::io::viridis(0.995));
-    CHECK(grad.pixel(49, 10) == tspline::io::viridis(0.495));
+    sq.fill_polygon({Eigen::Vector2d(0, 0), Eigen::Vector2d(1, 0), Eigen::Vector2d(1, 1)}, Rgb{1, 2, 3});
+    sq.fill_polygon({Eigen::Vector2d(0, 0), Eigen::Vector2d(1, 1), Eigen::Vector2d(0, 1)}, Rgb{1, 2, 3});
+    CHECK(count(sq, [](Rgb p) { return p == Rgb{1, 2, 3}; }) == 10000);
     CHECK(tspline::io::viridis(0.0) == Rgb{68, 1, 84});
     CHECK(tspline::io::viridis(1.0) == Rgb{253, 231, 37});
-    // A 3-pixel line from (10, 49.5) to (190, 49.5): about 180 x 3 pixels.
-    RasterImage line(200, 100);
+    CHECK(tspline::io::viridis(0.5) == Rgb{33, 144, 141});
+    // A 3-pixel horizontal line on the pixel rows 48..50 from x = 10 to 190:
+    // 180 x 3 full pixels; its round caps are antialiased (grey levels).
+    Canvas line(ImageFormat::Png, (d / "c.png").string(), 200, 100);
     line.set_view({0, 0}, {2, 1}, 0, 0, 200, 100);
-    line.draw_line({0.1, 0.505}, {1.9, 0.505}, Rgb{0, 0, 0}, 3.0);  // on the pixel row centre 49.5
-    std::size_t on = 0;
-    for (const Rgb& p : line.pixels()) on += (p == Rgb{0, 0, 0});
-    CHECK(on >= 3 * 178);
+    line.draw_line({0.1, 0.505}, {1.9, 0.505}, Rgb{0, 0, 0}, 3.0);
+    const std::size_t on = count(line, [](Rgb p) { return p == Rgb{0, 0, 0}; });
+    CHECK(on >= 3 * 180);
     CHECK(on <= 3 * 184);
-    // Text: "1" of the 5x7 font at scale 1 has 10 set pixels.
-    RasterImage text(20, 20);
-    text.draw_text(2, 2, "1", Rgb{0, 0, 0}, 1);
-    std::size_t ink = 0;
-    for (const Rgb& p : text.pixels()) ink += (p == Rgb{0, 0, 0});
-    CHECK(ink == 10);
-    CHECK_THROWS_AS(RasterImage(8, 100), std::invalid_argument);
+    CHECK(distinct(line) > 3);
+    // A diagonal line: antialiased, so many grey levels.
+    Canvas diag(ImageFormat::Png, (d / "d.png").string(), 100, 100);
+    diag.set_view({0, 0}, {1, 1}, 0, 0, 100, 100);
+    diag.draw_line({0.05, 0.1}, {0.95, 0.7}, Rgb{0, 0, 0}, 1.5);
+    CHECK(distinct(diag) >= 10);
+    // Text in a real font: ink, antialiased, widths grow with the text.
+    Canvas text(ImageFormat::Png, (d / "e.png").string(), 120, 40);
+    text.draw_text(5, 30, "0.125", Rgb{0, 0, 0}, 20.0);
+    const std::size_t ink = count(text, [](Rgb p) { return p != Rgb{255, 255, 255}; });
+    CHECK(ink > 60);
+    CHECK(distinct(text) >= 10);
+    CHECK(text.text_width("0.125", 20.0) > text.text_width("0.12", 20.0));
+    CHECK(text.text_width("0.125", 20.0) > 30.0);
+    text.finish();
+    CHECK(png_stats(d / "e.png").width == 120);
+    // SVG and PDF by the same calls.
+    for (auto [fmt, name, magic] : {std::tuple{ImageFormat::Svg, "f.svg", "<?xml"}, std::tuple{ImageFormat::Pdf, "f.pdf", "%PDF"}}) {
+      {
+        Canvas v(fmt, (d / name).string(), 100, 80);
+        v.set_view({0, 0}, {1, 1}, 0, 0, 100, 80);
+        v.fill_polygon({Eigen::Vector2d(0, 0), Eigen::Vector2d(1, 0), Eigen::Vector2d(1, 1)}, Rgb{10, 20, 30});
+        v.draw_text(10, 20, "J_r", Rgb{0, 0, 0});
+        v.finish();
+      }
+      CHECK(test_support::slurp(d / name).rfind(magic, 0) == 0);
+    }
+    CHECK(test_support::contains(test_support::slurp(d / "f.svg"), "<svg"));
+    CHECK(tspline::io::image_format_of("x.PDF") == ImageFormat::Pdf);
+    CHECK_THROWS_AS(tspline::io::image_format_of("x.jpg"), tspline::InputError);
+    CHECK_THROWS_AS(Canvas(ImageFormat::Png, (d / "g.png").string(), 8, 100), std::invalid_argument);
   }
 
   TEST_CASE("tspline render: every view of param and poisson outputs") {
@@ -144,6 +177,24 @@ TEST_SUITE("render") {
       CHECK(st.drawn_fraction >= c.min_drawn);
       CHECK(st.drawn_fraction <= c.max_drawn);
     }
+    // The same view as SVG and PDF, by the extension.
+    for (const char* ext : {"svg", "pdf"}) {
+      const fs::path file = d / (std::string("jacobian.") + ext);
+      const auto r = run_app("render " + q(d / "param") + " --image " + q(file) + " --view jacobian", d);
+      CAPTURE(r.err);
+      REQUIRE(r.exit_code == 0);
+      const std::string text = test_support::slurp(file);
+      CHECK(text.rfind(std::string(ext) == "svg" ? "<?xml" : "%PDF", 0) == 0);
+      CHECK(text.size() > 10000);
+    }
+    // tspline poisson draws convergence.png: errors and eta against DOFs.
+    const PngStats conv = png_stats(d / "poisson" / "convergence.png");
+    MESSAGE("convergence.png: " << conv.colours << " colours, " << conv.drawn_fraction << " drawn");
+    CHECK(conv.width == 800);
+    CHECK(conv.height == 600);
+    CHECK(conv.colours >= 50);  // three curve colours, grid, antialiased text
+    CHECK(conv.drawn_fraction >= 0.02);
+    CHECK(conv.drawn_fraction <= 0.3);
   }
 
   TEST_CASE("tspline render: bad input gives one error line and no file") {
@@ -162,10 +213,11 @@ TEST_SUITE("render") {
         {q(d / "empty") + " --view sideways", 1, "--view: 'sideways'"},
         {q(d / "empty") + " --size 10x10", 1, "--size"},
         {q(d / "empty") + " --size big", 1, "--size"},
+        {q(d / "empty") + " --png " + q(d / "out.jpg"), 1, "extension"},
     };
     for (const Case& c : cases) {
       CAPTURE(c.args);
-      const auto r = run_app("render " + c.args + " --png " + q(png), d);
+      const auto r = run_app("render " + c.args + (test_support::contains(c.args, "--png") ? "" : " --png " + q(png)), d);
       CAPTURE(r.err);
       CHECK(r.exit_code == c.code);
       CHECK(test_support::count_lines(r.err) == 1);

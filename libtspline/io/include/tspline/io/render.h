@@ -1,8 +1,8 @@
 #pragma once
 // Pictures of the toolkit's outputs without ParaView: `tspline render`.
 // Reads the .vtu files that `tspline param` / `tspline poisson` wrote into a
-// directory and draws one view into a PNG with the software rasterizer
-// (raster_image.h).
+// directory and draws one view with Cairo (canvas.h) into a PNG, SVG or PDF
+// file, by the file's extension.
 #include <string>
 
 namespace tspline::io {
@@ -31,7 +31,8 @@ struct RenderSummary {
   double min = 0.0, max = 0.0;         ///< range of the colour-mapped field (0, 0 if none)
 };
 
-/// Draws `dir`'s outputs into the PNG `png_path` (written atomically).
+/// Draws `dir`'s outputs into `png_path` (written atomically), a PNG, SVG or
+/// PDF file by its extension.
 /// \throw IoError if a needed file is missing or unreadable (the message names
 /// it and the command that writes it) or the PNG cannot be written; InputError
 /// for bad options.
