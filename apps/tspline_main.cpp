@@ -113,9 +113,21 @@ int run_param(const std::string& input, const std::string& out_dir, const std::s
   }
   if (adaptive.certify && !result.certified_valid()) {
     const tspline::MapCertification& c = result.certification;
+    std::string where;
+    if (!c.failures.empty()) {
+      // Where: the first failing element, in parametric and physical coordinates.
+      const tspline::CertificationFailure& f = c.failures.front();
+      const Eigen::Vector2d uv = f.certificate.status == tspline::ElementStatus::Invalid
+                                     ? f.certificate.negative_at
+                                     : Eigen::Vector2d(0.5 * (f.lo + f.hi));
+      const Eigen::Vector2d x = result.map->point(uv);
+      std::ostringstream s;
+      s << ", e.g. near (" << x.x() << ", " << x.y() << ") = S(" << uv.x() << ", " << uv.y() << ")";
+      where = s.str();
+    }
     std::cerr << "tspline: error: the map is not certified valid: " << c.elements - c.certified << " of " << c.elements
               << " elements not certified (" << c.invalid << " with det J < 0 proven, " << c.undecided
-              << " undecided); adaptive refinement stopped: " << result.stop_reason
+              << " undecided" << where << "); adaptive refinement stopped: " << result.stop_reason
               << " (files written; run 'tspline check' on tspline.json for the elements)" << std::endl;
     return 3;
   }

@@ -86,7 +86,6 @@ Map parameterize(const py::object& domain, py::kwargs kwargs) {
   adaptive.max_adapt = take(kw, "max_adapt", adaptive.max_adapt);
   adaptive.max_cells = take(kw, "max_cells", adaptive.max_cells);
   adaptive.optimize_control_points = !take(kw, "no_control_point_optimization", false);
-  adaptive.control_point_power = take(kw, "cpo_power", adaptive.control_point_power);
   adaptive.certification.max_depth = take(kw, "cert_depth", adaptive.certification.max_depth);
   if (kw.contains("polygon")) dopt.polygon_index = take<std::size_t>(kw, "polygon", 0);
   if (kw.contains("layer")) dopt.layer = py::str(kw["layer"]).cast<std::string>(), kw.attr("pop")("layer");
@@ -259,7 +258,7 @@ PYBIND11_MODULE(tspline, m) {
         "parameterize(domain, **options) -> Map. domain: an (n, 2) array of polygon vertices, or a file path (text "
         "polygon or any GIS polygon layer). Options as on the command line (tspline param), '-' as '_': corners, "
         "tol, tol_rel, corner_trials, init_level, max_level, max_sweeps, omega, sweep_tol, min_jacobian, max_adapt, "
-        "max_cells, no_control_point_optimization, cpo_power, cert_depth, polygon, layer, feature, planar.");
+        "max_cells, no_control_point_optimization, cert_depth, polygon, layer, feature, planar.");
   m.def("load", &load, py::arg("path"), "Reads a T-spline file; certified_valid is recomputed");
   m.def("poisson", &poisson, py::arg("map"), py::arg("f"), py::arg("g"), py::arg("exact") = py::none(),
         py::arg("steps") = 5, py::arg("refine") = "adaptive", py::arg("gamma") = 0.5, py::arg("max_dofs") = 200000,

@@ -28,6 +28,7 @@ void validate(const ParameterizationOptions& opt, const AdaptiveOptions& ad) {
   if (ad.dense_samples < 1 || ad.dense_samples > 64) fail("dense samples per element edge must be in [1, 64]");
   if (ad.stall_rounds < 1) fail("stall rounds must be >= 1");
   if (!(ad.min_quality_gain >= 0.0)) fail("the minimum quality gain per round must be >= 0");
+  if (!(ad.max_quality_fraction > 0.0)) fail("the largest fraction of cells refined for quality must be > 0");
   if (ad.certification.max_depth < 0 || ad.certification.max_depth > 20)
     fail("--cert-depth must be in [0, 20], got " + std::to_string(ad.certification.max_depth));
   const meshopt::SmoothingOptions& s = opt.smoothing;
@@ -308,6 +309,14 @@ ParameterizationResult run_parameterization(const Polygon& polygon, const Parame
       marked = cells_to_refine(f.mesh, cells, cert, ad, opt.max_level, &rec.certification_marked_cells);
       if (marked.empty())
         r.stop_reason = "the cells to refine are at --max-level";
+      else if (certified && static_cast<double>(marked.size()) > ad.max_quality_fraction * f.mesh.num_cells()) {
+        // J_r < delta on a large part of a certified map: anisotropy that the
+        // shape and the corner choice impose, which refinement only multiplies.
+        r.stop_reason = "certified; J_r < " + std::to_string(ad.min_jacobian) + " in " +
+                        std::to_string(marked.size()) + " of " + std::to_string(f.mesh.num_cells()) +
+                        " cells, a distortion that the shape and the corners impose (refinement does not remove it)";
+        marked.clear();
+      }
       else if (f.mesh.num_cells() + 3 * marked.size() > ad.max_cells) {
         r.stop_reason = "refining " + std::to_string(marked.size()) + " more cells would exceed the budget of " +
                         std::to_string(ad.max_cells) + " cells (--max-cells)";

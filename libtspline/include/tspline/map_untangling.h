@@ -59,7 +59,7 @@ struct MapUntanglingOptions {
   /// 1 favours the mean of 1/J_r, larger values the minimum J_r.
   double quality_power = 4.0;
   /// Stages at the floor eps (the quality phase) once certified, at most.
-  int max_quality_stages = 5;
+  int max_quality_stages = 3;
   double eps_floor = 1e-9;  ///< smallest eps (normalized det J units)
   /// Smallest relative decrease sigma of chi at the worst sample per stage
   /// (Garanzha et al. use 1/10; 1/4 needed 33 instead of 54 stages on Bali,
