@@ -4,6 +4,7 @@
 #include <Eigen/IterativeLinearSolvers>
 #include <Eigen/SparseCholesky>
 #include <chrono>
+#include <exception>
 #include <cmath>
 #include <span>
 #include <sstream>
@@ -259,65 +260,119 @@ Eigen::SparseMatrix<double> stiffness_pattern(const AnalysisSpace& sp, const std
                                                        inner.data(), zeros.data());
 }
 
+/// The element system of analysis cell c: Kloc (lower triangle) and floc, one
+/// row per function of the cell (basis.functions_on_cell(c), ascending), with
+/// the Dirichlet lift subtracted from floc: floc_r -= sum_{s Dirichlet} K_rs g_s.
+class CellKernel {
+ public:
+  CellKernel(const TSplineMap& map, const AnalysisSpace& sp, const ScalarField& f, const std::vector<int>& dof,
+             const Eigen::VectorXd& coefficients)
+      : map_(map), sp_(sp), f_(f), dof_(dof), coefficients_(coefficients) {}
+
+  void compute(int c) {
+    const HierarchicalBasis& basis = sp_.basis();
+    const TMesh& mesh = sp_.mesh();
+    const Eigen::Vector2d lo = mesh.cell_min(c), hi = mesh.cell_max(c);
+    ids = basis.functions_on_cell(c);
+    const std::size_t nf = ids.size();
+    const auto n = static_cast<Eigen::Index>(nf);
+    Kloc.setZero(n, n);
+    floc.setZero(n);
+    G_.resize(2, n);
+    box_quadrature(lo, hi, 4, qp_, map_.basis(), sp_.geometry_cell(c));
+    for (const QuadraturePoint& q : qp_) {
+      const Eigen::Vector2d& uv = q.uv;
+      basis.evaluate(c, uv, bv_, 1);
+      const MapDerivatives d = map_.derivatives(uv, 1, sp_.geometry_cell(c));
+      const double w = q.weight * std::abs(d.J.determinant());
+      const Eigen::Matrix2d JinvT = d.J.inverse().transpose();
+      for (std::size_t k = 0; k < nf; ++k) {  // physical gradient J^{-T} grad_xi (scalar form)
+        const Eigen::Index col = static_cast<Eigen::Index>(k);
+        G_(0, col) = JinvT(0, 0) * bv_.R_xi[k] + JinvT(0, 1) * bv_.R_eta[k];
+        G_(1, col) = JinvT(1, 0) * bv_.R_xi[k] + JinvT(1, 1) * bv_.R_eta[k];
+      }
+      Kloc.selfadjointView<Eigen::Lower>().rankUpdate(G_.transpose(), w);  // Kloc += w G^T G (lower)
+      const double fv = checked(f_, "f", d.x.x(), d.x.y());
+      floc.noalias() += (w * fv) * Eigen::Map<const Eigen::VectorXd>(bv_.R.data(), n);
+    }
+    rows.resize(nf);
+    for (std::size_t r = 0; r < nf; ++r) rows[r] = dof_[ids[r]];
+    // Dirichlet DOF s: lift K(r, s) g_s into the load of the interior rows r.
+    for (std::size_t s = 0; s < nf; ++s) {
+      if (rows[s] >= 0) continue;
+      const double gs = coefficients_[ids[s]];
+      for (std::size_t r = 0; r < nf; ++r)
+        if (rows[r] >= 0) floc[static_cast<Eigen::Index>(r)] -= (r >= s ? Kloc(r, s) : Kloc(s, r)) * gs;
+    }
+  }
+
+  std::span<const int> ids;  ///< the cell's basis functions
+  std::vector<int> rows;     ///< their interior numbers (-1: Dirichlet)
+  Eigen::MatrixXd Kloc;      ///< lower triangle
+  Eigen::VectorXd floc;
+
+ private:
+  const TSplineMap& map_;
+  const AnalysisSpace& sp_;
+  const ScalarField& f_;
+  const std::vector<int>& dof_;
+  const Eigen::VectorXd& coefficients_;
+  std::vector<QuadraturePoint> qp_;
+  BasisValues bv_;
+  Eigen::MatrixXd G_;
+};
+
 /// Interior stiffness matrix (lower triangle) and load vector, with the
 /// Dirichlet coefficients (already in `coefficients`) lifted into the load.
 Eigen::SparseMatrix<double> assemble_stiffness(const TSplineMap& map, const AnalysisSpace& sp, const ScalarField& f,
                                                const std::vector<int>& dof, int ni,
                                                const Eigen::VectorXd& coefficients, Eigen::VectorXd& rhs) {
-  const HierarchicalBasis& basis = sp.basis();
-  const TMesh& mesh = sp.mesh();
   Eigen::SparseMatrix<double> K = stiffness_pattern(sp, dof, ni);
   const int* outer = K.outerIndexPtr();
   const int* inner = K.innerIndexPtr();
   double* values = K.valuePtr();
   rhs = Eigen::VectorXd::Zero(ni);
-  std::vector<QuadraturePoint> qp;
-  BasisValues bv;
-  Eigen::MatrixXd G, Kloc;
-  Eigen::VectorXd floc;
-  for (int c = 0; c < static_cast<int>(mesh.num_cells()); ++c) {
-    const Eigen::Vector2d lo = mesh.cell_min(c), hi = mesh.cell_max(c);
-    const std::span<const int> ids = basis.functions_on_cell(c);
-    const std::size_t nf = ids.size();
-    Kloc.setZero(static_cast<Eigen::Index>(nf), static_cast<Eigen::Index>(nf));
-    floc.setZero(static_cast<Eigen::Index>(nf));
-    G.resize(2, static_cast<Eigen::Index>(nf));
-    box_quadrature(lo, hi, 4, qp, map.basis(), sp.geometry_cell(c));
-    for (const QuadraturePoint& q : qp) {
-      const Eigen::Vector2d& uv = q.uv;
-      basis.evaluate(c, uv, bv, 1);
-      const MapDerivatives d = map.derivatives(uv, 1, sp.geometry_cell(c));
-      const double w = q.weight * std::abs(d.J.determinant());
-      const Eigen::Matrix2d JinvT = d.J.inverse().transpose();
-      for (std::size_t k = 0; k < nf; ++k) {  // physical gradient J^{-T} grad_xi (scalar form)
-        const Eigen::Index col = static_cast<Eigen::Index>(k);
-        G(0, col) = JinvT(0, 0) * bv.R_xi[k] + JinvT(0, 1) * bv.R_eta[k];
-        G(1, col) = JinvT(1, 0) * bv.R_xi[k] + JinvT(1, 1) * bv.R_eta[k];
-      }
-      Kloc.selfadjointView<Eigen::Lower>().rankUpdate(G.transpose(), w);  // Kloc += w G^T G (lower)
-      const double fv = checked(f, "f", d.x.x(), d.x.y());
-      floc.noalias() += (w * fv) * Eigen::Map<const Eigen::VectorXd>(bv.R.data(), static_cast<Eigen::Index>(nf));
-    }
+  CellKernel cell(map, sp, f, dof, coefficients);
+  for (int c = 0; c < static_cast<int>(sp.mesh().num_cells()); ++c) {
+    cell.compute(c);
+    const std::size_t nf = cell.rows.size();
     // ids ascending => interior DOF numbers ascending, like the rows of a column.
     for (std::size_t s = 0; s < nf; ++s) {
-      const int js = dof[ids[s]];
-      if (js < 0) {  // Dirichlet DOF: lift K(r, s) g_s into the load of interior rows r
-        for (std::size_t r = 0; r < nf; ++r)
-          if (dof[ids[r]] >= 0)
-            rhs[dof[ids[r]]] -= (r >= s ? Kloc(r, s) : Kloc(s, r)) * coefficients[ids[s]];
-        continue;
-      }
-      rhs[js] += floc[s];
+      const int js = cell.rows[s];
+      if (js < 0) continue;
+      rhs[js] += cell.floc[static_cast<Eigen::Index>(s)];
       int p = outer[js];
       for (std::size_t r = s; r < nf; ++r) {
-        const int ir = dof[ids[r]];
+        const int ir = cell.rows[r];
         if (ir < 0) continue;
         while (inner[p] != ir) ++p;  // present by construction of the pattern
-        values[p] += Kloc(r, s);
+        values[p] += cell.Kloc(r, s);
       }
     }
   }
   return K;
+}
+
+/// The same system handed cell by cell to an external solver, for the cells it
+/// asks for. An exception on this process (e.g. f not finite) is rethrown only
+/// after end_assembly, so that the other processes are not left waiting.
+void assemble_external(const TSplineMap& map, const AnalysisSpace& sp, const ScalarField& f,
+                       const std::vector<int>& dof, int ni, const Eigen::VectorXd& coefficients,
+                       InteriorSystemSolver& solver) {
+  const auto [first, last] = solver.begin(sp, dof, ni);
+  std::exception_ptr failure;
+  try {
+    CellKernel cell(map, sp, f, dof, coefficients);
+    for (int c = first; c < last; ++c) {
+      cell.compute(c);
+      solver.add_cell(cell.rows, cell.Kloc, cell.floc);
+    }
+  } catch (...) {
+    failure = std::current_exception();
+  }
+  const bool all_ok = solver.end_assembly(!failure);
+  if (failure) std::rethrow_exception(failure);
+  if (!all_ok) throw NumericalError("Poisson assembly failed on another process (see its message)");
 }
 
 }  // namespace
@@ -328,6 +383,11 @@ PoissonSolution solve_poisson(const TSplineMap& map, const TMesh& analysis_mesh,
 
 PoissonSolution solve_poisson(const TSplineMap& map, std::shared_ptr<const AnalysisSpace> space,
                               const PoissonProblem& problem) {
+  return solve_poisson(map, std::move(space), problem, nullptr);
+}
+
+PoissonSolution solve_poisson(const TSplineMap& map, std::shared_ptr<const AnalysisSpace> space,
+                              const PoissonProblem& problem, InteriorSystemSolver* solver) {
   if (!problem.f) throw InputError("Poisson problem: the source f is missing");
   if (!problem.g) throw InputError("Poisson problem: the Dirichlet data g is missing");
   PoissonSolution sol;
@@ -347,6 +407,17 @@ PoissonSolution solve_poisson(const TSplineMap& map, std::shared_ptr<const Analy
   for (int a = 0; a < n; ++a)
     if (!sol.is_boundary[a]) dof[a] = ni++;
   sol.interior_dofs = static_cast<std::size_t>(ni);
+
+  if (ni > 0 && solver != nullptr && solver->accepts(static_cast<std::size_t>(ni))) {
+    t0 = Clock::now();
+    assemble_external(map, sp, problem.f, dof, ni, sol.coefficients, *solver);
+    sol.assembly_seconds = seconds_since(t0);
+    Eigen::VectorXd u;
+    sol.solver = solver->solve(u);
+    for (int a = 0; a < n; ++a)
+      if (dof[a] >= 0) sol.coefficients[a] = u[dof[a]];
+    return sol;
+  }
 
   t0 = Clock::now();
   Eigen::VectorXd rhs;
