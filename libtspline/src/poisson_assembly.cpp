@@ -6,6 +6,7 @@
 #include <chrono>
 #include <exception>
 #include <cmath>
+#include <array>
 #include <span>
 #include <sstream>
 
@@ -278,22 +279,35 @@ class CellKernel {
     const auto n = static_cast<Eigen::Index>(nf);
     Kloc.setZero(n, n);
     floc.setZero(n);
-    G_.resize(2, n);
     box_quadrature(lo, hi, 4, qp_, map_.basis(), sp_.geometry_cell(c));
-    for (const QuadraturePoint& q : qp_) {
-      const Eigen::Vector2d& uv = q.uv;
-      basis.evaluate(c, uv, bv_, 1);
+    tabulate_factors();
+    gx_.resize(nf);
+    gy_.resize(nf);
+    R_.resize(nf);
+    for (std::size_t q = 0; q < qp_.size(); ++q) {
+      const Eigen::Vector2d& uv = qp_[q].uv;
       const MapDerivatives d = map_.derivatives(uv, 1, sp_.geometry_cell(c));
-      const double w = q.weight * std::abs(d.J.determinant());
+      const double w = qp_[q].weight * std::abs(d.J.determinant());
       const Eigen::Matrix2d JinvT = d.J.inverse().transpose();
-      for (std::size_t k = 0; k < nf; ++k) {  // physical gradient J^{-T} grad_xi (scalar form)
-        const Eigen::Index col = static_cast<Eigen::Index>(k);
-        G_(0, col) = JinvT(0, 0) * bv_.R_xi[k] + JinvT(0, 1) * bv_.R_eta[k];
-        G_(1, col) = JinvT(1, 0) * bv_.R_xi[k] + JinvT(1, 1) * bv_.R_eta[k];
+      const Factor* fx = &ux_[qx_[q] * nfx_];
+      const Factor* fy = &uy_[qy_[q] * nfy_];
+      for (std::size_t k = 0; k < nf; ++k) {
+        // R = N(x) M(y), grad_xi R = (N'(x) M(y), N(x) M'(y)); physical gradient J^{-T} grad_xi R.
+        const Factor& a = fx[kx_[k]];
+        const Factor& b = fy[ky_[k]];
+        const double r_xi = a.d * b.v, r_eta = a.v * b.d;
+        R_[k] = a.v * b.v;
+        gx_[k] = JinvT(0, 0) * r_xi + JinvT(0, 1) * r_eta;
+        gy_[k] = JinvT(1, 0) * r_xi + JinvT(1, 1) * r_eta;
       }
-      Kloc.selfadjointView<Eigen::Lower>().rankUpdate(G_.transpose(), w);  // Kloc += w G^T G (lower)
+      // Kloc += w G^T G, lower triangle (K_rs = int grad R_r . grad R_s).
+      for (std::size_t s = 0; s < nf; ++s) {
+        const double wx = w * gx_[s], wy = w * gy_[s];
+        double* col = &Kloc(0, static_cast<Eigen::Index>(s));
+        for (std::size_t r = s; r < nf; ++r) col[r] += wx * gx_[r] + wy * gy_[r];
+      }
       const double fv = checked(f_, "f", d.x.x(), d.x.y());
-      floc.noalias() += (w * fv) * Eigen::Map<const Eigen::VectorXd>(bv_.R.data(), n);
+      for (std::size_t k = 0; k < nf; ++k) floc[static_cast<Eigen::Index>(k)] += w * fv * R_[k];
     }
     rows.resize(nf);
     for (std::size_t r = 0; r < nf; ++r) rows[r] = dof_[ids[r]];
@@ -318,8 +332,64 @@ class CellKernel {
   const std::vector<int>& dof_;
   const Eigen::VectorXd& coefficients_;
   std::vector<QuadraturePoint> qp_;
-  BasisValues bv_;
-  Eigen::MatrixXd G_;
+
+  // Tensor-product tabulation. Every function of the cell is a product
+  // N[knots_xi](x) N[knots_eta](y) (hierarchical_basis.h), the functions of one
+  // level share 4 distinct x factors and 4 distinct y factors, and the quadrature
+  // points of the cell's pieces lie on a few distinct x and y lines. Each
+  // distinct factor is evaluated once per distinct coordinate: 4 x 4 + 4 x 4
+  // cubic B-spline evaluations per level and piece instead of 8 per level and
+  // point (the same calls, so the values are those of HierarchicalBasis::evaluate).
+  struct Factor {
+    double v = 0.0, d = 0.0;  // value and first derivative
+  };
+  void tabulate_factors() {
+    const HierarchicalBasis& basis = sp_.basis();
+    auto index_of = [](auto& list, const auto& value) {
+      for (std::size_t i = 0; i < list.size(); ++i)
+        if (list[i] == value) return i;
+      list.push_back(value);
+      return list.size() - 1;
+    };
+    knx_.clear();
+    kny_.clear();
+    kx_.resize(ids.size());
+    ky_.resize(ids.size());
+    for (std::size_t k = 0; k < ids.size(); ++k) {
+      const HierarchicalFunction& f = basis.function(ids[k]);
+      kx_[k] = index_of(knx_, f.knots_xi);
+      ky_[k] = index_of(kny_, f.knots_eta);
+    }
+    xs_.clear();
+    ys_.clear();
+    qx_.resize(qp_.size());
+    qy_.resize(qp_.size());
+    for (std::size_t q = 0; q < qp_.size(); ++q) {
+      qx_[q] = index_of(xs_, qp_[q].uv.x());
+      qy_[q] = index_of(ys_, qp_[q].uv.y());
+    }
+    nfx_ = knx_.size();
+    nfy_ = kny_.size();
+    ux_.resize(xs_.size() * nfx_);
+    uy_.resize(ys_.size() * nfy_);
+    for (std::size_t i = 0; i < xs_.size(); ++i)
+      for (std::size_t j = 0; j < nfx_; ++j) {
+        Factor& u = ux_[i * nfx_ + j];
+        u.v = cubic_bspline(knx_[j], xs_[i], &u.d);
+      }
+    for (std::size_t i = 0; i < ys_.size(); ++i)
+      for (std::size_t j = 0; j < nfy_; ++j) {
+        Factor& u = uy_[i * nfy_ + j];
+        u.v = cubic_bspline(kny_[j], ys_[i], &u.d);
+      }
+  }
+  std::vector<std::array<double, 5>> knx_, kny_;  // distinct knot vectors in x and y
+  std::vector<std::size_t> kx_, ky_;              // per function: its factors
+  std::vector<double> xs_, ys_;                   // distinct quadrature coordinates
+  std::vector<std::size_t> qx_, qy_;              // per quadrature point: its coordinates
+  std::size_t nfx_ = 0, nfy_ = 0;
+  std::vector<Factor> ux_, uy_;  // [coordinate][factor]
+  std::vector<double> gx_, gy_, R_;
 };
 
 /// Interior stiffness matrix (lower triangle) and load vector, with the
