@@ -31,4 +31,6 @@ extern "C" const char* __lsan_default_suppressions() {
   return "leak:libmpi\nleak:libopen-pal\nleak:libopen-rte\nleak:libhwloc\nleak:libpetsc\nleak:libHYPRE\n"
          "leak:mca_\nleak:libpmix\nleak:libevent\n";
 }
+// Without the table of used suppressions on stderr (errors are one line).
+extern "C" const char* __lsan_default_options() { return "print_suppressions=0"; }
 #endif

@@ -77,8 +77,9 @@ struct PetscPoissonSolver::Impl {
   Vec b = nullptr;
   std::vector<PetscInt> perm;  // interior DOF -> global row (process-by-process numbering)
   PetscInt row_begin = 0, row_end = 0, n = 0;
-  std::vector<PetscInt> g;      // add_cell scratch: global rows
-  std::vector<PetscScalar> kv;  // add_cell scratch: full element matrix, row-major
+  std::vector<std::size_t> local;   // add_cell scratch: the cell's interior functions
+  std::vector<PetscInt> g;          // add_cell scratch: their global rows
+  std::vector<PetscScalar> kv, fv;  // add_cell scratch: full element matrix (row-major) and load
 
   void release() {
     if (A) MatDestroy(&A);
@@ -179,12 +180,19 @@ std::pair<int, int> PetscPoissonSolver::begin(const AnalysisSpace& space, const 
 
   check(MatCreate(PETSC_COMM_WORLD, &m.A), "MatCreate");
   check(MatSetSizes(m.A, nloc, nloc, ni, ni), "MatSetSizes");
-  check(MatSetType(m.A, MATAIJ), "MatSetType");
-  check(MatSeqAIJSetPreallocation(m.A, 0, d_nnz.data()), "MatSeqAIJSetPreallocation");
-  check(MatMPIAIJSetPreallocation(m.A, 0, d_nnz.data(), 0, o_nnz.data()), "MatMPIAIJSetPreallocation");
-  check(MatSetOption(m.A, MAT_NEW_NONZERO_ALLOCATION_ERR, PETSC_TRUE), "MatSetOption");
+  if (m.options.preconditioner == Preconditioner::BoomerAMG) {
+    // Assembled directly as hypre's ParCSR matrix: PCHYPRE would otherwise copy
+    // an AIJ matrix into one, and both would live through the solve (at 1e6
+    // DOFs ~0.6 GB each: 49 entries per row).
+    check(MatSetType(m.A, MATHYPRE), "MatSetType(hypre)");
+    check(MatHYPRESetPreallocation(m.A, 0, d_nnz.data(), 0, o_nnz.data()), "MatHYPRESetPreallocation");
+  } else {
+    check(MatSetType(m.A, MATAIJ), "MatSetType");
+    check(MatSeqAIJSetPreallocation(m.A, 0, d_nnz.data()), "MatSeqAIJSetPreallocation");
+    check(MatMPIAIJSetPreallocation(m.A, 0, d_nnz.data(), 0, o_nnz.data()), "MatMPIAIJSetPreallocation");
+    check(MatSetOption(m.A, MAT_NEW_NONZERO_ALLOCATION_ERR, PETSC_TRUE), "MatSetOption");
+  }
   check(VecCreateMPI(PETSC_COMM_WORLD, nloc, ni, &m.b), "VecCreateMPI");
-  check(VecSetOption(m.b, VEC_IGNORE_NEGATIVE_INDICES, PETSC_TRUE), "VecSetOption");
   check(VecSet(m.b, 0.0), "VecSet");
   return {c0, c1};
 }
@@ -192,16 +200,28 @@ std::pair<int, int> PetscPoissonSolver::begin(const AnalysisSpace& space, const 
 void PetscPoissonSolver::add_cell(std::span<const int> rows, const Eigen::MatrixXd& Kloc,
                                   const Eigen::VectorXd& floc) {
   Impl& m = *impl_;
-  const std::size_t nf = rows.size();
-  m.g.resize(nf);
+  // The interior functions only (rows[k] < 0: Dirichlet), in global numbering.
+  m.local.clear();
+  m.g.clear();
+  for (std::size_t k = 0; k < rows.size(); ++k)
+    if (rows[k] >= 0) {
+      m.local.push_back(k);
+      m.g.push_back(m.perm[rows[k]]);
+    }
+  const std::size_t nf = m.local.size();
   m.kv.resize(nf * nf);
-  // Negative indices (Dirichlet functions) are ignored by MatSetValues/VecSetValues.
-  for (std::size_t k = 0; k < nf; ++k) m.g[k] = rows[k] >= 0 ? m.perm[rows[k]] : -1;
-  for (std::size_t r = 0; r < nf; ++r)  // symmetric: the lower triangle mirrored
-    for (std::size_t s = 0; s < nf; ++s) m.kv[r * nf + s] = r >= s ? Kloc(r, s) : Kloc(s, r);
+  m.fv.resize(nf);
+  for (std::size_t i = 0; i < nf; ++i) {  // symmetric: the lower triangle mirrored, row-major
+    const std::size_t r = m.local[i];
+    m.fv[i] = floc[static_cast<Eigen::Index>(r)];
+    for (std::size_t j = 0; j < nf; ++j) {
+      const std::size_t s = m.local[j];
+      m.kv[i * nf + j] = r >= s ? Kloc(r, s) : Kloc(s, r);
+    }
+  }
   const auto n = static_cast<PetscInt>(nf);
   check(MatSetValues(m.A, n, m.g.data(), n, m.g.data(), m.kv.data(), ADD_VALUES), "MatSetValues");
-  check(VecSetValues(m.b, n, m.g.data(), floc.data(), ADD_VALUES), "VecSetValues");
+  check(VecSetValues(m.b, n, m.g.data(), m.fv.data(), ADD_VALUES), "VecSetValues");
 }
 
 bool PetscPoissonSolver::end_assembly(bool ok) {

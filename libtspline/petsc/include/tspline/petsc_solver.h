@@ -48,7 +48,7 @@ enum class Preconditioner {
 
 /// Interior unknowns from which `auto` uses the iterative solver: the measured
 /// crossover of CHOLMOD and CG + BoomerAMG in time on the benchmark (bench/README.md).
-inline constexpr std::size_t kAutoIterativeFrom = 40000;
+inline constexpr std::size_t kAutoIterativeFrom = 20000;
 
 struct IterativeOptions {
   SolverChoice choice = SolverChoice::Auto;
