@@ -19,8 +19,11 @@
 // DOFs near its border go to another process (MatSetValues stashes them; they
 // are sent in MatAssemblyBegin/End). The preallocation is exact (every process
 // counts, for its own rows, the columns in and outside its diagonal block).
+// With BoomerAMG the matrix is assembled as hypre's own (MATHYPRE), so that
+// PCHYPRE uses it without a copy; with GAMG it is a PETSc AIJ matrix.
 //
-// Solve: CG (the system is SPD) preconditioned by hypre's BoomerAMG or PETSc's
+// Solve: CG (the system is SPD) preconditioned by hypre's BoomerAMG (HMIS
+// coarsening, ext+i interpolation with P_max 4, one aggressive level) or PETSc's
 // GAMG, stopping when ||b - K u|| <= rtol ||b|| (the unpreconditioned residual,
 // so that rtol means the same for every preconditioner). PETSC_OPTIONS (e.g.
 // "-ksp_monitor -pc_hypre_boomeramg_strong_threshold 0.5") overrides the
