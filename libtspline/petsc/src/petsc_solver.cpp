@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <string>
 
 #include "tspline/errors.h"
@@ -29,6 +30,13 @@ void check(PetscErrorCode ierr, const char* what) {
 /// First cell of process r's contiguous block of nc cells split over p processes.
 int block_start(int nc, int r, int p) {
   return static_cast<int>(static_cast<std::int64_t>(nc) * r / p);
+}
+
+/// A number for messages (%g, 3 significant digits).
+std::string g3(double v) {
+  char b[32];
+  std::snprintf(b, sizeof b, "%.3g", v);
+  return b;
 }
 
 const char* preconditioner_name(Preconditioner p) {
@@ -92,7 +100,7 @@ struct PetscPoissonSolver::Impl {
 
 PetscPoissonSolver::PetscPoissonSolver(const IterativeOptions& options) : impl_(std::make_unique<Impl>()) {
   if (!(options.rtol > 0.0) || !std::isfinite(options.rtol))
-    throw InputError("the iterative solver's relative tolerance must be > 0, got " + std::to_string(options.rtol));
+    throw InputError("the iterative solver's relative tolerance must be > 0, got " + g3(options.rtol));
   if (options.max_iterations < 1)
     throw InputError("the iterative solver's iteration limit must be at least 1, got " +
                      std::to_string(options.max_iterations));
@@ -317,7 +325,7 @@ SolverStats PetscPoissonSolver::solve(Eigen::VectorXd& u) {
     throw NumericalError("iterative solve (" + st.kind + ") did not converge: " + KSPConvergedReasons[reason] +
                          " after " + std::to_string(its) + " iterations (limit " +
                          std::to_string(o.max_iterations) + "), relative residual " +
-                         std::to_string(st.relative_residual) + " > rtol " + std::to_string(o.rtol));
+                         g3(st.relative_residual) + " (rtol " + g3(o.rtol) + ")");
 
   // Gather the solution on every process and undo the renumbering.
   check(VecScatterCreateToAll(x, &gather, &xall), "VecScatterCreateToAll");
