@@ -2,6 +2,9 @@
 // isogeometric analysis on the domain of a T-spline file, and refine adaptively
 // or uniformly (libtspline/include/tspline/poisson.h). Writes convergence.csv, convergence.png,
 // report.json and solution.pvd + solution/step_NNN.vtu into OUTDIR.
+// Under `mpirun -n P` every process runs the same loop; the interior system is
+// assembled and solved by all of them (PETSc module, tspline/petsc_solver.h) when
+// the iterative solver is chosen, and only rank 0 prints and writes files.
 #include <unistd.h>
 
 #include <Eigen/Core>
@@ -17,6 +20,7 @@
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <numbers>
+#include <numeric>
 #include <sstream>
 #include <string>
 #include <utility>
@@ -31,6 +35,8 @@
 #include "tspline/io/tspline_file.h"
 #include "tspline/io/cell_grid.h"
 #include "tspline/io/vtu_writer.h"
+#include "petsc_session.h"
+#include "tspline/petsc_solver.h"
 #include "tspline/poisson.h"
 
 namespace tspline_app {
@@ -54,6 +60,10 @@ std::string fmt(double v) {
 
 struct PoissonArgs {
   std::string file, out_dir, f, g, exact, problem, refine = "adaptive";
+  std::string solver = "auto", preconditioner = "boomeramg";
+  double rtol = tspline::petsc::IterativeOptions{}.rtol;
+  int max_iterations = tspline::petsc::IterativeOptions{}.max_iterations;
+  std::size_t direct_below = tspline::petsc::kAutoIterativeFrom;
   int steps = 5;
   double gamma = 0.5;
   std::size_t max_dofs = 200000;
@@ -196,6 +206,21 @@ void validate_options(const PoissonArgs& a) {
   if (a.samples < 1 || a.samples > 64)
     throw tspline::InputError("--samples must be in [1, 64], got " + std::to_string(a.samples));
   if (a.out_dir.empty()) throw tspline::InputError("--out: empty path");
+  tspline::petsc::parse_solver_choice(a.solver);
+  tspline::petsc::parse_preconditioner(a.preconditioner);
+  if (!(a.rtol > 0.0) || !std::isfinite(a.rtol)) throw tspline::InputError("--rtol must be > 0, got " + fmt(a.rtol));
+  if (a.max_iterations < 1)
+    throw tspline::InputError("--max-iterations must be at least 1, got " + std::to_string(a.max_iterations));
+}
+
+tspline::petsc::IterativeOptions iterative_options(const PoissonArgs& a) {
+  tspline::petsc::IterativeOptions o;
+  o.choice = tspline::petsc::parse_solver_choice(a.solver);
+  o.preconditioner = tspline::petsc::parse_preconditioner(a.preconditioner);
+  o.rtol = a.rtol;
+  o.max_iterations = a.max_iterations;
+  o.auto_threshold = a.direct_below;
+  return o;
 }
 
 /// Fails (IoError) if `dir` could not be created or written, without creating it:
@@ -254,7 +279,9 @@ tspline::io::VtuMesh solution_vtu(const tspline::TSplineMap& map, const tspline:
 std::string short_solver(const tspline::SolverStats& s) {
   if (s.kind == "CholmodSupernodalLLT") return "CHOLMOD";
   if (s.kind == "SimplicialLDLT") return "LDLT";
-  if (s.kind == "ConjugateGradient+IncompleteCholesky") return "CG+IC(" + std::to_string(s.iterations) + ")";
+  if (s.kind == "ConjugateGradient+IncompleteCholesky") return "CG+IC";
+  if (s.kind == "PETSc CG + hypre BoomerAMG") return "CG+BoomerAMG";
+  if (s.kind == "PETSc CG + PETSc GAMG") return "CG+GAMG";
   return s.kind;
 }
 
@@ -279,8 +306,9 @@ class PoissonOutput {
     report_["steps"] = json::array();
   }
 
-  void step(const tspline::PoissonStep& st, const tspline::PoissonSolution& sol,
-            const std::vector<double>& eta) {
+  /// peak_mib: peak resident memory of every process so far (MiB, by rank).
+  void step(const tspline::PoissonStep& st, const tspline::PoissonSolution& sol, const std::vector<double>& eta,
+            const std::vector<double>& peak_mib) {
     const auto t0 = Clock::now();
     const fs::path out(args_.out_dir);
     if (!started_) {
@@ -309,7 +337,12 @@ class PoissonOutput {
                  {{"kind", st.solver.kind},
                   {"seconds", st.solver.seconds},
                   {"relative_residual", st.solver.relative_residual},
-                  {"iterations", st.solver.iterations}}},
+                  {"iterations", st.solver.iterations},
+                  {"processes", st.solver.processes}}},
+                {"peak_memory_mib",
+                 {{"per_process", peak_mib},
+                  {"max", *std::max_element(peak_mib.begin(), peak_mib.end())},
+                  {"total", std::accumulate(peak_mib.begin(), peak_mib.end(), 0.0)}}},
                 {"dirichlet_seconds", sol.dirichlet_seconds},
                 {"assembly_seconds", st.assembly_seconds},
                 {"solve_seconds", st.solver.seconds},
@@ -334,12 +367,13 @@ class PoissonOutput {
           {"h1", st.has_errors ? rate(p.errors.h1, st.errors.h1, p.dofs, st.dofs) : json(nullptr)}};
     }
     steps_.push_back(st);
+    peak_total_.push_back(std::accumulate(peak_mib.begin(), peak_mib.end(), 0.0));
     rec["output_seconds"] = seconds_since(t0);
     json event = rec;
     event["event"] = "step";
     report_["steps"].push_back(std::move(rec));
     write_tables(false);
-    if (progress_.human()) print_row(st);
+    if (progress_.human()) print_row(st, peak_total_.back());
     progress_.event(event);
   }
 
@@ -350,15 +384,19 @@ class PoissonOutput {
     const fs::path out(args_.out_dir);
     report_["finished"] = finished;
     std::ostringstream csv;
-    csv << "step,dofs,cells,eta,l2,h1,eta_over_h1,solver,residual,seconds\n";
-    for (const tspline::PoissonStep& s : steps_) {
+    csv << "step,dofs,cells,eta,l2,h1,eta_over_h1,solver,residual,seconds,iterations,assembly_seconds,"
+           "solve_seconds,peak_mib\n";
+    for (std::size_t k = 0; k < steps_.size(); ++k) {
+      const tspline::PoissonStep& s = steps_[k];
       csv << s.step << ',' << s.dofs << ',' << s.cells << ',' << num(s.eta) << ',';
       if (s.has_errors)
         csv << num(s.errors.l2) << ',' << num(s.errors.h1) << ','
             << (s.errors.h1 > 0 ? num(s.eta / s.errors.h1) : std::string());
       else
         csv << ",,";
-      csv << ',' << s.solver.kind << ',' << num(s.solver.relative_residual) << ',' << num(s.seconds) << '\n';
+      csv << ',' << s.solver.kind << ',' << num(s.solver.relative_residual) << ',' << num(s.seconds) << ','
+          << s.solver.iterations << ',' << num(s.assembly_seconds) << ',' << num(s.solver.seconds) << ','
+          << num(peak_total_[k]) << '\n';
     }
     tspline::io::write_text_atomic((out / "convergence.csv").string(), csv.str());
     tspline::io::write_convergence_plot((out / "convergence.png").string(), steps_);
@@ -371,18 +409,19 @@ class PoissonOutput {
 
  private:
   static void print_header() {
-    std::printf("%4s %9s %9s %11s %11s %11s %8s %-12s %9s %8s\n", "step", "dofs", "cells", "eta", "L2", "H1",
-                "eta/H1", "solver", "residual", "seconds");
+    std::printf("%4s %9s %9s %11s %11s %11s %8s %-12s %5s %9s %8s %8s %8s %8s\n", "step", "dofs", "cells", "eta",
+                "L2", "H1", "eta/H1", "solver", "its", "residual", "assembly", "solve", "seconds", "peak_MiB");
   }
-  static void print_row(const tspline::PoissonStep& s) {
+  static void print_row(const tspline::PoissonStep& s, double peak_mib) {
     char l2[32] = "-", h1[32] = "-", ratio[32] = "-";
     if (s.has_errors) {
       std::snprintf(l2, sizeof l2, "%.4e", s.errors.l2);
       std::snprintf(h1, sizeof h1, "%.4e", s.errors.h1);
       if (s.errors.h1 > 0) std::snprintf(ratio, sizeof ratio, "%.3f", s.eta / s.errors.h1);
     }
-    std::printf("%4d %9zu %9zu %11.4e %11s %11s %8s %-12s %9.2e %8.3f\n", s.step, s.dofs, s.cells, s.eta, l2,
-                h1, ratio, short_solver(s.solver).c_str(), s.solver.relative_residual, s.seconds);
+    std::printf("%4d %9zu %9zu %11.4e %11s %11s %8s %-12s %5d %9.2e %8.3f %8.3f %8.3f %8.1f\n", s.step, s.dofs,
+                s.cells, s.eta, l2, h1, ratio, short_solver(s.solver).c_str(), s.solver.iterations,
+                s.solver.relative_residual, s.assembly_seconds, s.solver.seconds, s.seconds, peak_mib);
     std::fflush(stdout);
   }
 
@@ -391,6 +430,7 @@ class PoissonOutput {
   const tspline::PoissonProblem& problem_;
   json report_;
   std::vector<tspline::PoissonStep> steps_;
+  std::vector<double> peak_total_;  // per step: sum over the processes of their peak memory, MiB
   std::vector<tspline::io::PvdEntry> pvd_;
   bool started_ = false;
   Progress& progress_;
@@ -398,11 +438,10 @@ class PoissonOutput {
 
 // ------------------------------------------------------------------ run
 
-int run_poisson(const PoissonArgs& args) {
-  const auto t_start = Clock::now();
-  // Everything that can be checked is checked before OUTDIR is created.
-  validate_options(args);
-  check_output_directory(args.out_dir);
+/// The loop on every process; rank 0 writes and prints.
+int run_poisson_process(const PoissonArgs& args, const PetscSession& session,
+                        std::chrono::steady_clock::time_point t_start) {
+  const bool root = session.rank() == 0;
   const tspline::io::LoadedTSpline t = tspline::io::read_tspline_file(args.file);
   const ProblemSetup setup = make_problem(args, t.map);
 
@@ -412,6 +451,8 @@ int run_poisson(const PoissonArgs& args) {
   opt.steps = args.steps;
   opt.gamma = args.gamma;
   opt.max_dofs = args.max_dofs;
+  tspline::petsc::PetscPoissonSolver solver(iterative_options(args));
+  opt.solver = &solver;
 
   json report = {
       {"command", "poisson"},
@@ -422,7 +463,13 @@ int run_poisson(const PoissonArgs& args) {
         {"steps", args.steps},
         {"gamma", args.gamma},
         {"max_dofs", args.max_dofs},
-        {"samples", args.samples}}},
+        {"samples", args.samples},
+        {"solver", args.solver},
+        {"preconditioner", args.preconditioner},
+        {"rtol", args.rtol},
+        {"max_iterations", args.max_iterations},
+        {"direct_below", args.direct_below},
+        {"processes", session.size()}}},
       {"geometry",
        {{"cells", t.map.mesh().num_cells()},
         {"functions", t.map.basis().size()},
@@ -430,16 +477,19 @@ int run_poisson(const PoissonArgs& args) {
       {"analysis_space", "cubic hierarchical B-splines of the analysis T-mesh"},
       {"dirichlet", "L2 projection of g onto the boundary functions' traces on the parameter square's border"},
       {"quadrature", {{"assembly", "4x4 Gauss"}, {"errors", "6x6 Gauss"}, {"estimator", "4x4 Gauss"}}}};
-  Progress progress(output_mode(args.quiet, args.json));
+  Progress progress(root ? output_mode(args.quiet, args.json) : OutputMode::Quiet);
   PoissonOutput output(args, t.map, setup.problem, std::move(report), progress);
   std::vector<tspline::PoissonStep> steps;
   try {
     steps = tspline::solve_adaptive(t.map, setup.problem, opt,
                                     [&](const tspline::PoissonStep& st, const tspline::PoissonSolution& sol,
-                                        const std::vector<double>& eta) { output.step(st, sol, eta); });
+                                        const std::vector<double>& eta) {
+                                      const std::vector<double> peak = tspline::petsc::peak_memory_mib();
+                                      if (root) output.step(st, sol, eta, peak);
+                                    });
   } catch (const std::exception& e) {
     // Keep what was written consistent and say why the run stopped.
-    if (output.started()) {
+    if (root && output.started()) {
       output.report()["error"] = e.what();
       output.report()["seconds_total"] = seconds_since(t_start);
       try {
@@ -458,6 +508,7 @@ int run_poisson(const PoissonArgs& args) {
     stop = "no cell marked (eta = 0 everywhere)";
   else
     stop = "the next space would have more than --max-dofs " + std::to_string(args.max_dofs) + " DOFs";
+  if (!root) return 0;
   output.report()["stop_reason"] = stop;
   output.report()["seconds_total"] = seconds_since(t_start);
   output.write_tables(true);
@@ -471,6 +522,27 @@ int run_poisson(const PoissonArgs& args) {
               << "); wrote convergence.csv, convergence.png, report.json, solution.pvd, solution/"
               << " to " << args.out_dir << std::endl;
   return 0;
+}
+
+int run_poisson(const PoissonArgs& args) {
+  const auto t_start = Clock::now();
+  // Everything that can be checked is checked before OUTDIR is created.
+  validate_options(args);
+  check_output_directory(args.out_dir);
+  const PetscSession session;
+  if (session.rank() == 0) return run_poisson_process(args, session, t_start);
+  // Other ranks fail alike (same input, same collective calls); only rank 0 prints the message.
+  try {
+    return run_poisson_process(args, session, t_start);
+  } catch (const tspline::InputError&) {
+    return 1;
+  } catch (const tspline::IoError&) {
+    return 2;
+  } catch (const tspline::NumericalError&) {
+    return 3;
+  } catch (const std::exception&) {
+    return 4;
+  }
 }
 
 }  // namespace
@@ -522,6 +594,24 @@ void add_poisson_command(CLI::App& app, CommandAction& action) {
       ->capture_default_str();
   cmd->add_option("--samples", a->samples,
                   "solution/step_NNN.vtu: k x k sub-quads per analysis cell, k in [1, 64]")
+      ->capture_default_str();
+  cmd->add_option("--solver", a->solver,
+                  "Linear solver of each step: direct (CHOLMOD sparse Cholesky), iterative (PETSc CG with an "
+                  "algebraic multigrid preconditioner, distributed under mpirun), or auto: direct below "
+                  "--direct-below interior DOFs, iterative from there")
+      ->type_name("auto|direct|iterative")
+      ->capture_default_str();
+  cmd->add_option("--preconditioner", a->preconditioner,
+                  "AMG preconditioner of the iterative solver: boomeramg (hypre) or gamg (PETSc)")
+      ->type_name("boomeramg|gamg")
+      ->capture_default_str();
+  cmd->add_option("--rtol", a->rtol, "Iterative solver: stop when ||b - K u|| <= rtol ||b|| (rtol > 0)")
+      ->capture_default_str();
+  cmd->add_option("--max-iterations", a->max_iterations,
+                  "Iterative solver: CG iterations at most; not converging by then is an error (exit 3)")
+      ->capture_default_str();
+  cmd->add_option("--direct-below", a->direct_below,
+                  "--solver auto: the direct solver below this many interior DOFs (the measured crossover)")
       ->capture_default_str();
   cmd->add_flag("--quiet,-q", a->quiet, "Print errors only");
   cmd->add_flag("--json", a->json,

@@ -3,12 +3,16 @@
 // T-mesh, control points at the Greville abscissae), u = sin(pi x) sin(pi y).
 // Prints one table row:
 //   level cells dofs space_s dirichlet_s assembly_s solve_s solver residual max_err peak_MiB
+//   ranks its peak_total_MiB
+// (peak_MiB: the largest peak of one process; peak_total_MiB: their sum.)
 // (space_s: analysis T-mesh + hierarchical B-spline basis; solve_s: factorization + solve;
 // max_err: max |u - u_h| at the centres of about 16 x 16 cells, a cheap check
 // that the solve is right).
-// Usage: bench_poisson LEVEL
+// Usage: [mpirun -n P] bench_poisson LEVEL [direct|iterative] [boomeramg|gamg] [RTOL]
+// (default direct; the iterative solver is PETSc CG + AMG, tspline/petsc_solver.h,
+// with the default rtol of `tspline poisson`.)
 // Run one size per process so the peak memory (getrusage) belongs to that size.
-#include <sys/resource.h>
+#include <petscsys.h>
 
 #include <algorithm>
 #include <chrono>
@@ -17,8 +21,12 @@
 #include <cstdlib>
 #include <memory>
 #include <numbers>
+#include <numeric>
 #include <vector>
 
+#include <string>
+
+#include "tspline/petsc_solver.h"
 #include "tspline/poisson.h"
 
 namespace {
@@ -35,11 +43,12 @@ tspline::TSplineMap identity_map(int level) {
   return tspline::greville_identity_map(std::move(m));
 }
 
-}  // namespace
 
-int main(int argc, char** argv) {
+int run(int argc, char** argv) {
   if (argc < 2) {
-    std::fprintf(stderr, "usage: %s LEVEL   (analysis mesh of 2^LEVEL x 2^LEVEL cells, LEVEL >= 2)\n",
+    std::fprintf(stderr,
+                 "usage: %s LEVEL [direct|iterative] [boomeramg|gamg] [RTOL]  (analysis mesh of 2^LEVEL x 2^LEVEL "
+                 "cells, LEVEL >= 2)\n",
                  argv[0]);
     return 1;
   }
@@ -48,6 +57,12 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "LEVEL must be in [2, 12]\n");
     return 1;
   }
+  tspline::petsc::IterativeOptions io;
+  io.choice = tspline::petsc::parse_solver_choice(argc > 2 ? argv[2] : "direct");
+  if (io.choice == tspline::petsc::SolverChoice::Auto) io.choice = tspline::petsc::SolverChoice::Direct;
+  if (argc > 3) io.preconditioner = tspline::petsc::parse_preconditioner(argv[3]);
+  if (argc > 4) io.rtol = std::atof(argv[4]);
+  tspline::petsc::PetscPoissonSolver solver(io);
   constexpr double pi = std::numbers::pi;
   tspline::PoissonProblem p;
   p.exact = [](double x, double y) { return std::sin(pi * x) * std::sin(pi * y); };
@@ -60,7 +75,7 @@ int main(int argc, char** argv) {
   mesh.build_topology();
   auto space = std::make_shared<const tspline::AnalysisSpace>(map, std::move(mesh));
   const double space_s = seconds_since(t0);
-  const tspline::PoissonSolution sol = tspline::solve_poisson(map, space, p);
+  const tspline::PoissonSolution sol = tspline::solve_poisson(map, space, p, &solver);
 
   // Cheap correctness check on a 16 x 16 grid of cell centres.
   double max_err = 0.0;
@@ -73,11 +88,32 @@ int main(int argc, char** argv) {
       max_err = std::max(max_err, std::abs(v.u - p.exact(v.x.x(), v.x.y())));
     }
 
-  rusage ru{};
-  getrusage(RUSAGE_SELF, &ru);
-  std::printf("%5d %9zu %9zu %8.3f %11.3f %10.3f %8.3f %-6s %9.1e %9.1e %9.1f\n", level, m.num_cells(),
-              space->num_dofs(), space_s, sol.dirichlet_seconds, sol.assembly_seconds, sol.solver.seconds,
-              sol.solver.kind == "CholmodSupernodalLLT" ? "CHOLMOD" : sol.solver.kind == "SimplicialLDLT" ? "LDLT" : "CG+IC", sol.solver.relative_residual, max_err,
-              ru.ru_maxrss / 1024.0);
+  const std::vector<double> peak = tspline::petsc::peak_memory_mib();
+  if (tspline::petsc::process_rank() != 0) return 0;
+  const std::string& k = sol.solver.kind;
+  const char* name = k == "CholmodSupernodalLLT"         ? "CHOLMOD"
+                     : k == "SimplicialLDLT"             ? "LDLT"
+                     : k == "PETSc CG + hypre BoomerAMG" ? "BoomerAMG"
+                     : k == "PETSc CG + PETSc GAMG"      ? "GAMG"
+                                                         : "CG+IC";
+  std::printf("%5d %9zu %9zu %8.3f %11.3f %10.3f %8.3f %-9s %9.1e %9.1e %9.1f %5d %5d %9.1f\n", level,
+              m.num_cells(), space->num_dofs(), space_s, sol.dirichlet_seconds, sol.assembly_seconds,
+              sol.solver.seconds, name, sol.solver.relative_residual, max_err,
+              *std::max_element(peak.begin(), peak.end()), tspline::petsc::process_count(), sol.solver.iterations,
+              std::accumulate(peak.begin(), peak.end(), 0.0));
   return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  if (PetscInitializeNoArguments() != 0) return 1;
+  int rc = 1;
+  try {
+    rc = run(argc, argv);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "bench_poisson: %s\n", e.what());
+  }
+  PetscFinalize();
+  return rc;
 }

@@ -4,9 +4,12 @@
 #include <Eigen/IterativeLinearSolvers>
 #include <Eigen/SparseCholesky>
 #include <chrono>
+#include <exception>
 #include <cmath>
+#include <array>
 #include <span>
 #include <sstream>
+#include <stdexcept>
 
 #include "tspline/bezier_extraction.h"
 #include "tspline/errors.h"
@@ -259,65 +262,232 @@ Eigen::SparseMatrix<double> stiffness_pattern(const AnalysisSpace& sp, const std
                                                        inner.data(), zeros.data());
 }
 
+/// The element system of analysis cell c: Kloc (lower triangle) and floc, one
+/// row per function of the cell (basis.functions_on_cell(c), ascending), with
+/// the Dirichlet lift subtracted from floc: floc_r -= sum_{s Dirichlet} K_rs g_s.
+class CellKernel {
+ public:
+  CellKernel(const TSplineMap& map, const AnalysisSpace& sp, const ScalarField& f, const std::vector<int>& dof,
+             const Eigen::VectorXd& coefficients)
+      : map_(map), sp_(sp), f_(f), dof_(dof), coefficients_(coefficients) {}
+
+  void compute(int c) {
+    const HierarchicalBasis& basis = sp_.basis();
+    const TMesh& mesh = sp_.mesh();
+    const Eigen::Vector2d lo = mesh.cell_min(c), hi = mesh.cell_max(c);
+    ids = basis.functions_on_cell(c);
+    const std::size_t nf = ids.size();
+    const auto n = static_cast<Eigen::Index>(nf);
+    Kloc.setZero(n, n);
+    floc.setZero(n);
+    gcell_ = sp_.geometry_cell(c);
+    box_quadrature(lo, hi, 4, qp_, map_.basis(), gcell_);
+    tabulate_factors();
+    gx_.resize(nf);
+    gy_.resize(nf);
+    R_.resize(nf);
+    for (std::size_t q = 0; q < qp_.size(); ++q) {
+      const MapDerivatives d = geometry_at(q);
+      const double w = qp_[q].weight * std::abs(d.J.determinant());
+      const Eigen::Matrix2d JinvT = d.J.inverse().transpose();
+      for (std::size_t k = 0; k < nf; ++k) {
+        // R = N(x) M(y), grad_xi R = (N'(x) M(y), N(x) M'(y)); physical gradient J^{-T} grad_xi R.
+        const TensorFactors::Factor a = analysis_.x(qx_[q], k), b = analysis_.y(qy_[q], k);
+        const double r_xi = a.d * b.v, r_eta = a.v * b.d;
+        R_[k] = a.v * b.v;
+        gx_[k] = JinvT(0, 0) * r_xi + JinvT(0, 1) * r_eta;
+        gy_[k] = JinvT(1, 0) * r_xi + JinvT(1, 1) * r_eta;
+      }
+      // Kloc += w G^T G, lower triangle (K_rs = int grad R_r . grad R_s).
+      for (std::size_t s = 0; s < nf; ++s) {
+        const double wx = w * gx_[s], wy = w * gy_[s];
+        double* col = &Kloc(0, static_cast<Eigen::Index>(s));
+        for (std::size_t r = s; r < nf; ++r) col[r] += wx * gx_[r] + wy * gy_[r];
+      }
+      const double fv = checked(f_, "f", d.x.x(), d.x.y());
+      for (std::size_t k = 0; k < nf; ++k) floc[static_cast<Eigen::Index>(k)] += w * fv * R_[k];
+    }
+    rows.resize(nf);
+    for (std::size_t r = 0; r < nf; ++r) rows[r] = dof_[ids[r]];
+    // Dirichlet DOF s: lift K(r, s) g_s into the load of the interior rows r.
+    for (std::size_t s = 0; s < nf; ++s) {
+      if (rows[s] >= 0) continue;
+      const double gs = coefficients_[ids[s]];
+      for (std::size_t r = 0; r < nf; ++r)
+        if (rows[r] >= 0) floc[static_cast<Eigen::Index>(r)] -= (r >= s ? Kloc(r, s) : Kloc(s, r)) * gs;
+    }
+  }
+
+  std::span<const int> ids;  ///< the cell's basis functions
+  std::vector<int> rows;     ///< their interior numbers (-1: Dirichlet)
+  Eigen::MatrixXd Kloc;      ///< lower triangle
+  Eigen::VectorXd floc;
+
+ private:
+  const TSplineMap& map_;
+  const AnalysisSpace& sp_;
+  const ScalarField& f_;
+  const std::vector<int>& dof_;
+  const Eigen::VectorXd& coefficients_;
+  std::vector<QuadraturePoint> qp_;
+
+  // Tensor-product tabulation (see TensorFactors): the analysis functions and
+  // the geometry's blending functions on the cell, at its quadrature points.
+  void tabulate_factors() {
+    xs_.clear();
+    ys_.clear();
+    qx_.resize(qp_.size());
+    qy_.resize(qp_.size());
+    for (std::size_t q = 0; q < qp_.size(); ++q) {
+      qx_[q] = index_of(xs_, qp_[q].uv.x());
+      qy_[q] = index_of(ys_, qp_[q].uv.y());
+    }
+    const HierarchicalBasis& basis = sp_.basis();
+    analysis_.build(ids.size(), [&](std::size_t k) -> const auto& { return basis.function(ids[k]).knots_xi; },
+                    [&](std::size_t k) -> const auto& { return basis.function(ids[k]).knots_eta; }, xs_, ys_);
+    const TSplineBasis& gb = map_.basis();
+    const std::vector<int>& gids = gb.functions_on_cell(gcell_);
+    geometry_.build(gids.size(), [&](std::size_t k) -> const auto& { return gb.function(gids[k]).knots_xi; },
+                    [&](std::size_t k) -> const auto& { return gb.function(gids[k]).knots_eta; }, xs_, ys_);
+  }
+
+  /// S and J at quadrature point q from the tabulated blending functions N_a
+  /// of the geometry cell: R_a = N_a / W, W = sum_b N_b, grad R_a = (grad N_a -
+  /// R_a grad W) / W (the formulas of TSplineBasis::evaluate, order 1).
+  MapDerivatives geometry_at(std::size_t q) const {
+    const std::vector<int>& gids = map_.basis().functions_on_cell(gcell_);
+    const std::vector<Eigen::Vector2d>& P = map_.control_points();
+    double W = 0, Wx = 0, Wy = 0;
+    Eigen::Vector2d x = Eigen::Vector2d::Zero(), dx = x, dy = x;  // sums of N P, N_xi P, N_eta P
+    for (std::size_t k = 0; k < gids.size(); ++k) {
+      const TensorFactors::Factor a = geometry_.x(qx_[q], k), b = geometry_.y(qy_[q], k);
+      const double n = a.v * b.v, nx = a.d * b.v, ny = a.v * b.d;
+      W += n;
+      Wx += nx;
+      Wy += ny;
+      x += n * P[gids[k]];
+      dx += nx * P[gids[k]];
+      dy += ny * P[gids[k]];
+    }
+    if (!(W > 0.0)) throw std::logic_error("Poisson assembly: the blending functions vanish at a quadrature point");
+    // S = x / W; dS/dxi = (dx - S Wx) / W, dS/deta = (dy - S Wy) / W.
+    MapDerivatives d;
+    d.x = x / W;
+    d.J.col(0) = (dx - d.x * Wx) / W;
+    d.J.col(1) = (dy - d.x * Wy) / W;
+    return d;
+  }
+
+  template <class List, class T>
+  static std::size_t index_of(List& list, const T& value) {
+    for (std::size_t i = 0; i < list.size(); ++i)
+      if (list[i] == value) return i;
+    list.push_back(value);
+    return list.size() - 1;
+  }
+
+  // Every function here (analysis or geometry) is a product N[knots_xi](x)
+  // N[knots_eta](y). The functions of a cell share few distinct knot vectors
+  // (4 per direction and level for the analysis functions), and the quadrature
+  // points of the cell's pieces lie on few distinct x and y lines. So each
+  // distinct factor is evaluated (cubic_bspline, as the bases do) once per
+  // distinct coordinate, instead of twice per function and point.
+  class TensorFactors {
+   public:
+    struct Factor {
+      double v = 0.0, d = 0.0;  // value and first derivative
+    };
+    template <class KnotsX, class KnotsY>
+    void build(std::size_t nf, KnotsX knots_x, KnotsY knots_y, const std::vector<double>& xs,
+               const std::vector<double>& ys) {
+      knx_.clear();
+      kny_.clear();
+      kx_.resize(nf);
+      ky_.resize(nf);
+      for (std::size_t k = 0; k < nf; ++k) {
+        kx_[k] = index_of(knx_, knots_x(k));
+        ky_[k] = index_of(kny_, knots_y(k));
+      }
+      tabulate(knx_, xs, ux_);
+      tabulate(kny_, ys, uy_);
+    }
+    /// Factor in x of function k at distinct coordinate i (and in y).
+    Factor x(std::size_t i, std::size_t k) const { return ux_[i * knx_.size() + kx_[k]]; }
+    Factor y(std::size_t i, std::size_t k) const { return uy_[i * kny_.size() + ky_[k]]; }
+
+   private:
+    static void tabulate(const std::vector<std::array<double, 5>>& knots, const std::vector<double>& ts,
+                         std::vector<Factor>& out) {
+      out.resize(ts.size() * knots.size());
+      for (std::size_t i = 0; i < ts.size(); ++i)
+        for (std::size_t j = 0; j < knots.size(); ++j) {
+          Factor& u = out[i * knots.size() + j];
+          u.v = cubic_bspline(knots[j], ts[i], &u.d);
+        }
+    }
+    std::vector<std::array<double, 5>> knx_, kny_;  // distinct knot vectors in x and y
+    std::vector<std::size_t> kx_, ky_;              // per function: its factors
+    std::vector<Factor> ux_, uy_;                   // [coordinate][factor]
+  };
+
+  int gcell_ = -1;                    // the geometry cell of the analysis cell
+  std::vector<double> xs_, ys_;       // distinct quadrature coordinates
+  std::vector<std::size_t> qx_, qy_;  // per quadrature point: its coordinates
+  TensorFactors analysis_, geometry_;
+  std::vector<double> gx_, gy_, R_;
+};
+
 /// Interior stiffness matrix (lower triangle) and load vector, with the
 /// Dirichlet coefficients (already in `coefficients`) lifted into the load.
 Eigen::SparseMatrix<double> assemble_stiffness(const TSplineMap& map, const AnalysisSpace& sp, const ScalarField& f,
                                                const std::vector<int>& dof, int ni,
                                                const Eigen::VectorXd& coefficients, Eigen::VectorXd& rhs) {
-  const HierarchicalBasis& basis = sp.basis();
-  const TMesh& mesh = sp.mesh();
   Eigen::SparseMatrix<double> K = stiffness_pattern(sp, dof, ni);
   const int* outer = K.outerIndexPtr();
   const int* inner = K.innerIndexPtr();
   double* values = K.valuePtr();
   rhs = Eigen::VectorXd::Zero(ni);
-  std::vector<QuadraturePoint> qp;
-  BasisValues bv;
-  Eigen::MatrixXd G, Kloc;
-  Eigen::VectorXd floc;
-  for (int c = 0; c < static_cast<int>(mesh.num_cells()); ++c) {
-    const Eigen::Vector2d lo = mesh.cell_min(c), hi = mesh.cell_max(c);
-    const std::span<const int> ids = basis.functions_on_cell(c);
-    const std::size_t nf = ids.size();
-    Kloc.setZero(static_cast<Eigen::Index>(nf), static_cast<Eigen::Index>(nf));
-    floc.setZero(static_cast<Eigen::Index>(nf));
-    G.resize(2, static_cast<Eigen::Index>(nf));
-    box_quadrature(lo, hi, 4, qp, map.basis(), sp.geometry_cell(c));
-    for (const QuadraturePoint& q : qp) {
-      const Eigen::Vector2d& uv = q.uv;
-      basis.evaluate(c, uv, bv, 1);
-      const MapDerivatives d = map.derivatives(uv, 1, sp.geometry_cell(c));
-      const double w = q.weight * std::abs(d.J.determinant());
-      const Eigen::Matrix2d JinvT = d.J.inverse().transpose();
-      for (std::size_t k = 0; k < nf; ++k) {  // physical gradient J^{-T} grad_xi (scalar form)
-        const Eigen::Index col = static_cast<Eigen::Index>(k);
-        G(0, col) = JinvT(0, 0) * bv.R_xi[k] + JinvT(0, 1) * bv.R_eta[k];
-        G(1, col) = JinvT(1, 0) * bv.R_xi[k] + JinvT(1, 1) * bv.R_eta[k];
-      }
-      Kloc.selfadjointView<Eigen::Lower>().rankUpdate(G.transpose(), w);  // Kloc += w G^T G (lower)
-      const double fv = checked(f, "f", d.x.x(), d.x.y());
-      floc.noalias() += (w * fv) * Eigen::Map<const Eigen::VectorXd>(bv.R.data(), static_cast<Eigen::Index>(nf));
-    }
+  CellKernel cell(map, sp, f, dof, coefficients);
+  for (int c = 0; c < static_cast<int>(sp.mesh().num_cells()); ++c) {
+    cell.compute(c);
+    const std::size_t nf = cell.rows.size();
     // ids ascending => interior DOF numbers ascending, like the rows of a column.
     for (std::size_t s = 0; s < nf; ++s) {
-      const int js = dof[ids[s]];
-      if (js < 0) {  // Dirichlet DOF: lift K(r, s) g_s into the load of interior rows r
-        for (std::size_t r = 0; r < nf; ++r)
-          if (dof[ids[r]] >= 0)
-            rhs[dof[ids[r]]] -= (r >= s ? Kloc(r, s) : Kloc(s, r)) * coefficients[ids[s]];
-        continue;
-      }
-      rhs[js] += floc[s];
+      const int js = cell.rows[s];
+      if (js < 0) continue;
+      rhs[js] += cell.floc[static_cast<Eigen::Index>(s)];
       int p = outer[js];
       for (std::size_t r = s; r < nf; ++r) {
-        const int ir = dof[ids[r]];
+        const int ir = cell.rows[r];
         if (ir < 0) continue;
         while (inner[p] != ir) ++p;  // present by construction of the pattern
-        values[p] += Kloc(r, s);
+        values[p] += cell.Kloc(r, s);
       }
     }
   }
   return K;
+}
+
+/// The same system handed cell by cell to an external solver, for the cells it
+/// asks for. An exception on this process (e.g. f not finite) is rethrown only
+/// after end_assembly, so that the other processes are not left waiting.
+void assemble_external(const TSplineMap& map, const AnalysisSpace& sp, const ScalarField& f,
+                       const std::vector<int>& dof, int ni, const Eigen::VectorXd& coefficients,
+                       InteriorSystemSolver& solver) {
+  const auto [first, last] = solver.begin(sp, dof, ni);
+  std::exception_ptr failure;
+  try {
+    CellKernel cell(map, sp, f, dof, coefficients);
+    for (int c = first; c < last; ++c) {
+      cell.compute(c);
+      solver.add_cell(cell.rows, cell.Kloc, cell.floc);
+    }
+  } catch (...) {
+    failure = std::current_exception();
+  }
+  const bool all_ok = solver.end_assembly(!failure);
+  if (failure) std::rethrow_exception(failure);
+  if (!all_ok) throw NumericalError("Poisson assembly failed on another process (see its message)");
 }
 
 }  // namespace
@@ -328,6 +498,11 @@ PoissonSolution solve_poisson(const TSplineMap& map, const TMesh& analysis_mesh,
 
 PoissonSolution solve_poisson(const TSplineMap& map, std::shared_ptr<const AnalysisSpace> space,
                               const PoissonProblem& problem) {
+  return solve_poisson(map, std::move(space), problem, nullptr);
+}
+
+PoissonSolution solve_poisson(const TSplineMap& map, std::shared_ptr<const AnalysisSpace> space,
+                              const PoissonProblem& problem, InteriorSystemSolver* solver) {
   if (!problem.f) throw InputError("Poisson problem: the source f is missing");
   if (!problem.g) throw InputError("Poisson problem: the Dirichlet data g is missing");
   PoissonSolution sol;
@@ -347,6 +522,17 @@ PoissonSolution solve_poisson(const TSplineMap& map, std::shared_ptr<const Analy
   for (int a = 0; a < n; ++a)
     if (!sol.is_boundary[a]) dof[a] = ni++;
   sol.interior_dofs = static_cast<std::size_t>(ni);
+
+  if (ni > 0 && solver != nullptr && solver->accepts(static_cast<std::size_t>(ni))) {
+    t0 = Clock::now();
+    assemble_external(map, sp, problem.f, dof, ni, sol.coefficients, *solver);
+    sol.assembly_seconds = seconds_since(t0);
+    Eigen::VectorXd u;
+    sol.solver = solver->solve(u);
+    for (int a = 0; a < n; ++a)
+      if (dof[a] >= 0) sol.coefficients[a] = u[dof[a]];
+    return sol;
+  }
 
   t0 = Clock::now();
   Eigen::VectorXd rhs;

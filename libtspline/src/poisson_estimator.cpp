@@ -141,7 +141,7 @@ std::vector<PoissonStep> solve_adaptive(const TSplineMap& map, const PoissonProb
     const auto t0 = Clock::now();
     auto space = std::make_shared<const AnalysisSpace>(map, mesh);
     if (k > 0 && space->num_dofs() > options.max_dofs) break;
-    const PoissonSolution sol = solve_poisson(map, space, problem);
+    const PoissonSolution sol = solve_poisson(map, space, problem, options.solver);
     PoissonStep st;
     st.step = k;
     st.dofs = space->num_dofs();

@@ -34,7 +34,10 @@
 //    interior system is symmetric positive definite.
 //  * Solve: CHOLMOD's supernodal Cholesky (SuiteSparse); if it fails, Eigen's
 //    SimplicialLDLT; if that fails too, conjugate gradients
-//    with an incomplete Cholesky preconditioner.
+//    with an incomplete Cholesky preconditioner. Or, when an InteriorSystemSolver
+//    is given (e.g. the PETSc module, tspline/petsc_solver.h) and accepts the
+//    size, the element matrices of the cells it asks for are handed to it and it
+//    solves (iteratively, possibly distributed over processes).
 //
 // Errors (when an exact solution is given): L2 and H1-seminorm, 6x6 Gauss points per
 // piece of each analysis cell (as above). If the exact gradient is not given it is computed by central
@@ -50,7 +53,9 @@
 #include <Eigen/SparseCore>
 #include <functional>
 #include <memory>
+#include <span>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "tspline/hierarchical_basis.h"
@@ -94,6 +99,33 @@ struct SolverStats {
   double seconds = 0.0;            ///< factorization + solve
   double relative_residual = 0.0;  ///< ||K u - b|| / ||b|| of the interior system (0 if b = 0)
   int iterations = 0;              ///< CG iterations (0 for the direct solver)
+  int processes = 1;               ///< processes that shared the solve
+};
+
+/// An external solver of the interior system K u = b (K symmetric positive
+/// definite), fed element by element. The core stays free of it: the PETSc
+/// module (target tspline_petsc) implements it. All calls are made on every
+/// process of a distributed run, in the same order (collective).
+class InteriorSystemSolver {
+ public:
+  virtual ~InteriorSystemSolver() = default;
+  /// Whether it solves a system of ni unknowns; if not, the built-in direct solver does.
+  virtual bool accepts(std::size_t ni) const = 0;
+  /// Starts the system: dof[a] = interior number of basis function a (-1 for a
+  /// Dirichlet function), ni unknowns. Returns the cells [first, last) this
+  /// process assembles.
+  virtual std::pair<int, int> begin(const AnalysisSpace& space, const std::vector<int>& dof, int ni) = 0;
+  /// One cell's contribution: rows[k] = interior number of the cell's k-th
+  /// function (-1: Dirichlet, to be ignored); Kloc its element stiffness matrix
+  /// (LOWER triangle filled, K(r, s) for r >= s); floc its load with the
+  /// Dirichlet lift already subtracted.
+  virtual void add_cell(std::span<const int> rows, const Eigen::MatrixXd& Kloc, const Eigen::VectorXd& floc) = 0;
+  /// Ends the assembly; ok = false if this process failed. Returns whether
+  /// every process succeeded.
+  virtual bool end_assembly(bool ok) = 0;
+  /// Solves; u receives all ni interior values (on every process). \throw
+  /// NumericalError if the solve does not converge.
+  virtual SolverStats solve(Eigen::VectorXd& u) = 0;
 };
 
 struct PoissonSolution {
@@ -129,6 +161,10 @@ PoissonSolution solve_poisson(const TSplineMap& map, const TMesh& analysis_mesh,
 /// Same on an already built analysis space (built with the same map).
 PoissonSolution solve_poisson(const TSplineMap& map, std::shared_ptr<const AnalysisSpace> space,
                               const PoissonProblem& problem);
+/// Same, with an external solver of the interior system (null: the built-in
+/// direct solver); it is used if it accepts the number of unknowns.
+PoissonSolution solve_poisson(const TSplineMap& map, std::shared_ptr<const AnalysisSpace> space,
+                              const PoissonProblem& problem, InteriorSystemSolver* solver);
 
 /// u_h at parametric point uv of analysis cell c (order 0, 1 or 2).
 SolutionValue evaluate_solution(const TSplineMap& map, const PoissonSolution& sol, int c, const Eigen::Vector2d& uv,
@@ -173,6 +209,7 @@ struct AdaptiveSolveOptions {
   int steps = 5;                ///< number of solves (>= 1)
   double gamma = 0.5;           ///< marking parameter in [0,1]
   std::size_t max_dofs = 200000;  ///< stop before a solve on a space with more DOFs
+  InteriorSystemSolver* solver = nullptr;  ///< external solver (see solve_poisson); not owned
 };
 
 struct PoissonStep {
