@@ -173,6 +173,8 @@ TEST_SUITE("tspline_fit") {
     ad.max_adapt = 2;
     ad.optimize_control_points = false;
     ad.stall_rounds = 5;
+    ad.min_quality_gain = 0.0;      // every round, whatever it gains
+    ad.max_quality_fraction = 2.0;  // and however many cells it marks
     const tspline::ParameterizationResult r = tspline::run_parameterization(poly, {}, ad);
     REQUIRE(r.iterations.size() == 3);
     for (std::size_t k = 0; k + 1 < r.iterations.size(); ++k) {

@@ -297,7 +297,7 @@ ParameterizationResult run_parameterization(const Polygon& polygon, const Parame
       r.stop_reason = r.boundary_problem;
     } else if (it >= ad.max_adapt) {
       r.stop_reason = "reached --max-adapt " + std::to_string(ad.max_adapt);
-    } else if (certified && best->score.certified && it > last_gain_it) {
+    } else if (certified && best->score.certified && ad.min_quality_gain > 0.0 && it > last_gain_it) {
       r.stop_reason = "certified; refining the cells with J_r < " + std::to_string(ad.min_jacobian) +
                       " raised the whole-map min J_r by less than " +
                       std::to_string(static_cast<int>(100 * ad.min_quality_gain)) +

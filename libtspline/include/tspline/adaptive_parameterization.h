@@ -42,6 +42,7 @@ struct AdaptiveOptions {
   /// raises the whole-map min J_r by at least this fraction (where the minimum
   /// is set by the boundary and the corners, refinement only adds cells:
   /// Hispaniola went from 0.077 to 0.096 over 5 rounds and 1,057 to 55,774 cells).
+  /// 0 disables this stop.
   double min_quality_gain = 0.1;
   /// Once certified, no round refines more than this fraction of the cells for
   /// J_r < delta alone (measured on Newfoundland: 3,647 of 6,964 cells below
