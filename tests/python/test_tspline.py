@@ -146,8 +146,10 @@ def test_example_script(tmp_path):
 
     root = pathlib.Path(__file__).resolve().parents[2]
     env = dict(os.environ, PYTHONPATH=os.pathsep.join(sys.path))
-    r = subprocess.run([sys.executable, str(root / "examples" / "ex6_python.py"), str(root / "examples" / "flower.txt"),
-                        str(tmp_path)], capture_output=True, text=True, env=env, check=False)
+    # On a bundled real coastline (Rhodes, km).
+    coast = root / "tests" / "data" / "coastlines" / "rhodes.txt"
+    r = subprocess.run([sys.executable, str(root / "examples" / "ex6_python.py"), str(coast), str(tmp_path)],
+                       capture_output=True, text=True, env=env, check=False)
     assert r.returncode == 0, r.stderr
     assert "certified valid: True" in r.stdout
     assert "reloaded map identical: True" in r.stdout
@@ -155,3 +157,25 @@ def test_example_script(tmp_path):
     # -Laplace u = 1, u = 0 on the border: u_h > 0 inside.
     last = [line for line in r.stdout.splitlines() if line.startswith("max u_h")][0]
     assert float(last.split(":")[1]) > 0
+
+
+def test_evaluate_equals_tspline_eval_on_a_coastline(tmp_path):
+    """A bundled coastline (km): the module's evaluate and the `tspline eval`
+    command on the saved file agree to round-off (both print/hold 17 digits)."""
+    import subprocess
+    app = pathlib.Path(__file__).resolve().parent.parent.parent / "build" / "apps" / "tspline"
+    if not app.exists():
+        pytest.fail(f"the tspline program is not built at {app}")
+    m = tspline.parameterize(str(DATA / "coastlines" / "isle_of_man.txt"))
+    assert m.certified_valid
+    path = tmp_path / "iom.json"
+    m.save(str(path))
+    uv = np.array([[0.1, 0.2], [0.5, 0.5], [0.93, 0.41], [0.0, 0.0], [1.0, 0.7]])
+    args = [str(app), "eval", str(path)]
+    for u, v in uv:
+        args += ["--at", repr(float(u)), repr(float(v))]
+    out = subprocess.run(args, check=True, capture_output=True, text=True).stdout.split("\n")
+    got = np.array([[float(t) for t in line.split()[2:4]] for line in out if line.strip()])
+    diam = np.ptp(np.loadtxt(DATA / "coastlines" / "isle_of_man.txt"), axis=0).max()
+    assert got.shape == (len(uv), 2)
+    assert np.abs(got - m.evaluate(uv)).max() <= 1e-13 * diam
