@@ -24,12 +24,15 @@ PetscSession::~PetscSession() {
 }  // namespace tspline_app
 
 #if defined(__SANITIZE_ADDRESS__)
+// The tspline program's LeakSanitizer suppressions (one definition per program).
 // Open MPI, hwloc and PETSc keep allocations to the end of the process (and
 // Open MPI's plugins are dlopen'ed; sanitizer_keep_plugins.cpp keeps them
-// mapped); LeakSanitizer would report them. Leaks whose stack passes through
-// these libraries are suppressed; ours are not.
+// mapped); so do GDAL/PROJ (driver registry, PROJ contexts) and
+// Cairo/fontconfig (font caches). LeakSanitizer would report them. Leaks whose
+// stack passes through these libraries are suppressed; ours are not.
 extern "C" const char* __lsan_default_suppressions() {
-  return "leak:libmpi\nleak:libopen-pal\nleak:libopen-rte\nleak:libhwloc\nleak:libpetsc\nleak:libHYPRE\n"
+  return "leak:libgdal\nleak:libproj\nleak:libcairo\nleak:libfontconfig\n"
+         "leak:libmpi\nleak:libopen-pal\nleak:libopen-rte\nleak:libhwloc\nleak:libpetsc\nleak:libHYPRE\n"
          "leak:mca_\nleak:libpmix\nleak:libevent\n"
          // One string of Open MPI's set-up (opal_asprintf): the fast unwinder
          // stops inside glibc's vasprintf, so its caller cannot be named. Our

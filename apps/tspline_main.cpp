@@ -25,15 +25,7 @@
 #include "tspline/io/polygon_reader.h"
 #include "tspline/parameterization.h"
 
-#if defined(__SANITIZE_ADDRESS__)
-// LeakSanitizer: GDAL/PROJ (driver registry, PROJ contexts) and Cairo/fontconfig
-// (font caches) keep allocations to the end of the process; suppress leaks
-// whose stack passes through those third-party libraries only.
-extern "C" const char* __lsan_default_suppressions() {
-  return "leak:libgdal\nleak:libproj\nleak:libcairo\nleak:libfontconfig\n";
-}
-extern "C" const char* __lsan_default_options() { return "print_suppressions=0"; }
-#endif
+// LeakSanitizer suppressions of the program (third-party libraries only): apps/petsc_session.cpp.
 
 namespace {
 
