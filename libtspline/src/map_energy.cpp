@@ -64,6 +64,39 @@ void parallel_ranges(std::size_t n, int threads, Body&& body) {
 
 }  // namespace
 
+namespace {
+
+// The sample's Jacobian J = dS/d(xi, eta) in normalized coordinates and what
+// the gradient needs, from the element's Bernstein coefficients.
+struct SampleJacobian {
+  double J00, J01, J10, J11;   // [dS/dxi dS/deta], rows x, y
+  double x, y, w, ws, wt;      // X and w and w's derivatives (local coordinates)
+};
+
+inline SampleJacobian sample_jacobian(const std::array<double, 16>& X, const std::array<double, 16>& Y,
+                                      const std::array<double, 16>& W, const std::array<double, 16>& B,
+                                      const std::array<double, 16>& Bs, const std::array<double, 16>& Bt, double hx,
+                                      double hy) {
+  double x = 0, y = 0, xs = 0, ys = 0, xt = 0, yt = 0, w = 0, ws = 0, wt = 0;
+  for (int i = 0; i < 16; ++i) {
+    x += X[i] * B[i], y += Y[i] * B[i];
+    xs += X[i] * Bs[i], ys += Y[i] * Bs[i];
+    xt += X[i] * Bt[i], yt += Y[i] * Bt[i];
+    w += W[i] * B[i], ws += W[i] * Bs[i], wt += W[i] * Bt[i];
+  }
+  const double iw = 1.0 / w;
+  // S = X / w: S_s = (X_s - S w_s) / w, S_t = (X_t - S w_t) / w.
+  SampleJacobian r;
+  r.J00 = (xs - x * iw * ws) * iw / hx;
+  r.J10 = (ys - y * iw * ws) * iw / hx;
+  r.J01 = (xt - x * iw * wt) * iw / hy;
+  r.J11 = (yt - y * iw * wt) * iw / hy;
+  r.x = x, r.y = y, r.w = w, r.ws = ws, r.wt = wt;
+  return r;
+}
+
+}  // namespace
+
 MapEnergy::MapEnergy(const TSplineMap& map, const MapEnergyOptions& opt)
     : options_(opt), extraction_(map.basis()) {
   if (!opt.lobatto && (opt.gauss < 1 || opt.gauss > 6)) throw std::invalid_argument("MapEnergy: gauss must be in [1, 6]");
@@ -139,30 +172,16 @@ MapEnergy::MapEnergy(const TSplineMap& map, const MapEnergyOptions& opt)
   for (std::size_t a = 0; a < P.size(); ++a) normalized_[a] = P[a] - centre_;
   double area = 0.0;
   {
-    const Eigen::VectorXd x0 = variables(map);
     // Integrate det J with area weights regardless of the weighting option.
+    const Eigen::VectorXd x0 = variables(map);
     const Pattern& pat = patterns_[0];
-    const std::vector<Eigen::Vector2d> cp = control_points(x0.data());
     for (std::size_t k = 0; k < es.size(); ++k) {
-      const BezierElement& e = es[k];
       const Element& d = elements_[k];
-      std::array<double, 16> X{}, Y{};
-      for (Eigen::Index r = 0; r < e.C.rows(); ++r) {
-        const Eigen::Vector2d p = cp[e.functions[r]] - centre_;
-        for (int i = 0; i < 16; ++i) X[i] += p.x() * e.C(r, i), Y[i] += p.y() * e.C(r, i);
-      }
+      std::array<double, 16> X, Y;
+      element_coefficients(k, x0.data(), X, Y);
       for (std::size_t q = 0; q < pat.weight.size(); ++q) {
-        double x = 0, y = 0, xs = 0, ys = 0, xt = 0, yt = 0, w = 0, ws = 0, wt = 0;
-        for (int i = 0; i < 16; ++i) {
-          x += X[i] * pat.B[q][i], y += Y[i] * pat.B[q][i];
-          xs += X[i] * pat.Bs[q][i], ys += Y[i] * pat.Bs[q][i];
-          xt += X[i] * pat.Bt[q][i], yt += Y[i] * pat.Bt[q][i];
-          w += d.W[i] * pat.B[q][i], ws += d.W[i] * pat.Bs[q][i], wt += d.W[i] * pat.Bt[q][i];
-        }
-        const double iw = 1.0 / w;
-        const double Sxs = (xs - x * iw * ws) * iw, Sys = (ys - y * iw * ws) * iw;
-        const double Sxt = (xt - x * iw * wt) * iw, Syt = (yt - y * iw * wt) * iw;
-        area += pat.weight[q] * (Sxs * Syt - Sys * Sxt);  // d(xi,eta) = h^2 ds dt cancels the 1/h^2 of J
+        const SampleJacobian j = sample_jacobian(X, Y, d.W, pat.B[q], pat.Bs[q], pat.Bt[q], d.hx, d.hy);
+        area += pat.weight[q] * d.hx * d.hy * (j.J00 * j.J11 - j.J01 * j.J10);
       }
     }
   }
@@ -170,6 +189,19 @@ MapEnergy::MapEnergy(const TSplineMap& map, const MapEnergyOptions& opt)
     throw std::invalid_argument("MapEnergy: the map's domain has no positive area (boundary curve clockwise or degenerate)");
   L_ = std::sqrt(area);
   for (Eigen::Vector2d& p : normalized_) p /= L_;
+}
+
+void MapEnergy::element_coefficients(std::size_t k, const double* x, std::array<double, 16>& X,
+                                     std::array<double, 16>& Y) const {
+  const BezierElement& e = extraction_.elements()[k];
+  X.fill(0.0), Y.fill(0.0);
+  for (Eigen::Index r = 0; r < e.C.rows(); ++r) {
+    const int a = e.functions[r];
+    const int v = variable_of_[a];
+    const double px = v >= 0 ? x[v] : normalized_[a].x();
+    const double py = v >= 0 ? x[v + 1] : normalized_[a].y();
+    for (int i = 0; i < 16; ++i) X[i] += px * e.C(r, i), Y[i] += py * e.C(r, i);
+  }
 }
 
 Eigen::VectorXd MapEnergy::variables(const TSplineMap& map) const {
@@ -202,38 +234,6 @@ std::size_t MapEnergy::num_samples() const {
   return n;
 }
 
-namespace {
-
-// The sample's Jacobian J = dS/d(xi, eta) in normalized coordinates and what
-// the gradient needs, from the element's Bernstein coefficients.
-struct SampleJacobian {
-  double J00, J01, J10, J11;   // [dS/dxi dS/deta], rows x, y
-  double x, y, w, ws, wt;      // X and w and w's derivatives (local coordinates)
-};
-
-inline SampleJacobian sample_jacobian(const std::array<double, 16>& X, const std::array<double, 16>& Y,
-                                      const std::array<double, 16>& W, const std::array<double, 16>& B,
-                                      const std::array<double, 16>& Bs, const std::array<double, 16>& Bt, double hx,
-                                      double hy) {
-  double x = 0, y = 0, xs = 0, ys = 0, xt = 0, yt = 0, w = 0, ws = 0, wt = 0;
-  for (int i = 0; i < 16; ++i) {
-    x += X[i] * B[i], y += Y[i] * B[i];
-    xs += X[i] * Bs[i], ys += Y[i] * Bs[i];
-    xt += X[i] * Bt[i], yt += Y[i] * Bt[i];
-    w += W[i] * B[i], ws += W[i] * Bs[i], wt += W[i] * Bt[i];
-  }
-  const double iw = 1.0 / w;
-  // S = X / w: S_s = (X_s - S w_s) / w, S_t = (X_t - S w_t) / w.
-  SampleJacobian r;
-  r.J00 = (xs - x * iw * ws) * iw / hx;
-  r.J10 = (ys - y * iw * ws) * iw / hx;
-  r.J01 = (xt - x * iw * wt) * iw / hy;
-  r.J11 = (yt - y * iw * wt) * iw / hy;
-  r.x = x, r.y = y, r.w = w, r.ws = ws, r.wt = wt;
-  return r;
-}
-
-}  // namespace
 
 double MapEnergy::evaluate(const double* xv, double eps, double* gradient, std::size_t* nonpositive,
                            double power) const {
@@ -253,14 +253,8 @@ double MapEnergy::evaluate(const double* xv, double eps, double* gradient, std::
       const Element& d = elements_[k];
       const Pattern& pat = patterns_[d.level];
       const Eigen::Index nf = e.C.rows();
-      std::array<double, 16> X{}, Y{};
-      for (Eigen::Index r = 0; r < nf; ++r) {
-        const int a = e.functions[r];
-        const int v = variable_of_[a];
-        const double px = v >= 0 ? xv[v] : normalized_[a].x();
-        const double py = v >= 0 ? xv[v + 1] : normalized_[a].y();
-        for (int i = 0; i < 16; ++i) X[i] += px * e.C(r, i), Y[i] += py * e.C(r, i);
-      }
+      std::array<double, 16> X, Y;
+      element_coefficients(k, xv, X, Y);
       std::array<double, 16> GX{}, GY{};
       for (std::size_t q = 0; q < pat.weight.size(); ++q) {
         const SampleJacobian s = sample_jacobian(X, Y, d.W, pat.B[q], pat.Bs[q], pat.Bt[q], d.hx, d.hy);
@@ -327,17 +321,10 @@ SampleStats MapEnergy::stats(const double* xv) const {
   st.min_mean_ratio = std::numeric_limits<double>::infinity();
   double wsum = 0.0, jsum = 0.0;
   for (std::size_t k = 0; k < es.size(); ++k) {
-    const BezierElement& e = es[k];
     const Element& d = elements_[k];
     const Pattern& pat = patterns_[d.level];
-    std::array<double, 16> X{}, Y{};
-    for (Eigen::Index r = 0; r < e.C.rows(); ++r) {
-      const int a = e.functions[r];
-      const int v = variable_of_[a];
-      const double px = v >= 0 ? xv[v] : normalized_[a].x();
-      const double py = v >= 0 ? xv[v + 1] : normalized_[a].y();
-      for (int i = 0; i < 16; ++i) X[i] += px * e.C(r, i), Y[i] += py * e.C(r, i);
-    }
+    std::array<double, 16> X, Y;
+    element_coefficients(k, xv, X, Y);
     for (std::size_t q = 0; q < pat.weight.size(); ++q) {
       const SampleJacobian s = sample_jacobian(X, Y, d.W, pat.B[q], pat.Bs[q], pat.Bt[q], d.hx, d.hy);
       const double D = s.J00 * s.J11 - s.J01 * s.J10;

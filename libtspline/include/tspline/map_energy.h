@@ -124,6 +124,10 @@ class MapEnergy {
     double weight = 1.0;
     int level = 0;
   };
+  // X and Y Bernstein coefficients of element k at the variables x.
+  void element_coefficients(std::size_t k, const double* x, std::array<double, 16>& X,
+                            std::array<double, 16>& Y) const;
+
   MapEnergyOptions options_;
   BezierExtraction extraction_;
   std::vector<Element> elements_;
