@@ -85,6 +85,7 @@ Map parameterize(const py::object& domain, py::kwargs kwargs) {
   adaptive.min_jacobian = take(kw, "min_jacobian", adaptive.min_jacobian);
   adaptive.max_adapt = take(kw, "max_adapt", adaptive.max_adapt);
   adaptive.max_cells = take(kw, "max_cells", adaptive.max_cells);
+  opt.max_cells = adaptive.max_cells;  // one budget, as in `tspline param`
   adaptive.optimize_control_points = !take(kw, "no_control_point_optimization", false);
   adaptive.certification.max_depth = take(kw, "cert_depth", adaptive.certification.max_depth);
   if (kw.contains("polygon")) dopt.polygon_index = take<std::size_t>(kw, "polygon", 0);

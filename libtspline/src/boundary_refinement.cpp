@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <sstream>
 #include <vector>
 
 #include "tspline/errors.h"
@@ -75,7 +76,17 @@ BoundaryRefinementReport refine_to_boundary(TMesh& mesh, const BoundaryMap& boun
     throw InputError("boundary tolerance must be a positive number");
   if (options.max_level < 1 || options.max_level > TMesh::kMaxLevel)
     throw InputError("maximum refinement level must be in [1, " + std::to_string(TMesh::kMaxLevel) + "]");
+  if (options.max_cells < 1) throw InputError("--max-cells must be >= 1");
   BoundaryRefinementReport report;
+  std::size_t leaves = 0;
+  for (const QuadNode& q : mesh.nodes()) leaves += q.is_leaf();
+  auto over_budget = [&] {
+    std::ostringstream s;
+    s << "the boundary needs more than " << options.max_cells << " cells (--max-cells) to meet the tolerance "
+      << options.tolerance_area << " (an area) at levels up to " << options.max_level
+      << ": raise --max-cells, --tol or --tol-rel, or simplify the polygon (long thin parts need the most cells)";
+    return InputError(s.str());
+  };
   for (;;) {
     ++report.passes;
     std::vector<int> work;
@@ -87,13 +98,17 @@ BoundaryRefinementReport refine_to_boundary(TMesh& mesh, const BoundaryMap& boun
       const QuadNode q = mesh.node(n);
       if (q.level >= options.max_level) continue;
       if (node_boundary_error(q, boundary) <= options.tolerance_area) continue;
+      if (leaves + 3 > options.max_cells) throw over_budget();
       const int c = mesh.refine(n);
+      leaves += 3;
       ++report.boundary_splits;
       for (int k = 0; k < 4; ++k)
         if (touches_boundary(mesh.node(c + k))) work.push_back(c + k);
     }
     const std::size_t splits = mesh.balance();
     report.balance_splits += splits;
+    leaves += 3 * splits;
+    if (leaves > options.max_cells) throw over_budget();
     if (splits == 0) break;
   }
   for (const QuadNode& q : mesh.nodes()) {

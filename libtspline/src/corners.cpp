@@ -248,9 +248,27 @@ std::vector<Corners> corner_candidates(const Polygon& p, std::size_t count) {
   for (int j = 0; j < 16; ++j) cand.push_back(snap(j * per / 16));
   for (std::size_t b = 0; b < std::min<std::size_t>(4, best.size()); ++b)
     for (int j = 1; j < 4; ++j) cand.push_back(snap(cum[best[b]] + j * per / 4));
-  for (std::size_t i = 0; cand.size() < 4 + 4 && i < n; ++i) cand.push_back(i);  // tiny polygons
   std::sort(cand.begin(), cand.end());
   cand.erase(std::unique(cand.begin(), cand.end()), cand.end());
+  // Too few distinct candidates (a small polygon, or one whose perimeter is
+  // nearly all in a few long edges, so that the snapped positions coincide):
+  // add the cheapest other vertices (convex ones first: `order` is by cost)
+  // until there are 8, or all n.
+  // A corner must be strictly convex (run_front rejects others), so at least
+  // four convex candidates are wanted where the polygon has them.
+  auto convex = [&](std::size_t i) { return vc[i] < 10.0; };
+  const std::size_t convex_wanted = std::min<std::size_t>(4, std::count_if(order.begin(), order.end(), convex));
+  for (std::size_t i : order) {
+    if (cand.size() >= std::min<std::size_t>(8, n) &&
+        static_cast<std::size_t>(std::count_if(cand.begin(), cand.end(), convex)) >= convex_wanted)
+      break;
+    const auto at = std::lower_bound(cand.begin(), cand.end(), i);
+    if (at == cand.end() || *at != i) cand.insert(at, i);
+  }
+  // Where four convex candidates are, drop the others, so that no balance
+  // term can pick a reflex or straight vertex.
+  if (std::count_if(cand.begin(), cand.end(), convex) >= 4)
+    cand.erase(std::remove_if(cand.begin(), cand.end(), [&](std::size_t i) { return !convex(i); }), cand.end());
 
   // Exhaustive search over ordered quadruples of candidates: O(K^4), K <= 72.
   // Keep the kKeep cheapest in a max-heap, then pick up to `count` of them that
@@ -290,6 +308,9 @@ std::vector<Corners> corner_candidates(const Polygon& p, std::size_t count) {
     kept.push_back(ch.second);
     result.push_back(finish_choice(p, cum, ch.second, ch.first, K));
   }
+  // Unreachable for a validated polygon (n >= 4 candidates, finite costs); a
+  // clear error rather than an empty list that callers index.
+  if (result.empty()) throw NumericalError("corners: no automatic choice of four corners could be evaluated");
   return result;
 }
 

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
+#include <optional>
 #include <sstream>
 
 #include "tspline/coons.h"
@@ -138,7 +140,7 @@ FrontResult optimize_front(BoundaryMap boundary, const ParameterizationOptions& 
     TMesh coarse = k == 0 ? TMesh(st.level[0]) : r.mesh;
     if (k == 0) r.mesh = TMesh(st.level[0]);
     refine_below(r.mesh, st.level[k]);
-    const BoundaryRefinementReport rep = refine_to_boundary(r.mesh, r.boundary, {st.tol[k], opt.max_level});
+    const BoundaryRefinementReport rep = refine_to_boundary(r.mesh, r.boundary, {st.tol[k], opt.max_level, opt.max_cells});
     if (last) r.refinement = rep;
     clock.stop("tmesh");
     if (last) {
@@ -183,20 +185,66 @@ FrontResult optimize_front(BoundaryMap boundary, const ParameterizationOptions& 
       r.mesh.refine(coarse.cell_node(c));
       ++refined;
     }
-    if (refined == 0) break;
+    if (refined == 0) {
+      r.repair_stop_reason = "the " + std::to_string(r.quality_optimized.inverted_cells) +
+                             " inverted cells are at --max-level " + std::to_string(opt.max_level);
+      log("repair stopped: " + r.repair_stop_reason);
+      break;
+    }
     r.mesh.balance();
     r.mesh.build_topology();
+    if (r.mesh.num_cells() > opt.max_cells) {
+      // The domain needs a finer mesh than allowed (typically a long thin
+      // part): say so and stop rather than go on with a tangled mesh.
+      std::ostringstream s;
+      s << "the polygon needs more than " << opt.max_cells << " cells (--max-cells): after " << round
+        << " repair round(s) " << r.quality_optimized.inverted_cells << " of " << coarse.num_cells()
+        << " T-mesh cells are still inverted, and refining them makes " << r.mesh.num_cells()
+        << " cells; raise --max-cells, or check the polygon for long thin parts (spikes, narrow channels)";
+      throw InputError(s.str());
+    }
+    // The state before this round, restored if the round makes things worse.
+    std::vector<Eigen::Vector2d> before = r.optimized;
+    const MeshQualityStats quality_before = r.quality_optimized;
+    const meshopt::SmoothingReport smoothing_before = r.smoothing;
     r.optimized = transfer_positions(coarse, r.optimized, r.mesh, r.boundary);
     r.repair_refined_cells.push_back(refined);
     log("repair round " + std::to_string(round + 1) + ": refined " + std::to_string(refined) +
         " inverted cells, now " + std::to_string(r.mesh.num_cells()) + " cells");
     optimize("repair " + std::to_string(round + 1));
     clock.stop("repair");
+    if (r.quality_optimized.inverted_cells > quality_before.inverted_cells) {
+      // Diverging (the inverted region grows with each round, as where a long
+      // thin part needs far finer cells than its neighbourhood): more rounds
+      // only multiply the cells. Keep the mesh before this round.
+      r.repair_stop_reason = "repair round " + std::to_string(round + 1) + " left more inverted cells (" +
+                             std::to_string(r.quality_optimized.inverted_cells) + ") than before it (" +
+                             std::to_string(quality_before.inverted_cells) + "); kept the mesh before it";
+      r.mesh = coarse;
+      r.optimized = std::move(before);
+      r.quality_optimized = quality_before;
+      r.smoothing = smoothing_before;
+      r.repair_refined_cells.pop_back();
+      log("repair stopped: " + r.repair_stop_reason);
+      break;
+    }
   }
   return r;
 }
 
 }  // namespace
+
+std::size_t best_corner_trial(const std::vector<CornerTrial>& trials) {
+  std::size_t best = 0;
+  for (std::size_t k = 1; k < trials.size(); ++k) {
+    const CornerTrial& a = trials[k];
+    const CornerTrial& b = trials[best];
+    if (a.inverted_cells < b.inverted_cells ||
+        (a.inverted_cells == b.inverted_cells && a.min_quality + a.mean_quality > b.min_quality + b.mean_quality))
+      best = k;
+  }
+  return best;
+}
 
 FrontResult run_front(const Polygon& input, const ParameterizationOptions& opt) {
   auto log = [&](const std::string& s) {
@@ -212,6 +260,7 @@ FrontResult run_front(const Polygon& input, const ParameterizationOptions& opt) 
     throw InputError("--tol-rel must be a positive finite number");
   if (opt.max_repair_rounds < 0) throw InputError("the number of repair rounds must be >= 0");
   if (opt.corner_trials < 1) throw InputError("--corner-trials must be >= 1");
+  if (opt.max_cells < 1) throw InputError("--max-cells must be >= 1");
 
   std::vector<StageTime> times;
   StageClock clock(times);
@@ -244,18 +293,23 @@ FrontResult run_front(const Polygon& input, const ParameterizationOptions& opt) 
         const double tol = opt.tolerance_absolute ? *opt.tolerance_absolute : opt.tolerance_relative * d * d;
         topt.tolerance_absolute = std::max(tol, 1e-5 * d * d);
       }
-      std::size_t best = 0;
+      std::optional<InputError> failed;  // the first trial that needed more than --max-cells
       for (std::size_t k = 0; k < cands.size(); ++k) {
-        const FrontResult t = optimize_front(BoundaryMap(poly, cands[k]), topt, nullptr);
-        trials.push_back({cands[k].index, t.quality_optimized.inverted_cells, t.quality_optimized.min_quality,
-                          t.quality_optimized.mean_quality});
-        const CornerTrial& a = trials[k];
-        const CornerTrial& b = trials[best];
-        if (a.inverted_cells < b.inverted_cells ||
-            (a.inverted_cells == b.inverted_cells &&
-             a.min_quality + a.mean_quality > b.min_quality + b.mean_quality))
-          best = k;
+        log("corners: trying automatic choice " + std::to_string(k + 1) + " of " + std::to_string(cands.size()));
+        try {
+          const FrontResult t = optimize_front(BoundaryMap(poly, cands[k]), topt, nullptr);
+          trials.push_back({cands[k].index, t.quality_optimized.inverted_cells, t.quality_optimized.min_quality,
+                            t.quality_optimized.mean_quality});
+        } catch (const InputError& e) {
+          // Over the cell budget with these corners: ranked last (the options
+          // themselves were validated above, so that is the only InputError).
+          if (!failed) failed.emplace(e);
+          constexpr double kWorst = -std::numeric_limits<double>::infinity();
+          trials.push_back({cands[k].index, std::numeric_limits<std::size_t>::max(), kWorst, kWorst});
+        }
       }
+      const std::size_t best = best_corner_trial(trials);
+      if (failed && trials[best].inverted_cells == std::numeric_limits<std::size_t>::max()) throw *failed;
       corners = cands[best];
       corners.explanation += " Of the " + std::to_string(cands.size()) +
                              " best automatic choices, tried on the T-mesh, this one gave the fewest inverted "
@@ -274,8 +328,9 @@ FrontResult run_front(const Polygon& input, const ParameterizationOptions& opt) 
       std::ostringstream s;
       s << "corner " << k << " (file vertex " << poly.file_index[i] << ") has an inner angle of "
         << corners.inner_angle_deg[k]
-        << " degrees: corners must be convex vertices (inner angle below 180); pick another vertex, or omit "
-           "--corners for the automatic choice";
+        << " degrees: corners must be convex vertices (inner angle below 180); "
+        << (opt.corners ? "pick another vertex, or omit --corners for the automatic choice"
+                        : "the polygon has fewer than four strictly convex vertices: give --corners");
       throw InputError(s.str());
     }
   }

@@ -83,6 +83,36 @@ bool edges_conflict(const std::vector<Point>& pts, std::size_t i, std::size_t j,
 
 }  // namespace
 
+void check_polygon_scale(const Polygon& p) {
+  if (p.vertices.empty()) return;
+  const auto& fi = p.file_index;
+  Eigen::Vector2d lo = p.vertices.front(), hi = lo;
+  std::size_t far = 0;
+  for (std::size_t i = 0; i < p.vertices.size(); ++i) {
+    const Eigen::Vector2d& v = p.vertices[i];
+    lo = lo.cwiseMin(v), hi = hi.cwiseMax(v);
+    if (v.cwiseAbs().maxCoeff() > p.vertices[far].cwiseAbs().maxCoeff()) far = i;
+  }
+  const Eigen::Vector2d& v = p.vertices[far];
+  if (v.cwiseAbs().maxCoeff() > kMaxPolygonCoordinate) {
+    std::ostringstream s;
+    s << "vertex " << (fi.empty() ? far : fi[far]) << " " << fmt_point(v.x(), v.y())
+      << " is too far from the origin: coordinates must lie within +-" << kMaxPolygonCoordinate
+      << " (lengths are squared in areas and Jacobian determinants, which would overflow); rescale the "
+         "coordinates (e.g. to km) or shift them nearer the origin";
+    throw InputError(s.str());
+  }
+  // Extent: the larger side of the bounding box (exact, no squares).
+  const double extent = (hi - lo).maxCoeff();
+  if (extent < kMinPolygonExtent) {
+    std::ostringstream s;
+    s << "polygon is too small: its bounding box is " << (hi - lo).x() << " x " << (hi - lo).y()
+      << ", below the smallest supported extent " << kMinPolygonExtent
+      << " (areas and Jacobian determinants would underflow); rescale the coordinates (e.g. to mm or um)";
+    throw InputError(s.str());
+  }
+}
+
 double signed_area(const Polygon& p) {
   const std::size_t n = p.vertices.size();
   if (n < 3) return 0.0;
@@ -117,6 +147,7 @@ Polygon validate_polygon(Polygon p) {
                        fmt_point(v.x(), v.y()));
     }
   }
+  check_polygon_scale(p);
   for (std::size_t i = 0; i < n; ++i) {
     const std::size_t j = (i + 1) % n;
     if (p.vertices[i] == p.vertices[j]) {

@@ -2,6 +2,7 @@
 // Refinement of the T-mesh until its boundary edges approximate the polygon
 // within a tolerance (Brovka 2013 Sect. 3, Fig. 2a).
 #include <cstddef>
+#include <limits>
 
 #include "tspline/boundary_map.h"
 #include "tspline/tmesh.h"
@@ -17,6 +18,9 @@ double boundary_edge_error(const BoundaryMap& boundary, Side side, double t0, do
 struct BoundaryRefinementOptions {
   double tolerance_area = 0.0;  ///< epsilon: refine while some triangle area exceeds it (absolute units^2)
   int max_level = 22;           ///< cells are not refined beyond this level
+  /// The T-mesh never has more leaves than this: InputError if meeting the
+  /// tolerance needs more (a long thin feature, or a tolerance too fine).
+  std::size_t max_cells = std::numeric_limits<std::size_t>::max();
 };
 
 struct BoundaryRefinementReport {
@@ -29,7 +33,8 @@ struct BoundaryRefinementReport {
 
 /// Refines the boundary cells of `mesh` by the area criterion and re-balances
 /// until every boundary edge meets the tolerance or reaches max_level. Builds the
-/// topology at the end. \throw InputError if tolerance_area <= 0 or max_level is invalid.
+/// topology at the end. \throw InputError if tolerance_area <= 0 or max_level is
+/// invalid, or if the mesh would need more than max_cells cells.
 BoundaryRefinementReport refine_to_boundary(TMesh& mesh, const BoundaryMap& boundary,
                                             const BoundaryRefinementOptions& options);
 

@@ -22,8 +22,8 @@ struct ParameterizationOptions {
   /// Corner vertex indices in the file's own numbering; automatic if empty.
   std::optional<std::array<long long, 4>> corners;
   /// Automatic corners: how many of the best choices to try (the whole front
-  /// half, initial level capped at 5) before keeping the one with the fewest
-  /// inverted cells, then the best min + mean triangle quality. 1: no trials.
+  /// half, initial level capped at 5) before keeping one by best_corner_trial
+  /// (a trial over --max-cells ranks last). 1: no trials.
   int corner_trials = 4;
   /// Boundary tolerance epsilon (an AREA, Sect. 3). If unset, epsilon =
   /// tolerance_relative * (bounding-box diagonal)^2.
@@ -33,6 +33,10 @@ struct ParameterizationOptions {
   int initial_level = 3;
   /// No cell is refined beyond this level.
   int max_level = 22;
+  /// The T-mesh never has more cells than this (`--max-cells`, the same budget
+  /// as AdaptiveOptions::max_cells): boundary refinement that needs more throws
+  /// InputError; repair rounds that would exceed it stop (repair_stop_reason).
+  std::size_t max_cells = 200000;
   /// If inverted cells remain after optimization, refine them, re-balance,
   /// re-optimize; at most this many rounds (0 disables the repair).
   int max_repair_rounds = 8;
@@ -58,6 +62,11 @@ struct CornerTrial {
   double mean_quality = 0.0;
 };
 
+/// The rule that keeps one of the corner trials: the fewest inverted cells,
+/// then the highest min + mean triangle quality; the first of equal trials.
+/// Returns its index (0 for an empty list).
+std::size_t best_corner_trial(const std::vector<CornerTrial>& trials);
+
 /// Everything the front half produces, for writers and reports.
 struct FrontResult {
   explicit FrontResult(BoundaryMap b) : boundary(std::move(b)) {}
@@ -75,6 +84,9 @@ struct FrontResult {
   std::size_t node_visits = 0;          ///< node optimizations over all runs
   /// Cells refined in each repair round (inverted cells after optimization).
   std::vector<std::size_t> repair_refined_cells;
+  /// Why the repair stopped with inverted cells left ("" if none are left or
+  /// the repair rounds ran out).
+  std::string repair_stop_reason;
   std::vector<CornerTrial> corner_trials;  ///< empty unless automatic corners were tried
   std::vector<StageTime> times;
   /// What clean_polygon removed from the input (file numbering), one note each.

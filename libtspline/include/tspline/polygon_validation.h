@@ -7,11 +7,24 @@
 
 namespace tspline {
 
+/// Coordinates beyond +-kMaxPolygonCoordinate, and polygons whose bounding box
+/// is smaller than kMinPolygonExtent on both sides, are rejected (not
+/// rescaled): the pipeline squares lengths (tolerance areas, Jacobian
+/// determinants, energies), which must stay far inside the range of doubles.
+/// A user rescales once (km, m, mm, ...) and keeps the units of the output.
+inline constexpr double kMaxPolygonCoordinate = 1e50;
+inline constexpr double kMinPolygonExtent = 1e-50;
+
+/// \throw InputError naming the vertex or the extent if the polygon's scale is
+/// outside the supported range above (called by validate_polygon).
+void check_polygon_scale(const Polygon& p);
+
 /// Checks that `p` is a simple polygon usable as a domain boundary and returns it
 /// oriented counter-clockwise (vertex order reversed if it was clockwise; the
 /// file_index entries travel with their vertices).
 /// \throw InputError with a one-line message naming the problem:
-///   fewer than 4 vertices; a NaN/inf coordinate (names the vertex); two equal
+///   fewer than 4 vertices; a NaN/inf coordinate (names the vertex); a scale
+///   out of range (check_polygon_scale); two equal
 ///   consecutive vertices (names them); zero area; collinear-overlapping or
 ///   crossing edges (names the two edges by their file vertex indices, e.g.
 ///   "polygon is not simple: edges 3-4 and 10-11 intersect near (x, y)"; "overlap
