@@ -1,6 +1,7 @@
 // meshopt: command-line front end of libmeshopt on CAD surfaces (issue 5).
 // Thin by design: it parses options, loads the model and mesh through the Gmsh
 // adapter, calls smooth_surface, writes the outputs and maps errors to exit codes.
+// Exit codes (apps/exit_codes.h, shared with tspline):
 //   exit 0  success
 //   exit 1  invalid input (model, mesh, options)
 //   exit 2  a file could not be written
@@ -16,10 +17,11 @@
 #include <stdexcept>
 #include <string>
 
+#include "exit_codes.h"
 #include "expression.h"
 #include "meshopt/gmsh/gmsh_mesh.h"
 #include "meshopt/surface_smoother.h"
-#include "tspline/errors.h"
+#include "toolkit/errors.h"
 #include "tspline/io/atomic_file.h"
 #include "tspline/io/vtu_writer.h"
 
@@ -47,7 +49,7 @@ SurfaceMeasure parse_measure(const std::string& s) {
   if (s == "shape") return SurfaceMeasure::shape;
   if (s == "size") return SurfaceMeasure::size;
   if (s == "size-shape") return SurfaceMeasure::size_shape;
-  throw tspline::InputError("--measure must be shape, size or size-shape, got '" + s + "'");
+  throw toolkit::InputError("--measure must be shape, size or size-shape, got '" + s + "'");
 }
 
 nlohmann::json stats_json(const ElementQualities& q) {
@@ -80,8 +82,8 @@ std::string line(const char* name, const ElementQualities& q) {
 int run_smooth(const SmoothArgs& a) {
   namespace fs = std::filesystem;
   const SurfaceMeasure measure = parse_measure(a.measure);
-  if (a.max_sweeps < 0) throw tspline::InputError("--max-sweeps must be >= 0");
-  if (!(a.tol > 0.0) || !std::isfinite(a.tol)) throw tspline::InputError("--tol must be positive");
+  if (a.max_sweeps < 0) throw toolkit::InputError("--max-sweeps must be >= 0");
+  if (!(a.tol > 0.0) || !std::isfinite(a.tol)) throw toolkit::InputError("--tol must be positive");
   const std::string report = a.report.empty() ? fs::path(a.out).replace_extension(".json").string() : a.report;
   for (const std::string& f : {a.out, a.vtu, report})
     if (!f.empty()) tspline::io::ensure_writable_directory(fs::absolute(f).parent_path().string());
@@ -178,29 +180,7 @@ int main(int argc, char** argv) {
   }
   try {
     return run_smooth(a);
-  } catch (const tspline::InputError& e) {
-    std::cerr << "error: " << e.what() << std::endl;
-    return 1;
-  } catch (const meshopt::gmsh_io::InputError& e) {
-    std::cerr << "error: " << e.what() << std::endl;
-    return 1;
-  } catch (const std::invalid_argument& e) {
-    std::cerr << "error: " << e.what() << std::endl;
-    return 1;
-  } catch (const tspline::IoError& e) {
-    std::cerr << "error: " << e.what() << std::endl;
-    return 2;
-  } catch (const meshopt::gmsh_io::IoError& e) {
-    std::cerr << "error: " << e.what() << std::endl;
-    return 2;
-  } catch (const std::exception& e) {
-    std::cerr << "internal error: " << e.what() << std::endl;
-    return 4;
-  } catch (const std::string& e) {  // Gmsh 4.8 throws strings
-    std::cerr << "internal error (Gmsh): " << e << std::endl;
-    return 4;
   } catch (...) {
-    std::cerr << "internal error" << std::endl;
-    return 4;
+    return tspline_app::report_current_exception("meshopt");
   }
 }

@@ -6,6 +6,8 @@
 #include <cstdio>
 #include <iostream>
 
+#include "interrupt.h"
+
 namespace tspline_app {
 
 OutputMode output_mode(bool quiet, bool json) {
@@ -30,6 +32,7 @@ void Progress::transient(const std::string& text) {
 }
 
 void Progress::log(const std::string& line) {
+  throw_if_interrupted();  // each report is a point where Ctrl-C stops the run (interrupt.h)
   switch (mode_) {
     case OutputMode::Quiet: return;
     case OutputMode::Json: std::cout << nlohmann::json{{"event", "log"}, {"message", line}}.dump() << std::endl; return;
@@ -42,6 +45,7 @@ void Progress::log(const std::string& line) {
 }
 
 void Progress::progress(const std::string& task, long done, long total) {
+  throw_if_interrupted();
   switch (mode_) {
     case OutputMode::Quiet: return;
     case OutputMode::Json:

@@ -32,6 +32,7 @@ class Progress {
   bool human() const { return mode_ == OutputMode::Human; }
 
   /// A log line. Lines that start with two spaces and "sweep" are transient.
+  /// log() and progress() throw toolkit::Interrupted after a SIGINT (interrupt.h).
   void log(const std::string& line);
   /// A progress bar "task [#####.....] done/total" (transient in human mode).
   void progress(const std::string& task, long done, long total);

@@ -1,5 +1,6 @@
 // tspline: command-line front end of libtspline. Thin by design: it parses
 // options, calls the library, prints progress, and maps errors to exit codes.
+// Exit codes (apps/exit_codes.h, shared with meshopt):
 //   exit 0  success
 //   exit 1  invalid input (polygon, corners, options)
 //   exit 2  file could not be read or written
@@ -7,6 +8,7 @@
 //           or det J > 0 not certified on every element; `tspline check`),
 //           or a numerical step failed (e.g. a singular interpolation system)
 //   exit 4  unexpected internal error
+//   exit 130 interrupted (Ctrl-C): stopped before writing any output
 #include <CLI/CLI.hpp>
 #include <array>
 #include <cstdio>
@@ -16,6 +18,8 @@
 #include <string>
 
 #include "commands.h"
+#include "exit_codes.h"
+#include "interrupt.h"
 #include "progress.h"
 #include "tspline/errors.h"
 #include "tspline/io/atomic_file.h"
@@ -194,7 +198,8 @@ int main(int argc, char** argv) {
                     "below it at some of the 4x4 Gauss points")
       ->capture_default_str();
   param->add_option("--max-adapt", adaptive.max_adapt, "Adaptive refinement rounds at most")->capture_default_str();
-  param->add_option("--max-cells", adaptive.max_cells, "Adaptive refinement never goes beyond this many cells")
+  param->add_option("--max-cells", adaptive.max_cells, "The T-mesh never goes beyond this many cells (boundary refinement, repair, adaptive "
+                    "refinement); a polygon that needs more stops with a message")
       ->capture_default_str();
   bool no_cpo = false;
   param->add_flag("--no-control-point-optimization", no_cpo,
@@ -228,29 +233,21 @@ int main(int argc, char** argv) {
     std::cerr << "tspline: error: " << e.what() << " (see --help)" << std::endl;
     return 1;
   }
+  tspline_app::install_interrupt_handlers();
   try {
     if (command) return command();
     if (param->parsed()) {
       if (tol_opt->count() > 0) opt.tolerance_absolute = tol;
       adaptive.optimize_control_points = !no_cpo;
+      opt.max_cells = adaptive.max_cells;  // one budget for the front half and the adaptive loop
       if (gj_opt->count() > 0) domain_options.polygon_index = geojson_polygon;
       if (layer_opt->count() > 0) domain_options.layer = layer;
       if (feature_opt->count() > 0) domain_options.feature = feature;
       return run_param(input, out_dir, corners, opt, adaptive, samples, domain_options,
                        tspline_app::output_mode(quiet, json_events));
     }
-  } catch (const tspline::InputError& e) {
-    std::cerr << "tspline: error: " << e.what() << std::endl;
-    return 1;
-  } catch (const tspline::NumericalError& e) {
-    std::cerr << "tspline: error: " << e.what() << std::endl;
-    return 3;
-  } catch (const tspline::IoError& e) {
-    std::cerr << "tspline: error: " << e.what() << std::endl;
-    return 2;
-  } catch (const std::exception& e) {
-    std::cerr << "tspline: internal error: " << e.what() << std::endl;
-    return 4;
+  } catch (...) {
+    return tspline_app::report_current_exception("tspline");
   }
   return 0;
 }

@@ -22,7 +22,7 @@ inline bool is_spd(const Eigen::Matrix2d& H) {
   return std::isfinite(lmax) && lmax > 0.0 && lmin > 1e-12 * lmax;
 }
 
-/// \throw std::invalid_argument for out-of-range options.
+/// \throw toolkit::InputError (a std::invalid_argument) for out-of-range options.
 void validate_options(const SmoothingOptions& o);
 
 struct Counters {

@@ -7,11 +7,11 @@
 #include <algorithm>
 #include <Eigen/LU>  // determinant()
 #include <cmath>
-#include <stdexcept>
 #include <string>
 
 #include "meshopt/triangle_measure.h"
 #include "newton_descent.h"
+#include "toolkit/errors.h"
 
 namespace meshopt {
 
@@ -29,7 +29,7 @@ std::span<const LocalTriangle> SmoothingProblem::triangles_of(std::size_t k) con
 namespace detail {
 
 void validate_options(const SmoothingOptions& o) {
-  auto bad = [](const char* what) { throw std::invalid_argument(std::string("meshopt::smooth: ") + what); };
+  auto bad = [](const char* what) { throw toolkit::InputError(std::string("meshopt::smooth: ") + what); };
   if (o.max_sweeps < 0) bad("max_sweeps must be >= 0");
   if (!(o.relative_displacement_tolerance >= 0.0) || !std::isfinite(o.relative_displacement_tolerance))
     bad("relative_displacement_tolerance must be finite and >= 0");
@@ -50,13 +50,13 @@ void validate_triangles(std::span<const Eigen::Vector2d> positions, std::span<co
   const auto n = static_cast<long long>(positions.size());
   for (const LocalTriangle& t : tris) {
     if (t.a < 0 || t.a >= n || t.b < 0 || t.b >= n)
-      throw std::invalid_argument("meshopt: triangle vertex index out of range");
+      throw toolkit::InputError("meshopt: triangle vertex index out of range");
     if (t.a == node || t.b == node || t.a == t.b)
-      throw std::invalid_argument("meshopt: local triangle repeats a vertex (or references the free node)");
+      throw toolkit::InputError("meshopt: local triangle repeats a vertex (or references the free node)");
     if (!std::isfinite(t.weight) || t.weight < 0.0 || !t.ideal_inv.allFinite())
-      throw std::invalid_argument("meshopt: triangle weight must be finite and >= 0, ideal_inv finite");
+      throw toolkit::InputError("meshopt: triangle weight must be finite and >= 0, ideal_inv finite");
     if (!positions[t.a].allFinite() || !positions[t.b].allFinite())
-      throw std::invalid_argument("meshopt: non-finite node position");
+      throw toolkit::InputError("meshopt: non-finite node position");
   }
 }
 
@@ -127,13 +127,13 @@ std::size_t count_tangled(const std::vector<Eigen::Vector2d>& positions, const S
 void validate_problem(const std::vector<Eigen::Vector2d>& positions, const SmoothingProblem& p) {
   if (p.offsets.size() != p.nodes.size() + 1 || p.offsets.front() != 0 ||
       p.offsets.back() != p.triangles.size())
-    throw std::invalid_argument("meshopt::smooth: offsets inconsistent with nodes/triangles");
+    throw toolkit::InputError("meshopt::smooth: offsets inconsistent with nodes/triangles");
   for (std::size_t k = 0; k < p.size(); ++k) {
-    if (p.offsets[k] > p.offsets[k + 1]) throw std::invalid_argument("meshopt::smooth: offsets not sorted");
+    if (p.offsets[k] > p.offsets[k + 1]) throw toolkit::InputError("meshopt::smooth: offsets not sorted");
     const int node = p.nodes[k];
     if (node < 0 || static_cast<std::size_t>(node) >= positions.size())
-      throw std::invalid_argument("meshopt::smooth: free node index out of range");
-    if (!positions[node].allFinite()) throw std::invalid_argument("meshopt::smooth: non-finite node position");
+      throw toolkit::InputError("meshopt::smooth: free node index out of range");
+    if (!positions[node].allFinite()) throw toolkit::InputError("meshopt::smooth: non-finite node position");
     validate_triangles(positions, p.triangles_of(k), node);
   }
 }

@@ -5,15 +5,15 @@
 #include <algorithm>
 #include <cmath>
 #include <sstream>
-#include <stdexcept>
 #include <string>
 
 #include "meshopt/triangle_measure.h"
+#include "toolkit/errors.h"
 
 namespace meshopt {
 namespace {
 
-[[noreturn]] void fail(const std::string& what) { throw std::invalid_argument("meshopt surface mesh: " + what); }
+[[noreturn]] void fail(const std::string& what) { throw toolkit::InputError("meshopt surface mesh: " + what); }
 
 std::string uv_string(const Eigen::Vector2d& u) {
   std::ostringstream s;

@@ -5,12 +5,12 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <stdexcept>
 #include <string>
 
 #include "meshopt/surface_objective.h"
 #include "meshopt/triangle_measure.h"
 #include "newton_descent.h"
+#include "toolkit/errors.h"
 
 namespace meshopt {
 namespace {
@@ -111,7 +111,7 @@ double global_objective(const SurfaceMesh& m, const std::vector<Eigen::Vector3d>
 
 void validate_surface_options(const SurfaceSmoothingOptions& o) {
   detail::validate_options(o.newton);
-  auto bad = [](const std::string& what) { throw std::invalid_argument("meshopt::smooth_surface: " + what); };
+  auto bad = [](const std::string& what) { throw toolkit::InputError("meshopt::smooth_surface: " + what); };
   if (o.max_sweeps < 0) bad("max_sweeps must be >= 0");
   if (!(o.tol_x >= 0.0) || !std::isfinite(o.tol_x)) bad("tol_x must be finite and >= 0");
   if (!(o.tol_f >= 0.0) || !std::isfinite(o.tol_f)) bad("tol_f must be finite and >= 0");
@@ -174,7 +174,7 @@ SurfaceSmoothingReport smooth_surface(SurfaceMesh& m, const SurfaceSmoothingOpti
       if (opt.size) {
         node_size[i] = opt.size(q.x);
         if (!(node_size[i] > 0.0) || !std::isfinite(node_size[i]))
-          throw std::invalid_argument("meshopt::smooth_surface: the size field is not positive and finite at node " +
+          throw toolkit::InputError("meshopt::smooth_surface: the size field is not positive and finite at node " +
                                       std::to_string(i) + " after it moved");
       }
     }

@@ -4,7 +4,8 @@
 
 #include <Eigen/LU>  // determinant()
 #include <cmath>
-#include <stdexcept>
+
+#include "toolkit/errors.h"
 
 namespace meshopt {
 
@@ -15,7 +16,7 @@ Eigen::Matrix2d ideal_inverse(const Eigen::Vector2d& v0, const Eigen::Vector2d& 
   W.col(1) = v2 - v0;
   const double det = W.determinant();
   if (!std::isfinite(det) || det == 0.0) {
-    throw std::invalid_argument("meshopt::ideal_inverse: degenerate or non-finite ideal triangle");
+    throw toolkit::InputError("meshopt::ideal_inverse: degenerate or non-finite ideal triangle");
   }
   Eigen::Matrix2d inv;
   inv << W(1, 1), -W(0, 1), -W(1, 0), W(0, 0);
@@ -46,7 +47,7 @@ double regularized_sigma(double sigma, double delta) {
 
 double untangling_delta(double sigma_star, double alpha, double scale) {
   if (!(alpha > 0.0) || !std::isfinite(alpha) || std::isnan(sigma_star)) {
-    throw std::invalid_argument("meshopt::untangling_delta: alpha must be positive and sigma_star not NaN");
+    throw toolkit::InputError("meshopt::untangling_delta: alpha must be positive and sigma_star not NaN");
   }
   if (sigma_star > 0.0) return 0.0;
   // Eqs. 35-37: h(sigma*) = tau = alpha |sigma*|  =>  delta = sqrt(tau^2 + tau |sigma*|)

@@ -14,6 +14,8 @@
 
 namespace meshopt::gmsh_io {
 namespace fs = std::filesystem;
+using toolkit::InputError;
+using toolkit::IoError;
 
 namespace {
 

@@ -60,14 +60,14 @@ struct SmoothingReport {
 };
 
 /// Moves positions[problem.nodes[k]] in place. Nodes not listed are fixed.
-/// \throw std::invalid_argument for indices out of range or bad options.
+/// \throw toolkit::InputError (a std::invalid_argument) for indices out of range or bad options.
 SmoothingReport smooth(std::vector<Eigen::Vector2d>& positions, const SmoothingProblem& problem,
                        const SmoothingOptions& options = {});
 
 /// Optimizes a single free node (used by smooth(); exposed for tests and for
 /// callers with their own sweep logic). Returns the new position. Counters, if given,
 /// are incremented by the accepted Newton / gradient steps.
-/// \throw std::invalid_argument for bad options or triangle indices out of range.
+/// \throw toolkit::InputError (a std::invalid_argument) for bad options or triangle indices out of range.
 Eigen::Vector2d optimize_node(const Eigen::Vector2d& start, std::span<const Eigen::Vector2d> positions,
                               std::span<const LocalTriangle> triangles, const SmoothingOptions& options,
                               std::size_t* newton_steps = nullptr, std::size_t* gradient_fallbacks = nullptr);

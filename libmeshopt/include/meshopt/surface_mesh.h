@@ -49,12 +49,12 @@ std::vector<CornerTriangle> corner_triangles(int nv, double h);
 
 /// Checks the mesh: sizes, indices, faces, free nodes inside their face's
 /// domain with phi(u) = x, non-degenerate surface normals at every corner.
-/// \throw std::invalid_argument naming the first problem (node, element, face).
+/// \throw toolkit::InputError (a std::invalid_argument) naming the first problem (node, element, face).
 void validate_surface_mesh(const SurfaceMesh& mesh);
 
 /// Unit surface normal at each element corner (4 per element); zero at a fixed
 /// node on a degenerate point (e.g. a pole that is a CAD vertex).
-/// \throw std::invalid_argument at a degenerate point under a free node.
+/// \throw toolkit::InputError (a std::invalid_argument) at a degenerate point under a free node.
 std::vector<Eigen::Vector3d> corner_normals(const SurfaceMesh& mesh);
 
 /// Per-element quality 1/eta (delta = 0; quads: 1 / mean of the four corner

@@ -54,7 +54,7 @@ struct SurfaceSmoothingReport {
 };
 
 /// Moves the free nodes of `mesh` (u and x) in place.
-/// \throw std::invalid_argument for an invalid mesh (see validate_surface_mesh) or options.
+/// \throw toolkit::InputError (a std::invalid_argument) for an invalid mesh (see validate_surface_mesh) or options.
 SurfaceSmoothingReport smooth_surface(SurfaceMesh& mesh, const SurfaceSmoothingOptions& options = {});
 
 /// Element qualities of `mesh` for `measure` (size field as in the options).

@@ -10,7 +10,7 @@
 namespace meshopt {
 
 /// W^{-1} for the ideal triangle (v0,v1,v2). \pre the ideal triangle is not degenerate.
-/// \throw std::invalid_argument if det W is zero or not finite.
+/// \throw toolkit::InputError (a std::invalid_argument) if det W is zero or not finite.
 Eigen::Matrix2d ideal_inverse(const Eigen::Vector2d& v0, const Eigen::Vector2d& v1,
                               const Eigen::Vector2d& v2);
 
@@ -33,7 +33,7 @@ double regularized_sigma(double sigma, double delta);
 /// A submesh with sigma_star == 0 exactly uses a tiny positive delta scaled by
 /// `scale` (the typical |sigma| of the submesh) so the objective stays finite;
 /// a non-positive or non-finite `scale` is replaced by 1.
-/// \throw std::invalid_argument if alpha <= 0 (or not finite) or sigma_star is NaN.
+/// \throw toolkit::InputError (a std::invalid_argument) if alpha <= 0 (or not finite) or sigma_star is NaN.
 double untangling_delta(double sigma_star, double alpha, double scale);
 
 }  // namespace meshopt

@@ -1,27 +1,14 @@
 #pragma once
-// Typed exceptions of libtspline. User-facing preconditions throw these; the
-// message is one line that names the problem (the apps print it verbatim).
-#include <stdexcept>
-#include <string>
+// The exception types of libtspline are the toolkit's own (toolkit/errors.h,
+// shared with libmeshopt): the names below are the same classes, so that
+// `catch (const tspline::InputError&)` also catches libmeshopt's input errors.
+#include "toolkit/errors.h"
 
 namespace tspline {
 
-/// Invalid user input: a malformed or invalid polygon, bad corner indices, bad options.
-class InputError : public std::runtime_error {
- public:
-  using std::runtime_error::runtime_error;
-};
-
-/// A file could not be read or written.
-class IoError : public std::runtime_error {
- public:
-  using std::runtime_error::runtime_error;
-};
-
-/// A numerical procedure failed in a way the caller must know about.
-class NumericalError : public std::runtime_error {
- public:
-  using std::runtime_error::runtime_error;
-};
+using toolkit::InputError;      ///< invalid user input (a std::invalid_argument)
+using toolkit::Interrupted;     ///< the run was stopped on request (SIGINT)
+using toolkit::IoError;         ///< a file could not be read or written
+using toolkit::NumericalError;  ///< a numerical procedure failed
 
 }  // namespace tspline

@@ -5,25 +5,18 @@
 // inside faces. Nodes on CAD curves and points are fixed (free_face = -1).
 #include <cstddef>
 #include <memory>
-#include <stdexcept>
 #include <string>
 #include <vector>
 
 #include "meshopt/gmsh/gmsh_face.h"
 #include "meshopt/surface_mesh.h"
+#include "toolkit/errors.h"
 
 namespace meshopt::gmsh_io {
 
-/// Bad input: unreadable model, mesh without parametric coordinates, unsupported elements...
-class InputError : public std::runtime_error {
- public:
-  using std::runtime_error::runtime_error;
-};
-/// A file could not be written.
-class IoError : public std::runtime_error {
- public:
-  using std::runtime_error::runtime_error;
-};
+// Errors: toolkit::InputError for bad input (unreadable model, mesh without
+// parametric coordinates, unsupported elements...), toolkit::IoError for a file
+// that cannot be written (toolkit/errors.h).
 
 /// gmsh::initialize / finalize for the lifetime of the object (terminal output off
 /// unless `verbose`). One at a time per process.
