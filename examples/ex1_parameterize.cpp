@@ -1,6 +1,6 @@
 // Example 1: parameterize a polygon.
 //
-//   example_parameterize [POLYGON] [OUTDIR]      (defaults: examples/flower.txt, out/ex1)
+//   example_parameterize [POLYGON] [OUTDIR]      (defaults: tests/data/polygons/flower.txt, out/ex1)
 //
 // The whole pipeline of the toolkit in one call: the polygon's boundary is
 // validated, four corners are chosen and the boundary is mapped by chord length
@@ -18,7 +18,7 @@
 #include "tspline/io/polygon_reader.h"          // read_polygon (text or GeoJSON)
 
 int run(int argc, char** argv) {
-  const std::string input = argc > 1 ? argv[1] : TSPLINE_EXAMPLES_DIR "/flower.txt";
+  const std::string input = argc > 1 ? argv[1] : TSPLINE_DATA_DIR "/polygons/flower.txt";
   const std::string out = argc > 2 ? argv[2] : "out/ex1";
 
   // 1. Read the polygon: one "x y" pair per line ('#' starts a comment). The
@@ -50,8 +50,8 @@ int run(int argc, char** argv) {
 
 // Library errors are exceptions with a message that names the problem:
 // tspline::InputError (bad input or options), tspline::IoError (files),
-// tspline::NumericalError (e.g. a singular system); std::invalid_argument from
-// libmeshopt for malformed problems.
+// tspline::NumericalError (e.g. a singular system); libmeshopt throws the same
+// InputError (toolkit/errors.h, one header for all libraries).
 int main(int argc, char** argv) {
   try {
     return run(argc, argv);

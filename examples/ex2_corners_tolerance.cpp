@@ -1,6 +1,6 @@
 // Example 2: choose the corners and the boundary tolerance yourself.
 //
-//   example_corners_tolerance [POLYGON]      (default: examples/flower.txt)
+//   example_corners_tolerance [POLYGON]      (default: tests/data/polygons/flower.txt)
 //
 // The four polygon vertices that go to the corners (0,0), (1,0), (1,1), (0,1)
 // of the parameter square decide how the domain is stretched; by default the
@@ -20,7 +20,7 @@
 #include "tspline/io/polygon_reader.h"
 
 int run(int argc, char** argv) {
-  const std::string input = argc > 1 ? argv[1] : TSPLINE_EXAMPLES_DIR "/flower.txt";
+  const std::string input = argc > 1 ? argv[1] : TSPLINE_DATA_DIR "/polygons/flower.txt";
   const tspline::Polygon polygon = tspline::io::read_polygon(input);
   const long long n = static_cast<long long>(polygon.vertices.size());
 
@@ -74,8 +74,8 @@ int run(int argc, char** argv) {
 
 // Library errors are exceptions with a message that names the problem:
 // tspline::InputError (bad input or options), tspline::IoError (files),
-// tspline::NumericalError (e.g. a singular system); std::invalid_argument from
-// libmeshopt for malformed problems.
+// tspline::NumericalError (e.g. a singular system); libmeshopt throws the same
+// InputError (toolkit/errors.h, one header for all libraries).
 int main(int argc, char** argv) {
   try {
     return run(argc, argv);

@@ -52,8 +52,8 @@ int run(int argc, char** argv) {
 
 // Library errors are exceptions with a message that names the problem:
 // tspline::InputError (bad input or options), tspline::IoError (files),
-// tspline::NumericalError (e.g. a singular system); std::invalid_argument from
-// libmeshopt for malformed problems.
+// tspline::NumericalError (e.g. a singular system); libmeshopt throws the same
+// InputError (toolkit/errors.h, one header for all libraries).
 int main(int argc, char** argv) {
   try {
     return run(argc, argv);

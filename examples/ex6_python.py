@@ -7,7 +7,7 @@ text polygon, Shapefile, GeoPackage, GeoJSON, ...), evaluates the map and its
 Jacobian on a grid of the unit square, saves and reloads the T-spline file,
 and solves a Poisson problem with the source given as a Python function.
 
-    PYTHONPATH=build/python python3 examples/ex6_python.py examples/flower.txt out/ex6
+    PYTHONPATH=build/python python3 examples/ex6_python.py tests/data/polygons/flower.txt out/ex6
 """
 import pathlib
 import sys
@@ -16,7 +16,7 @@ import numpy as np
 
 import tspline
 
-polygon_file = sys.argv[1] if len(sys.argv) > 1 else "examples/flower.txt"
+polygon_file = sys.argv[1] if len(sys.argv) > 1 else "tests/data/polygons/flower.txt"
 out = pathlib.Path(sys.argv[2] if len(sys.argv) > 2 else "out/ex6")
 out.mkdir(parents=True, exist_ok=True)
 

@@ -6,7 +6,8 @@ PACKAGES=(build-essential cmake pkg-config libeigen3-dev libcgal-dev libgmp-dev 
           libvtk9-dev doctest-dev nlohmann-json3-dev libcli11-dev
           libmuparser-dev libsuitesparse-dev libgmsh-dev gmsh libpetsc-real-dev openmpi-bin
           libgdal-dev libcairo2-dev fonts-dejavu-core
-          pybind11-dev python3-dev python3-numpy python3-pytest)
+          pybind11-dev python3-dev python3-numpy python3-pytest
+          clang libfuzzer-14-dev)
 missing=()
 for p in "${PACKAGES[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

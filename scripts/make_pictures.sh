@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # The README's pictures, made by `tspline render` from the bundled example:
-# parameterizes examples/flower.txt, solves the Gaussian-peak Poisson problem
+# parameterizes tests/data/polygons/flower.txt, solves the Gaussian-peak Poisson problem
 # adaptively on it, and draws four views into docs/images/, with the Poisson
 # run's convergence plot; and Corsica from its longitude/latitude GeoJSON (GIS
 # input projected to metres).
@@ -9,7 +9,7 @@ cd "$(dirname "$0")/.."
 bash scripts/install_deps.sh
 bash scripts/build.sh
 T=./build/apps/tspline
-$T param examples/flower.txt --out out/flower -q
+$T param tests/data/polygons/flower.txt --out out/flower -q
 $T poisson out/flower/tspline.json --problem gaussian --steps 8 --out out/flower_poisson -q
 mkdir -p docs/images
 for view in jacobian tmesh control-net; do

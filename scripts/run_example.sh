@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # The main job on a bundled example: installs what is missing, builds, and
-# parameterizes examples/flower.txt into out/flower (open the .vtu files in ParaView).
+# parameterizes tests/data/polygons/flower.txt into out/flower (open the .vtu files in ParaView).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/install_deps.sh
 bash scripts/build.sh
-./build/apps/tspline param examples/flower.txt --out out/flower "$@"
+./build/apps/tspline param tests/data/polygons/flower.txt --out out/flower "$@"

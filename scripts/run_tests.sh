@@ -5,6 +5,8 @@
 # build/install and builds and runs tests/downstream against the installed
 # CMake package (and imports the installed Python module). The Python tests
 # (pytest, tests/python) run after the Release suites, not under the sanitizers.
+# Before the sanitizer suites, the libFuzzer targets (scripts/run_fuzz.sh: clang,
+# ASan, about 25 s each), so that the run still ends with doctest's summary.
 # Exits non-zero if any test fails.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -26,6 +28,8 @@ cmake --build build/downstream -j "$(nproc)"
 ./build/downstream/downstream_check
 PYTHONPATH="$PWD/build/install/lib/python3/dist-packages" "$PYTHON" -c \
   "import tspline, numpy as np; m = tspline.parameterize(np.loadtxt('tests/data/polygons/square.txt'), init_level=2, max_adapt=1); assert m.certified_valid; print('installed Python module: ok')"
+echo "== Fuzz targets (libFuzzer, ASan+UBSan; bounded time each)"
+bash scripts/run_fuzz.sh
 echo "== ASan+UBSan build and tests"
 # -O1 -g1 (line tables for the sanitizer's stack traces): about half the compile
 # time of RelWithDebInfo's -O2 -g, as the sanitizers' documentation recommends.

@@ -6,6 +6,8 @@
 
 #include "test_support.h"
 
+using test_support::contains;
+
 #include "tspline/io/polygon_reader.h"
 #include "tspline/parameterization.h"
 
@@ -70,15 +72,17 @@ TEST_SUITE("parameterization") {
     opt.corner_trials = 4;
     const tspline::FrontResult r = tspline::run_front(poly, opt);
     REQUIRE(r.corner_trials.size() == 4);
-    std::size_t best = 0;
-    for (std::size_t k = 0; k < r.corner_trials.size(); ++k) {
-      const auto& a = r.corner_trials[k];
-      const auto& b = r.corner_trials[best];
-      if (a.inverted_cells < b.inverted_cells ||
-          (a.inverted_cells == b.inverted_cells && a.min_quality + a.mean_quality > b.min_quality + b.mean_quality))
-        best = k;
-    }
+    // The rule itself is tested on literal values (best_corner_trial, test_hardening.cpp);
+    // here: the run keeps the trial it names, and that trial is no worse than any other.
+    const std::size_t best = tspline::best_corner_trial(r.corner_trials);
     CHECK(r.boundary.corners().index == r.corner_trials[best].corners);
+    for (const auto& t : r.corner_trials) {
+      CHECK(r.corner_trials[best].inverted_cells <= t.inverted_cells);
+      if (t.inverted_cells == r.corner_trials[best].inverted_cells)
+        CHECK(r.corner_trials[best].min_quality + r.corner_trials[best].mean_quality >=
+              t.min_quality + t.mean_quality);
+    }
+    CHECK(contains(r.boundary.corners().explanation, "(choice " + std::to_string(best + 1) + ")"));
     // With the default initial level the trial is the final run: identical numbers.
     CHECK(r.quality_optimized.min_quality == r.corner_trials[best].min_quality);
     CHECK(r.quality_optimized.mean_quality == r.corner_trials[best].mean_quality);

@@ -46,12 +46,6 @@ void gauss_points_01(int n, std::vector<double>& p, std::vector<double>& w) {
   for (const auto& [x, wt] : table[n - 1]) p.push_back(0.5 * (x + 1.0)), w.push_back(0.5 * wt);
 }
 
-std::vector<CellMapQuality> cell_map_quality(const TSplineMap& map, int gauss) {
-  std::vector<CellMapQuality> per_cell;
-  map_quality(map, gauss, &per_cell);
-  return per_cell;
-}
-
 MapQualityStats map_quality(const TSplineMap& map, int gauss, std::vector<CellMapQuality>* per_cell) {
   std::vector<double> gp, gw;
   gauss_points_01(gauss, gp, gw);

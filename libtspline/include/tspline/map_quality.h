@@ -33,10 +33,7 @@ struct MapQualityStats {
   double min_scaled = 1.0;
 };
 
-/// Per cell, over gauss x gauss points.
-std::vector<CellMapQuality> cell_map_quality(const TSplineMap& map, int gauss = 4);
-
-/// Over all cells' gauss x gauss points.
+/// Over all cells' gauss x gauss points; per cell too if `per_cell` is given.
 MapQualityStats map_quality(const TSplineMap& map, int gauss = 4, std::vector<CellMapQuality>* per_cell = nullptr);
 
 /// Quality over the whole map, not only at quadrature points: a dense sample

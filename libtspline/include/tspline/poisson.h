@@ -1,6 +1,8 @@
 #pragma once
 // Isogeometric Poisson solver with a residual-based adaptive loop
-// (Brovka 2013 Sect. 7.2; DESIGN.md "IGA Poisson").
+// (Brovka, López, Escobar, Cascón, Montenegro, "A new method for T-spline parameterization
+// of complex 2D geometries", Engineering with Computers 2014, Sect. 7.2; README.md,
+// "tspline poisson").
 //
 //   -Laplace(u) = f in Omega = S([0,1]^2),   u = g on the boundary of Omega.
 //

@@ -1,7 +1,6 @@
 #include "tspline/io/bezier_export.h"
 
 #include "tspline/bezier_extraction.h"
-#include "tspline/io/atomic_file.h"
 
 namespace tspline::io {
 
@@ -42,10 +41,6 @@ nlohmann::json bezier_document(const TSplineMap& map, const std::string& source)
           {"bernstein_order", "k = i + 4 j for B_i(s) B_j(t)"},
           {"control_points", std::move(points)},
           {"elements", std::move(elements)}};
-}
-
-void write_bezier_file(const std::string& path, const TSplineMap& map, const std::string& source) {
-  write_text_atomic(path, bezier_document(map, source).dump() + "\n");
 }
 
 }  // namespace tspline::io

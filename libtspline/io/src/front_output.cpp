@@ -151,9 +151,4 @@ void write_front_meshes(const FrontResult& r, const std::string& out_dir) {
   write_vtu((dir / "boundary.vtu").string(), boundary_vtu(r.boundary));
 }
 
-void write_front_outputs(const FrontResult& r, const std::string& out_dir, const nlohmann::json& report) {
-  write_front_meshes(r, out_dir);
-  write_text_atomic((std::filesystem::path(out_dir) / "report.json").string(), report.dump(2) + "\n");
-}
-
 }  // namespace tspline::io

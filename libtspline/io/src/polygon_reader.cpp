@@ -159,6 +159,8 @@ Polygon parse_geojson(const std::string& content, const std::string& source, con
     doc = json::parse(content);
   } catch (const json::parse_error& e) {
     throw InputError(source + ": invalid JSON: " + e.what());
+  } catch (const json::exception& e) {  // e.g. a number too large for a double (out_of_range.406)
+    throw InputError(source + ": invalid JSON: " + e.what());
   }
   std::vector<Found> found;
   collect(doc, "", source, found);

@@ -372,8 +372,9 @@ std::string strip_id(std::string what) {
 
 }  // namespace
 
-LoadedTSpline read_tspline_file(const std::string& path) {
-  const std::string text = read_text(path);
+LoadedTSpline read_tspline_file(const std::string& path) { return parse_tspline_file(read_text(path), path); }
+
+LoadedTSpline parse_tspline_file(const std::string& text, const std::string& path) {
   json doc;
   try {
     doc = json::parse(text);

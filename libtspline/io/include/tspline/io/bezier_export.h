@@ -13,7 +13,4 @@ namespace tspline::io {
 /// The document described in docs/bezier_format.md.
 nlohmann::json bezier_document(const TSplineMap& map, const std::string& source);
 
-/// Writes bezier_document() atomically. \throw IoError.
-void write_bezier_file(const std::string& path, const TSplineMap& map, const std::string& source);
-
 }  // namespace tspline::io

@@ -24,8 +24,4 @@ nlohmann::json front_report(const FrontResult& result, const std::string& input_
 /// Writes parametric_tmesh.vtu, physical_tmesh.vtu and boundary.vtu (each atomically) into out_dir.
 void write_front_meshes(const FrontResult& result, const std::string& out_dir);
 
-/// Writes parametric_tmesh.vtu, physical_tmesh.vtu, boundary.vtu and
-/// report.json (each atomically) into out_dir.
-void write_front_outputs(const FrontResult& result, const std::string& out_dir, const nlohmann::json& report);
-
 }  // namespace tspline::io

@@ -32,4 +32,8 @@ struct LoadedTSpline {
 /// inconsistent or non-finite data; the message names the JSON path).
 LoadedTSpline read_tspline_file(const std::string& path);
 
+/// The same from the file's content; `source_name` stands for the path in
+/// messages. \throw InputError.
+LoadedTSpline parse_tspline_file(const std::string& text, const std::string& source_name);
+
 }  // namespace tspline::io
