@@ -213,8 +213,11 @@ class AdaptiveRun {
       std::ostringstream s;
       s << "untangling: " << u.free_points << " free control points, " << u.elements << " elements, " << u.stages
         << " stages, " << u.iterations << " L-BFGS iterations, samples with det J <= 0 " << u.before.nonpositive
-        << " -> " << u.after.nonpositive << ", " << (u.certified ? "certified" : "not certified") << ", "
-        << u.seconds << " s";
+        << " -> " << u.after.nonpositive;
+      if (u.local_repairs > 0)
+        s << ", " << u.local_repairs << " local repairs of folds between samples (" << u.local_repairs_certified
+          << " certified the map)";
+      s << ", " << (u.certified ? "certified" : "not certified") << ", " << u.seconds << " s";
       log("untangling", s.str());
       t_untangle_ += seconds_since(t1);
     } else if (ad_.certify) {

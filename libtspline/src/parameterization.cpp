@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <atomic>
 #include <exception>
+#include <mutex>
 #include <chrono>
 #include <cmath>
 #include <optional>
@@ -266,8 +267,12 @@ FrontResult run_front(const Polygon& input, const ParameterizationOptions& opt) 
       trial_is_run = topt.initial_level == opt.initial_level && *topt.tolerance_absolute == tol;
       // The trials are independent front halves: they run concurrently, each
       // collecting its log lines (replayed for the kept one if it is the run).
+      // Each finished trial is reported at once (from its worker thread, one
+      // event at a time); the sweeps of concurrent trials are not.
       std::vector<std::optional<FrontResult>> results(cands.size());
       std::vector<std::vector<ProgressEvent>> events(cands.size());
+      std::mutex report_mutex;
+      std::size_t finished = 0;
       for_each_concurrently(cands.size(), [&](std::size_t k) {
         ParameterizationOptions o = topt;
         o.progress = nullptr;
@@ -276,6 +281,14 @@ FrontResult run_front(const Polygon& input, const ParameterizationOptions& opt) 
             if (e.kind == ProgressEvent::Kind::Step || e.kind == ProgressEvent::Kind::Note) events[k].push_back(e);
           };
         results[k].emplace(optimize_front(BoundaryMap(poly, cands[k]), o));
+        if (!opt.progress) return;
+        const FrontResult& t = *results[k];
+        std::ostringstream s;
+        const std::lock_guard<std::mutex> lock(report_mutex);
+        s << "corners: trial " << ++finished << " of " << cands.size() << " done (choice " << k + 1 << "): "
+          << t.quality_optimized.inverted_cells << " inverted cells, min/mean quality "
+          << t.quality_optimized.min_quality << " / " << t.quality_optimized.mean_quality;
+        report_step(opt.progress, "corners", s.str());
       });
       std::size_t best = 0;
       for (std::size_t k = 0; k < cands.size(); ++k) {

@@ -29,6 +29,8 @@ struct ProgressEvent {
   std::size_t defects = 0;  ///< Sweep: tangled nodes; Untangling: samples with det J <= 0
 };
 
+/// Called from the thread that runs the pipeline or from its worker threads
+/// (the concurrent corner trials), never from two threads at once.
 using ProgressCallback = std::function<void(const ProgressEvent&)>;
 
 /// Kind::Step or Kind::Note events, if `callback` is set.

@@ -210,6 +210,8 @@ nlohmann::json param_report(const ParameterizationResult& r, const std::string& 
                      {"lbfgs_iterations", it.untangling.iterations},
                      {"evaluations", it.untangling.evaluations},
                      {"sample_refinements", it.untangling.sample_refinements},
+                     {"local_repairs", it.untangling.local_repairs},
+                     {"local_repairs_certified", it.untangling.local_repairs_certified},
                      {"samples_nonpositive_before", it.untangling.before.nonpositive},
                      {"samples_nonpositive_after", it.untangling.after.nonpositive},
                      {"certified", it.untangling.certified},
