@@ -69,6 +69,10 @@ void check_meta(const TSplineMap& map, const TSplineFileMeta& meta) {
 }  // namespace
 
 void write_tspline_file(const std::string& path, const TSplineMap& map, const TSplineFileMeta& meta) {
+  write_text_atomic(path, tspline_file_text(map, meta));
+}
+
+std::string tspline_file_text(const TSplineMap& map, const TSplineFileMeta& meta) {
   check_meta(map, meta);
   const TMesh& mesh = map.mesh();
   const TSplineBasis& basis = map.basis();
@@ -108,7 +112,7 @@ void write_tspline_file(const std::string& path, const TSplineMap& map, const TS
         << json(meta.corners).dump() << "\n  }";
   }
   out << "\n}\n";
-  write_text_atomic(path, out.str());
+  return out.str();
 }
 
 // ------------------------------------------------------------------ reading
@@ -382,7 +386,11 @@ LoadedTSpline read_tspline_file(const std::string& path) {
   } catch (const json::exception& e) {  // e.g. a number too large for a double
     throw InputError(path + ": /: invalid JSON: " + strip_id(e.what()));
   }
-  const Reader r(path);
+  return tspline_from_json(doc, path);
+}
+
+LoadedTSpline tspline_from_json(const nlohmann::json& doc, const std::string& name) {
+  const Reader r(name);
   r.header(doc);
   TSplineFileMeta meta = r.meta(doc);
   TMesh mesh = r.tmesh(doc);

@@ -1,0 +1,328 @@
+#include "tspline/automatic_cuts.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numbers>
+#include <numeric>
+#include <optional>
+#include <sstream>
+
+#include "tspline/errors.h"
+
+namespace tspline {
+namespace {
+
+constexpr double kPi = std::numbers::pi;
+
+double cross(const Eigen::Vector2d& a, const Eigen::Vector2d& b) { return a.x() * b.y() - a.y() * b.x(); }
+
+// Angle from direction b counter-clockwise to direction a, in [0, 2 pi).
+double ccw_angle(const Eigen::Vector2d& b, const Eigen::Vector2d& a) {
+  double t = std::atan2(cross(b, a), b.dot(a));
+  return t < 0 ? t + 2.0 * kPi : t;
+}
+
+// A closed polyline with arc-length access.
+class Loop {
+ public:
+  explicit Loop(std::vector<Eigen::Vector2d> pts) : p_(std::move(pts)), s_(p_.size() + 1, 0.0) {
+    for (std::size_t i = 0; i < p_.size(); ++i) s_[i + 1] = s_[i] + (p_[(i + 1) % p_.size()] - p_[i]).norm();
+  }
+  double length() const { return s_.back(); }
+  std::size_t size() const { return p_.size(); }
+  const Eigen::Vector2d& vertex(std::size_t i) const { return p_[i]; }
+  double arc_of_vertex(std::size_t i) const { return s_[i]; }
+  Eigen::Vector2d at(double s) const {
+    const double L = length();
+    s = std::fmod(s, L);
+    if (s < 0) s += L;
+    const std::size_t i = std::min<std::size_t>(
+        static_cast<std::size_t>(std::upper_bound(s_.begin(), s_.end(), s) - s_.begin()) - 1, p_.size() - 1);
+    const double len = s_[i + 1] - s_[i];
+    const double f = len > 0 ? (s - s_[i]) / len : 0.0;
+    return p_[i] + f * (p_[(i + 1) % p_.size()] - p_[i]);
+  }
+  // Closest point: (arc position, distance).
+  std::pair<double, double> closest(const Eigen::Vector2d& x) const {
+    double best_s = 0.0, best_d = std::numeric_limits<double>::infinity();
+    for (std::size_t i = 0; i < p_.size(); ++i) {
+      const Eigen::Vector2d a = p_[i], ab = p_[(i + 1) % p_.size()] - a;
+      const double l2 = ab.squaredNorm();
+      const double f = l2 > 0 ? std::clamp((x - a).dot(ab) / l2, 0.0, 1.0) : 0.0;
+      const double d = (a + f * ab - x).norm();
+      if (d < best_d) best_d = d, best_s = s_[i] + f * (s_[i + 1] - s_[i]);
+    }
+    return {best_s, best_d};
+  }
+  // Interior angle at arc position s measured by chords to s -+ h (the
+  // interior on the left of increasing s).
+  double angle_at(double s, double h) const {
+    const Eigen::Vector2d x = at(s);
+    return ccw_angle(at(s + h) - x, at(s - h) - x);
+  }
+
+ private:
+  std::vector<Eigen::Vector2d> p_;
+  std::vector<double> s_;
+};
+
+double arc_distance(double a, double b, double L) {
+  const double d = std::fmod(std::abs(a - b), L);
+  return std::min(d, L - d);
+}
+
+// Rings as loops with the domain on the left (holes reversed).
+std::vector<Loop> domain_loops(const Domain& d) {
+  std::vector<Loop> out{Loop(d.outer.vertices)};
+  for (const Polygon& h : d.holes) out.emplace_back(std::vector<Eigen::Vector2d>(h.vertices.rbegin(), h.vertices.rend()));
+  return out;
+}
+
+// Penalty of a cut end at arc position s of loop L, cut direction c: the two
+// angles a, b it leaves on its sides should be equal.
+double end_penalty(const Loop& L, double s, const Eigen::Vector2d& c, double h) {
+  const Eigen::Vector2d x = L.at(s);
+  const Eigen::Vector2d fwd = L.at(s + h) - x, back = L.at(s - h) - x;
+  const double a = ccw_angle(fwd, c), b = ccw_angle(c, back);
+  const double theta = ccw_angle(fwd, back);
+  if (a + b > theta + 1e-9 || std::min(a, b) < kPi / 9) return 4.0;  // leaves the domain at this scale, or too sharp
+  return std::pow((a - b) / (a + b), 2);
+}
+
+struct Candidate {
+  Cut cut;
+  std::size_t ring_p = 0, ring_q = 0;
+  double s_p = 0.0, s_q = 0.0;
+  double cost = 0.0;
+  bool to_sharp = false;
+};
+
+bool valid_cut(const Domain& d, const Cut& c) {
+  try {
+    validate_cuts(d, {c});
+    return true;
+  } catch (const InputError&) {
+    return false;
+  }
+}
+
+bool segments_meet(const Eigen::Vector2d& a, const Eigen::Vector2d& b, const Eigen::Vector2d& c,
+                   const Eigen::Vector2d& e) {
+  const double d1 = cross(b - a, c - a), d2 = cross(b - a, e - a), d3 = cross(e - c, a - c), d4 = cross(e - c, b - c);
+  if (d1 == 0 && d2 == 0) {  // collinear: meet iff the boxes overlap
+    const Eigen::Vector2d lo1 = a.cwiseMin(b), hi1 = a.cwiseMax(b), lo2 = c.cwiseMin(e), hi2 = c.cwiseMax(e);
+    return (lo1.array() <= hi2.array()).all() && (lo2.array() <= hi1.array()).all();
+  }
+  return d1 * d2 <= 0 && d3 * d4 <= 0;
+}
+
+struct Context {
+  const Domain& d;
+  std::vector<Loop> loops;
+  double scale;  // sqrt(area)
+};
+
+std::vector<Candidate> hole_candidates(const Context& cx, std::size_t h) {
+  std::vector<Candidate> out;
+  const Loop& H = cx.loops[h];
+  auto add = [&](double s_p, std::size_t r, double s_q, bool sharp) {
+    const Eigen::Vector2d p = H.at(s_p), q = cx.loops[r].at(s_q);
+    const double len = (q - p).norm();
+    if (!(len > 0)) return;
+    const Cut cut{p, q};
+    if (!valid_cut(cx.d, cut)) return;
+    const double hp = std::min(0.3 * len, H.length() / 12), hq = std::min(0.3 * len, cx.loops[r].length() / 12);
+    const double cost = len / cx.scale + end_penalty(H, s_p, q - p, hp) + end_penalty(cx.loops[r], s_q, p - q, hq);
+    out.push_back({cut, h, r, s_p, s_q, cost, sharp});
+  };
+  const std::size_t stride = std::max<std::size_t>(1, H.size() / 96);
+  for (std::size_t i = 0; i < H.size(); i += stride) {
+    const Eigen::Vector2d p = H.vertex(i);
+    std::size_t best_r = 0;
+    std::pair<double, double> best{0.0, std::numeric_limits<double>::infinity()};
+    for (std::size_t r = 0; r < cx.loops.size(); ++r) {
+      if (r == h) continue;
+      const auto c = cx.loops[r].closest(p);
+      if (c.second < best.second) best = c, best_r = r;
+    }
+    add(H.arc_of_vertex(i), best_r, best.first, false);
+  }
+  // Into the sharp convex vertices of the other rings (angle < 150 degrees at 1/50 of the ring's length).
+  for (std::size_t r = 0; r < cx.loops.size(); ++r) {
+    if (r == h) continue;
+    const Loop& R = cx.loops[r];
+    for (std::size_t i = 0; i < R.size(); ++i) {
+      if (R.angle_at(R.arc_of_vertex(i), R.length() / 50) > kPi * 150.0 / 180.0) continue;
+      if (R.angle_at(R.arc_of_vertex(i), 0.0) > kPi) continue;
+      add(H.closest(R.vertex(i)).first, r, R.arc_of_vertex(i), true);
+    }
+  }
+  return out;
+}
+
+// Cheapest chord between cut ends i and i+3 of a face with more than four.
+bool best_chord(const Context& cx, const LayoutFace& f, Cut& chord) {
+  std::vector<std::size_t> nodes;
+  for (std::size_t i = 0; i < f.points.size(); ++i)
+    if (f.is_node[i]) nodes.push_back(i);
+  const Loop F(f.points);
+  double best = std::numeric_limits<double>::infinity();
+  for (std::size_t k = 0; k < nodes.size(); ++k) {
+    const std::size_t i = nodes[k], j = nodes[(k + 3) % nodes.size()];
+    const Eigen::Vector2d a = f.points[i], b = f.points[j];
+    const double len = (b - a).norm();
+    if (!(len > 0)) continue;
+    bool ok = true;
+    for (std::size_t e = 0; e < f.points.size() && ok; ++e) {
+      const std::size_t e1 = (e + 1) % f.points.size();
+      if (e == i || e1 == i || e == j || e1 == j) continue;
+      if (segments_meet(a, b, f.points[e], f.points[e1])) ok = false;
+    }
+    if (!ok || !domain_contains(cx.d, 0.5 * (a + b))) continue;
+    // Inside this face: the chord leaves a between its two face edges.
+    const double h = std::min(0.3 * len, F.length() / 40);
+    const double pa = end_penalty(F, F.arc_of_vertex(i), b - a, h), pb = end_penalty(F, F.arc_of_vertex(j), a - b, h);
+    if (pa >= 4.0 || pb >= 4.0) continue;
+    const double cost = len / cx.scale + pa + pb;
+    if (cost < best) best = cost, chord = {a, b};
+  }
+  return std::isfinite(best);
+}
+
+// One variant: k cut ends per hole, sharp-vertex cuts first or not.
+std::optional<std::vector<Cut>> variant(const Context& cx, const std::vector<std::vector<Candidate>>& cands, int k,
+                                        bool sharp_first) {
+  const std::size_t rings = cx.loops.size();
+  std::vector<Candidate> chosen;
+  std::vector<std::vector<std::pair<double, double>>> ends(rings);  // per ring: (arc position, cut length)
+  auto crosses_chosen = [&](const Cut& c) {
+    for (const Candidate& o : chosen)
+      if (segments_meet(c.front(), c.back(), o.cut.front(), o.cut.back())) return true;
+    return false;
+  };
+  auto separated = [&](std::size_t r, double s, double min_gap) {
+    for (const auto& [t, len] : ends[r])
+      if (arc_distance(s, t, cx.loops[r].length()) < std::max(min_gap, 0.5 * len)) return false;
+    return true;
+  };
+  auto accept = [&](const Candidate& c) {
+    chosen.push_back(c);
+    const double len = (c.cut.back() - c.cut.front()).norm();
+    ends[c.ring_p].push_back({c.s_p, len});
+    ends[c.ring_q].push_back({c.s_q, len});
+  };
+  auto fits = [&](const Candidate& c, int per_ring) {
+    return !crosses_chosen(c.cut) && separated(c.ring_p, c.s_p, cx.loops[c.ring_p].length() / (2.0 * per_ring)) &&
+           separated(c.ring_q, c.s_q, 0.0);
+  };
+  for (std::size_t h = 1; h < rings; ++h) {
+    std::vector<const Candidate*> order;
+    for (const Candidate& c : cands[h]) order.push_back(&c);
+    std::stable_sort(order.begin(), order.end(), [&](const Candidate* a, const Candidate* b) {
+      if (sharp_first && a->to_sharp != b->to_sharp) return a->to_sharp;
+      return a->cost < b->cost;
+    });
+    for (const Candidate* c : order) {
+      if (static_cast<int>(ends[h].size()) >= k) break;
+      if (fits(*c, k)) accept(*c);
+    }
+  }
+  // Join every hole to the outer ring (union-find over rings).
+  std::vector<std::size_t> parent(rings);
+  std::iota(parent.begin(), parent.end(), 0);
+  auto find = [&](std::size_t x) {
+    while (parent[x] != x) x = parent[x] = parent[parent[x]];
+    return x;
+  };
+  for (const Candidate& c : chosen) parent[find(c.ring_p)] = find(c.ring_q);
+  for (bool again = true; again;) {
+    again = false;
+    const Candidate* best = nullptr;
+    for (std::size_t h = 1; h < rings; ++h)
+      for (const Candidate& c : cands[h])
+        if (find(c.ring_p) != find(c.ring_q) && (find(c.ring_p) != find(0) || find(c.ring_q) != find(0)) &&
+            fits(c, k) && (!best || c.cost < best->cost))
+          best = &c;
+    if (best) {
+      accept(*best);
+      parent[find(best->ring_p)] = find(best->ring_q);
+      again = true;
+    }
+  }
+  for (std::size_t r = 1; r < rings; ++r)
+    if (find(r) != find(0) || ends[r].size() < 2) return std::nullopt;
+  std::vector<Cut> cuts;
+  for (const Candidate& c : chosen) cuts.push_back(c.cut);
+  // Split the faces with more than four cut ends.
+  for (std::size_t round = 0; round < 8 * rings + 8; ++round) {
+    std::vector<LayoutFace> faces;
+    try {
+      faces = layout_faces(cx.d, cuts);
+    } catch (const InputError&) {
+      return std::nullopt;
+    }
+    const LayoutFace* big = nullptr;
+    for (const LayoutFace& f : faces)
+      if (f.nodes() > 4) big = &f;
+    if (!big) return cuts;
+    if (big->nodes() % 2 == 1) return std::nullopt;
+    Cut chord;
+    if (!best_chord(cx, *big, chord)) return std::nullopt;
+    cuts.push_back(chord);
+  }
+  return std::nullopt;
+}
+
+}  // namespace
+
+double layout_cost(const Domain& d, const PatchLayout& layout) {
+  const double scale = std::sqrt(domain_area(d));
+  double cost = 0.0;
+  for (const Cut& c : layout.cuts)
+    for (std::size_t k = 0; k + 1 < c.size(); ++k) cost += (c[k + 1] - c[k]).norm() / scale;
+  for (const Patch& p : layout.patches) {
+    const Loop F(p.polygon.vertices);
+    const double h = F.length() / 40;
+    std::vector<char> corner(p.polygon.vertices.size(), 0);
+    for (std::size_t c : p.corners) corner[c] = 1;
+    for (std::size_t i = 0; i < F.size(); ++i) {
+      const double angle = F.angle_at(F.arc_of_vertex(i), h);
+      if (corner[i]) cost += std::pow((angle - kPi / 2) / (kPi / 2), 2);
+      else if (std::abs(kPi - angle) > kPi * 25.0 / 180.0) cost += 4.0 * std::pow((kPi - angle) / (kPi / 2), 2);
+    }
+  }
+  return cost;
+}
+
+AutomaticCuts automatic_cuts(const Domain& d) {
+  if (d.holes.empty()) throw InputError("automatic cuts need a domain with holes");
+  Context cx{d, domain_loops(d), std::sqrt(domain_area(d))};
+  std::vector<std::vector<Candidate>> cands(cx.loops.size());
+  for (std::size_t h = 1; h < cx.loops.size(); ++h) cands[h] = hole_candidates(cx, h);
+  AutomaticCuts best;
+  best.cost = std::numeric_limits<double>::infinity();
+  for (int k = 2; k <= 4; ++k)
+    for (bool sharp_first : {false, true}) {
+      const auto cuts = variant(cx, cands, k, sharp_first);
+      if (!cuts) continue;
+      try {
+        const PatchLayout L = build_patch_layout(d, *cuts);
+        const double cost = layout_cost(d, L);
+        if (cost < best.cost) {
+          std::ostringstream s;
+          s << k << " cut ends per hole" << (sharp_first ? ", cuts into sharp vertices first" : "") << ", "
+            << L.cuts.size() << " cuts, " << L.patches.size() << " patches, layout cost " << cost;
+          best = {*cuts, cost, s.str()};
+        }
+      } catch (const InputError&) {
+        // this variant leaves a face that is not a four-sided patch
+      }
+    }
+  if (best.cuts.empty())
+    throw InputError("no automatic decomposition into four-sided patches found for this domain with " +
+                     std::to_string(d.holes.size()) + " hole(s); give the cuts with --cuts FILE");
+  return best;
+}
+
+}  // namespace tspline
