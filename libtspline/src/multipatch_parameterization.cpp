@@ -10,6 +10,9 @@
 #include "tspline/bezier_extraction.h"
 #include "tspline/border_knots.h"
 #include "tspline/errors.h"
+#include "tspline/map_certification.h"
+#include "tspline/map_quality.h"
+#include "tspline/tspline_fit.h"
 
 namespace tspline {
 
@@ -77,6 +80,69 @@ double MultiPatchResult::min_mean_ratio_gauss() const {
   return m;
 }
 
+namespace {
+
+// Knots of both sides of interface f (patch a's parameters; b's mirrored).
+std::set<double> interface_knots(const MultiPatchResult& R, const Interface& f) {
+  std::set<double> u;
+  for (double t : border_params(R.patches[f.patch_a].map->mesh(), static_cast<Side>(f.side_a))) u.insert(t);
+  for (double t : border_params(R.patches[f.patch_b].map->mesh(), static_cast<Side>(f.side_b)))
+    u.insert(reversed_param(t));
+  return u;
+}
+
+InterfaceReport measure_interface(const MultiPatchResult& R, const Interface& f) {
+  const TSplineMap& a = *R.patches[f.patch_a].map;
+  const TSplineMap& b = *R.patches[f.patch_b].map;
+  InterfaceReport rep;
+  rep.max_gap = interface_gap(a, f.side_a, b, f.side_b);
+  const std::vector<double> ka = border_params(a.mesh(), static_cast<Side>(f.side_a));
+  std::vector<double> kb = border_params(b.mesh(), static_cast<Side>(f.side_b));
+  rep.knots_a = ka.size();
+  rep.knots_b = kb.size();
+  for (double& t : kb) t = reversed_param(t);
+  std::sort(kb.begin(), kb.end());
+  rep.same_knots = ka == kb;
+  return rep;
+}
+
+// Once the boundary curves agree, the later adaptive rounds may still have
+// refined one side of an interface and not the other. Each patch is refined to
+// the union of the knots of its interfaces and its map carried over
+// (transfer_map reproduces the boundary curve exactly; inside it is the
+// interpolant of the old map), then checked again: the new map replaces the
+// old one only if it is still certified (or the old one was not either).
+void equalize_interface_knots(MultiPatchResult& R, const AdaptiveOptions& ad, int max_level) {
+  std::vector<BorderParams> want(R.patches.size());
+  for (const Interface& f : R.layout.interfaces) {
+    const std::set<double> u = interface_knots(R, f);
+    for (double t : u) {
+      want[f.patch_a][f.side_a].push_back(t);
+      want[f.patch_b][f.side_b].push_back(reversed_param(t));
+    }
+  }
+  for (std::size_t p = 0; p < R.patches.size(); ++p) {
+    ParameterizationResult& r = R.patches[p];
+    TMesh mesh = r.map->mesh();
+    if (refine_to_border_params(mesh, want[p], max_level) == 0) continue;
+    TSplineMap map = transfer_map(*r.map, std::move(mesh));
+    MapCertification cert = ad.certify ? certify_map(map, ad.certification) : MapCertification{};
+    if (ad.certify && r.certified_valid() && !cert.certified_valid()) continue;
+    std::vector<CellMapQuality> cells;
+    r.quality = map_quality(map, ad.gauss, &cells);
+    r.cell_quality = std::move(cells);
+    r.dense_quality = dense_map_quality(map, ad.dense_samples);
+    r.certification = std::move(cert);
+    r.front.mesh = map.mesh();
+    r.front.optimized.assign(r.front.mesh.num_vertices(), Eigen::Vector2d::Zero());
+    for (int v = 0; v < static_cast<int>(r.front.mesh.num_vertices()); ++v)
+      r.front.optimized[v] = map.point(r.front.mesh.vertex_param(v));
+    r.map.emplace(std::move(map));
+  }
+}
+
+}  // namespace
+
 MultiPatchResult run_multipatch_parameterization(const Domain& input, const std::optional<std::vector<Cut>>& cuts,
                                                  const ParameterizationOptions& options,
                                                  const AdaptiveOptions& adaptive, const MultiPatchOptions& multi,
@@ -134,23 +200,12 @@ MultiPatchResult run_multipatch_parameterization(const Domain& input, const std:
     bool all_conform = true;
     for (std::size_t i = 0; i < R.layout.interfaces.size(); ++i) {
       const Interface& f = R.layout.interfaces[i];
-      const TSplineMap& a = *R.patches[f.patch_a].map;
-      const TSplineMap& b = *R.patches[f.patch_b].map;
-      InterfaceReport& rep = R.interfaces[i];
-      rep.max_gap = interface_gap(a, f.side_a, b, f.side_b);
-      const std::vector<double> ka = border_params(a.mesh(), static_cast<Side>(f.side_a));
-      std::vector<double> kb = border_params(b.mesh(), static_cast<Side>(f.side_b));
-      rep.knots_a = ka.size();
-      rep.knots_b = kb.size();
-      for (double& t : kb) t = reversed_param(t);
-      std::sort(kb.begin(), kb.end());
-      rep.same_knots = ka == kb;
+      const InterfaceReport& rep = R.interfaces[i] = measure_interface(R, f);
       if (rep.max_gap <= multi.gap_tolerance * R.diameter) continue;
       all_conform = false;
       if (round >= multi.max_sync_rounds) continue;
       // Both sides get the union of the knots, mirrored for patch b.
-      std::set<double> u(ka.begin(), ka.end());
-      u.insert(kb.begin(), kb.end());
+      std::set<double> u = interface_knots(R, f);
       u.insert(required[f.patch_a][f.side_a].begin(), required[f.patch_a][f.side_a].end());
       for (double t : required[f.patch_b][f.side_b]) u.insert(reversed_param(t));
       required[f.patch_a][f.side_a].assign(u.begin(), u.end());
@@ -165,6 +220,9 @@ MultiPatchResult run_multipatch_parameterization(const Domain& input, const std:
     log("interfaces: re-running " + std::to_string(std::count(stale.begin(), stale.end(), 1)) +
         " patches with the union of the knots of their interfaces");
   }
+  equalize_interface_knots(R, adaptive, options.max_level);
+  for (std::size_t i = 0; i < R.layout.interfaces.size(); ++i)
+    R.interfaces[i] = measure_interface(R, R.layout.interfaces[i]);
   R.map_area = 0.0;
   for (const auto& r : R.patches) R.map_area += map_area(*r.map);
   return R;
