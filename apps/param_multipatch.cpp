@@ -53,6 +53,13 @@ int run_multipatch_param(const tspline::io::DomainInput& input_domain, const std
                             "parametric_tmesh.vtu, physical_tmesh.vtu, boundary.vtu, report.json to "
               << out_dir << std::endl;
   }
+  if (!R.conforming(tspline::MultiPatchOptions{}.gap_tolerance)) {
+    std::cerr << "tspline: error: the map is not watertight: the two images of a cut differ by up to " << R.max_gap()
+              << " (" << R.max_gap() / R.diameter << " x diameter) after " << R.sync_rounds
+              << " rounds of re-running patches with shared knots (files written; see report.json, interfaces)"
+              << std::endl;
+    return 3;
+  }
   if (!R.certified_valid() && adaptive.certify) {
     for (std::size_t p = 0; p < R.patches.size(); ++p)
       if (!R.patches[p].certified_valid())
