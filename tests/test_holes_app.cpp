@@ -75,6 +75,22 @@ TEST_SUITE("holes_app") {
     const auto no_patch = test_support::run_app("eval " + quoted(out / "tspline.json") + " --at 0 0", d);
     CHECK(no_patch.exit_code == 1);
     CHECK(contains(no_patch.err, "give --patch P"));
+
+    // Poisson with C0 coupling, uniform refinement: the solution is continuous across the cuts.
+    const auto pois = test_support::run_app("poisson " + quoted(out / "tspline.json") +
+                                                " --problem sinsin --refine uniform --steps 2 -q --out " +
+                                                quoted(d / "poisson"),
+                                            d);
+    CAPTURE(pois.err);
+    REQUIRE(pois.exit_code == 0);
+    const nlohmann::json prep = nlohmann::json::parse(test_support::slurp(d / "poisson" / "report.json"));
+    REQUIRE(prep["steps"].size() == 2);
+    CHECK(prep["steps"][1]["max_interface_jump"].get<double>() < 1e-12);
+    CHECK(prep["steps"][1]["l2_error"].get<double>() < prep["steps"][0]["l2_error"].get<double>() / 8);
+    const auto adaptive = test_support::run_app(
+        "poisson " + quoted(out / "tspline.json") + " --problem sinsin --out " + quoted(d / "p2"), d);
+    CHECK(adaptive.exit_code == 1);
+    CHECK(contains(adaptive.err, "only --refine uniform"));
   }
 
   TEST_CASE("a domain without holes keeps format version 1") {
