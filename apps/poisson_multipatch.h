@@ -1,6 +1,7 @@
 #pragma once
 // `tspline poisson` on a multi-patch map (format version 2): C0 coupling across
-// the interfaces (multipatch_poisson.h), uniform refinement.
+// the interfaces (multipatch_poisson.h), uniform or adaptive refinement (the
+// refinement propagated across the interfaces so that they stay conforming).
 #include <nlohmann/json.hpp>
 #include <string>
 
@@ -10,16 +11,16 @@
 namespace tspline_app {
 
 struct MultiPatchPoissonArgs {
-  std::string refine;  ///< only "uniform" is supported on multi-patch maps
+  std::string refine;  ///< "uniform" or "adaptive"
   int steps = 5;
+  double gamma = 0.5;  ///< adaptive: mark eta_e > gamma max eta (over all patches)
   std::size_t max_dofs = 200000;
   std::string out_dir;
   bool quiet = false;
 };
 
-/// Solves on every patch refined uniformly step by step, prints the errors
-/// and writes report.json into out_dir. Returns the exit code.
-/// \throw InputError for --refine adaptive (not available on multi-patch maps yet).
+/// Solves, prints the errors and the estimator per step and writes
+/// report.json into out_dir. Returns the exit code.
 int run_multipatch_poisson(const tspline::io::LoadedMaps& maps, const MultiPatchPoissonArgs& args,
                            const tspline::PoissonProblem& problem, const nlohmann::json& problem_description);
 

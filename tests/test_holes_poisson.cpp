@@ -2,8 +2,10 @@
 // across the cuts, optimal rates on uniform refinement.
 #include <doctest/doctest.h>
 
+#include <algorithm>
 #include <cmath>
 
+#include "tspline/border_knots.h"
 #include "tspline/errors.h"
 #include "tspline/io/gis_reader.h"
 #include "tspline/multipatch_parameterization.h"
@@ -77,5 +79,45 @@ TEST_SUITE("holes_poisson") {
     meshes[0] = refined({meshes[0]}).front();
     CHECK_THROWS_AS(tspline::solve_multipatch_poisson(maps, R.layout.interfaces, meshes, smooth_problem()),
                     tspline::NumericalError);
+  }
+
+  TEST_CASE("adaptive refinement across a cut stays conforming and lowers the H1 error") {
+    const tspline::MultiPatchResult R = plate_map();
+    std::vector<const tspline::TSplineMap*> maps;
+    std::vector<tspline::TMesh> meshes;
+    for (const auto& r : R.patches) maps.push_back(&*r.map), meshes.push_back(r.map->mesh());
+    // A Gaussian bump on the cut of interface 0, so that the marked region crosses it.
+    const tspline::Interface& f = R.layout.interfaces[0];
+    const Eigen::Vector2d c = maps[f.patch_a]->point(tspline::side_point_uv(f.side_a, 0.5));
+    tspline::PoissonProblem pb;
+    const double s2 = 0.25;
+    pb.exact = [c, s2](double x, double y) { return std::exp(-((x - c.x()) * (x - c.x()) + (y - c.y()) * (y - c.y())) / s2); };
+    pb.f = [c, s2](double x, double y) {
+      const double r2 = (x - c.x()) * (x - c.x()) + (y - c.y()) * (y - c.y());
+      return -(4 * r2 / (s2 * s2) - 4 / s2) * std::exp(-r2 / s2);  // -Laplace u
+    };
+    pb.g = pb.exact;
+    double h1_first = 0, h1_last = 0;
+    std::size_t border_splits = 0;
+    for (int step = 0; step < 3; ++step) {
+      const tspline::MultiPatchSolution S = tspline::solve_multipatch_poisson(maps, R.layout.interfaces, meshes, pb);
+      CHECK(tspline::multipatch_interface_jump(R.layout.interfaces, S) < 1e-12);
+      const double h1 = tspline::multipatch_errors(maps, S, pb).h1;
+      (step == 0 ? h1_first : h1_last) = h1;
+      const auto eta = tspline::multipatch_estimate(maps, S, pb);
+      double max_eta = 0;
+      for (const auto& e : eta) max_eta = std::max(max_eta, *std::max_element(e.begin(), e.end()));
+      std::vector<std::vector<int>> marked(maps.size());
+      for (std::size_t p = 0; p < maps.size(); ++p)  // eta_e > 0.5 max eta over all patches
+        for (int c = 0; c < static_cast<int>(eta[p].size()); ++c)
+          if (eta[p][c] > 0.5 * max_eta) marked[p].push_back(c);
+      // Both patches of the cut are refined.
+      if (step == 0) CHECK((!marked[f.patch_a].empty() && !marked[f.patch_b].empty()));
+      const auto before = tspline::border_params(meshes[f.patch_a], static_cast<tspline::Side>(f.side_a)).size();
+      meshes = tspline::refine_multipatch(meshes, R.layout.interfaces, marked);
+      border_splits += tspline::border_params(meshes[f.patch_a], static_cast<tspline::Side>(f.side_a)).size() - before;
+    }
+    CHECK(border_splits > 0);  // the refined region reached the cut
+    CHECK(h1_last < 0.5 * h1_first);
   }
 }

@@ -4,9 +4,11 @@
 #include <Eigen/SparseCholesky>
 #include <cmath>
 #include <map>
+#include <set>
 #include <numeric>
 
 #include "tspline/bezier_extraction.h"
+#include "tspline/border_knots.h"
 #include "tspline/errors.h"
 #include "tspline/map_quality.h"
 #include "tspline/multipatch_parameterization.h"
@@ -275,6 +277,68 @@ double multipatch_interface_jump(const std::vector<Interface>& interfaces, const
                                      value(f.patch_b, side_point_uv(f.side_b, 1.0 - t))));
     }
   return jump;
+}
+
+std::vector<std::vector<double>> multipatch_estimate(const std::vector<const TSplineMap*>& maps,
+                                                     const MultiPatchSolution& S, const PoissonProblem& problem) {
+  std::vector<std::vector<double>> eta(maps.size());
+  std::vector<QuadraturePoint> qp;
+  BasisValues bv;
+  for (std::size_t p = 0; p < maps.size(); ++p) {
+    const AnalysisSpace& sp = *S.spaces[p];
+    const TMesh& mesh = sp.mesh();
+    eta[p].assign(mesh.num_cells(), 0.0);
+    for (int c = 0; c < static_cast<int>(mesh.num_cells()); ++c) {
+      const Eigen::Vector2d lo = mesh.cell_min(c), hi = mesh.cell_max(c);
+      const int g = sp.geometry_cell(c);
+      // h_e: the longer diagonal of the image of the cell's corners.
+      const double h = std::max((maps[p]->point(hi) - maps[p]->point(lo)).norm(),
+                                (maps[p]->point({hi.x(), lo.y()}) - maps[p]->point({lo.x(), hi.y()})).norm());
+      qp.clear();
+      box_quadrature(lo, hi, 4, qp, maps[p]->basis(), g);
+      double sum = 0.0;
+      for (const QuadraturePoint& q : qp) {
+        const MapDerivatives d = maps[p]->derivatives(q.uv, 2, g);
+        sp.basis().evaluate(c, q.uv, bv, 2);
+        Eigen::Vector2d gxi = Eigen::Vector2d::Zero();
+        Eigen::Matrix2d hxi = Eigen::Matrix2d::Zero();
+        for (std::size_t i = 0; i < bv.ids.size(); ++i) {
+          const double v = S.values[S.global[p][bv.ids[i]]];
+          gxi += v * Eigen::Vector2d(bv.R_xi[i], bv.R_eta[i]);
+          hxi(0, 0) += v * bv.R_xixi[i], hxi(0, 1) += v * bv.R_xieta[i], hxi(1, 1) += v * bv.R_etaeta[i];
+        }
+        hxi(1, 0) = hxi(0, 1);
+        const Eigen::Vector2d gx = d.J.inverse().transpose() * gxi;
+        const double r = value_of(problem.f, "f", d.x) + physical_hessian(gx, hxi, d).trace();
+        sum += q.weight * std::abs(d.J.determinant()) * h * h * r * r;
+      }
+      eta[p][c] = std::sqrt(sum);
+    }
+  }
+  return eta;
+}
+
+std::vector<TMesh> refine_multipatch(const std::vector<TMesh>& meshes, const std::vector<Interface>& interfaces,
+                                     const std::vector<std::vector<int>>& marked) {
+  std::vector<TMesh> out;
+  for (std::size_t p = 0; p < meshes.size(); ++p)
+    out.push_back(marked[p].empty() ? meshes[p] : refine_cells(meshes[p], refinement_patch(meshes[p], marked[p])));
+  // Propagation: refining one side of a cut adds border knots there; the other
+  // side gets them too (and balancing may add more, hence the loop).
+  for (std::size_t splits = 1; splits > 0;) {
+    splits = 0;
+    for (const Interface& f : interfaces) {
+      std::set<double> u;
+      for (double t : border_params(out[f.patch_a], static_cast<Side>(f.side_a))) u.insert(t);
+      for (double t : border_params(out[f.patch_b], static_cast<Side>(f.side_b))) u.insert(reversed_param(t));
+      BorderParams a, b;
+      a[f.side_a].assign(u.begin(), u.end());
+      for (double t : u) b[f.side_b].push_back(reversed_param(t));
+      splits += refine_to_border_params(out[f.patch_a], a, TMesh::kMaxLevel);
+      splits += refine_to_border_params(out[f.patch_b], b, TMesh::kMaxLevel);
+    }
+  }
+  return out;
 }
 
 }  // namespace tspline

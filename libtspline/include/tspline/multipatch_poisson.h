@@ -47,6 +47,18 @@ MultiPatchSolution solve_multipatch_poisson(const std::vector<const TSplineMap*>
 PoissonErrors multipatch_errors(const std::vector<const TSplineMap*>& maps, const MultiPatchSolution& sol,
                                 const PoissonProblem& problem);
 
+/// The residual estimator of poisson.h per patch and analysis cell:
+/// eta_e^2 = int_{S(e)} h_e^2 (f + Laplace u_h)^2 dx (4 x 4 Gauss points per piece).
+std::vector<std::vector<double>> multipatch_estimate(const std::vector<const TSplineMap*>& maps,
+                                                     const MultiPatchSolution& sol, const PoissonProblem& problem);
+
+/// Refines the marked cells of every patch with their refinement patch
+/// (refinement_patch in poisson.h), then propagates across the interfaces:
+/// both sides of each cut are refined to the union of their border knots
+/// (mirrored), repeatedly, until every interface is conforming again.
+std::vector<TMesh> refine_multipatch(const std::vector<TMesh>& meshes, const std::vector<Interface>& interfaces,
+                                     const std::vector<std::vector<int>>& marked);
+
 /// The largest jump of u_h across the interfaces (sampled at 33 points per cut).
 double multipatch_interface_jump(const std::vector<Interface>& interfaces, const MultiPatchSolution& sol);
 
