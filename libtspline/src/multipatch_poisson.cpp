@@ -67,6 +67,25 @@ void side_quadrature(const TMesh& mesh, int c, int side, std::vector<double>& t_
   }
 }
 
+// Calls fn(c, d, w, bv) at every point of n x n Gauss points per piece of every
+// analysis cell c of one patch: d the map's derivatives up to `order`, w the
+// physical weight (parametric weight times |det J|), bv the analysis functions
+// up to `order`.
+template <class Fn>
+void for_each_point(const TSplineMap& map, const AnalysisSpace& sp, int n, int order, Fn&& fn) {
+  std::vector<QuadraturePoint> qp;
+  BasisValues bv;
+  for (int c = 0; c < static_cast<int>(sp.mesh().num_cells()); ++c) {
+    qp.clear();
+    box_quadrature(sp.mesh().cell_min(c), sp.mesh().cell_max(c), n, qp, map.basis(), sp.geometry_cell(c));
+    for (const QuadraturePoint& q : qp) {
+      const MapDerivatives d = map.derivatives(q.uv, order, sp.geometry_cell(c));
+      sp.basis().evaluate(c, q.uv, bv, order);
+      fn(c, d, q.weight * std::abs(d.J.determinant()), bv);
+    }
+  }
+}
+
 }  // namespace
 
 MultiPatchSolution solve_multipatch_poisson(const std::vector<const TSplineMap*>& maps,
@@ -177,34 +196,25 @@ MultiPatchSolution solve_multipatch_poisson(const std::vector<const TSplineMap*>
   // Stiffness and load.
   std::vector<Eigen::Triplet<double>> kt;
   Eigen::VectorXd load = Eigen::VectorXd::Zero(ni);
-  std::vector<QuadraturePoint> qp;
   for (std::size_t p = 0; p < P; ++p) {
-    const AnalysisSpace& sp = *S.spaces[p];
-    for (int c = 0; c < static_cast<int>(sp.mesh().num_cells()); ++c) {
-      qp.clear();
-      box_quadrature(sp.mesh().cell_min(c), sp.mesh().cell_max(c), 4, qp, maps[p]->basis(), sp.geometry_cell(c));
-      for (const QuadraturePoint& q : qp) {
-        const MapDerivatives d = maps[p]->derivatives(q.uv, 1, sp.geometry_cell(c));
-        const double w = q.weight * std::abs(d.J.determinant());
-        const Eigen::Matrix2d JinvT = d.J.inverse().transpose();
-        sp.basis().evaluate(c, q.uv, bv, 1);
-        const double fv = value_of(problem.f, "f", d.x);
-        const std::size_t m = bv.ids.size();
-        std::vector<Eigen::Vector2d> grad(m);
-        for (std::size_t i = 0; i < m; ++i) grad[i] = JinvT * Eigen::Vector2d(bv.R_xi[i], bv.R_eta[i]);
-        for (std::size_t i = 0; i < m; ++i) {
-          const int gi = S.global[p][bv.ids[i]];
-          if (inum[gi] < 0) continue;
-          load[inum[gi]] += w * fv * bv.R[i];
-          for (std::size_t j = 0; j < m; ++j) {
-            const int gj = S.global[p][bv.ids[j]];
-            const double k = w * grad[i].dot(grad[j]);
-            if (inum[gj] >= 0) kt.emplace_back(inum[gi], inum[gj], k);
-            else load[inum[gi]] -= k * S.values[gj];
-          }
+    for_each_point(*maps[p], *S.spaces[p], 4, 1, [&](int, const MapDerivatives& d, double w, const BasisValues& bv) {
+      const Eigen::Matrix2d JinvT = d.J.inverse().transpose();
+      const double fv = value_of(problem.f, "f", d.x);
+      const std::size_t m = bv.ids.size();
+      std::vector<Eigen::Vector2d> grad(m);
+      for (std::size_t i = 0; i < m; ++i) grad[i] = JinvT * Eigen::Vector2d(bv.R_xi[i], bv.R_eta[i]);
+      for (std::size_t i = 0; i < m; ++i) {
+        const int gi = S.global[p][bv.ids[i]];
+        if (inum[gi] < 0) continue;
+        load[inum[gi]] += w * fv * bv.R[i];
+        for (std::size_t j = 0; j < m; ++j) {
+          const int gj = S.global[p][bv.ids[j]];
+          const double k = w * grad[i].dot(grad[j]);
+          if (inum[gj] >= 0) kt.emplace_back(inum[gi], inum[gj], k);
+          else load[inum[gi]] -= k * S.values[gj];
         }
       }
-    }
+    });
   }
   Eigen::SparseMatrix<double> K(ni, ni);
   K.setFromTriplets(kt.begin(), kt.end());
@@ -221,39 +231,29 @@ PoissonErrors multipatch_errors(const std::vector<const TSplineMap*>& maps, cons
                                 const PoissonProblem& problem) {
   if (!problem.exact) throw InputError("errors need the exact solution");
   PoissonErrors e;
-  std::vector<QuadraturePoint> qp;
-  BasisValues bv;
   const double h = kGradientStep;
   for (std::size_t p = 0; p < maps.size(); ++p) {
-    const AnalysisSpace& sp = *S.spaces[p];
-    for (int c = 0; c < static_cast<int>(sp.mesh().num_cells()); ++c) {
-      qp.clear();
-      box_quadrature(sp.mesh().cell_min(c), sp.mesh().cell_max(c), 6, qp, maps[p]->basis(), sp.geometry_cell(c));
-      for (const QuadraturePoint& q : qp) {
-        const MapDerivatives d = maps[p]->derivatives(q.uv, 1, sp.geometry_cell(c));
-        const double w = q.weight * std::abs(d.J.determinant());
-        sp.basis().evaluate(c, q.uv, bv, 1);
-        double uh = 0;
-        Eigen::Vector2d gxi = Eigen::Vector2d::Zero();
-        for (std::size_t i = 0; i < bv.ids.size(); ++i) {
-          const double v = S.values[S.global[p][bv.ids[i]]];
-          uh += v * bv.R[i];
-          gxi += v * Eigen::Vector2d(bv.R_xi[i], bv.R_eta[i]);
-        }
-        const Eigen::Vector2d guh = d.J.inverse().transpose() * gxi;
-        const double ue = problem.exact(d.x.x(), d.x.y());
-        const Eigen::Vector2d gue =
-            problem.exact_gradient
-                ? problem.exact_gradient(d.x.x(), d.x.y())
-                : Eigen::Vector2d((problem.exact(d.x.x() + h, d.x.y()) - problem.exact(d.x.x() - h, d.x.y())) / (2 * h),
-                                  (problem.exact(d.x.x(), d.x.y() + h) - problem.exact(d.x.x(), d.x.y() - h)) / (2 * h));
-        e.l2 += w * (ue - uh) * (ue - uh);
-        e.h1 += w * (gue - guh).squaredNorm();
-        e.l2_exact += w * ue * ue;
-        e.h1_exact += w * gue.squaredNorm();
-        e.max_abs_at_qp = std::max(e.max_abs_at_qp, std::abs(ue - uh));
+    for_each_point(*maps[p], *S.spaces[p], 6, 1, [&](int, const MapDerivatives& d, double w, const BasisValues& bv) {
+      double uh = 0;
+      Eigen::Vector2d gxi = Eigen::Vector2d::Zero();
+      for (std::size_t i = 0; i < bv.ids.size(); ++i) {
+        const double v = S.values[S.global[p][bv.ids[i]]];
+        uh += v * bv.R[i];
+        gxi += v * Eigen::Vector2d(bv.R_xi[i], bv.R_eta[i]);
       }
-    }
+      const Eigen::Vector2d guh = d.J.inverse().transpose() * gxi;
+      const double x = d.x.x(), y = d.x.y();
+      const double ue = problem.exact(x, y);
+      const Eigen::Vector2d gue =
+          problem.exact_gradient ? problem.exact_gradient(x, y)
+                                 : Eigen::Vector2d((problem.exact(x + h, y) - problem.exact(x - h, y)) / (2 * h),
+                                                   (problem.exact(x, y + h) - problem.exact(x, y - h)) / (2 * h));
+      e.l2 += w * (ue - uh) * (ue - uh);
+      e.h1 += w * (gue - guh).squaredNorm();
+      e.l2_exact += w * ue * ue;
+      e.h1_exact += w * gue.squaredNorm();
+      e.max_abs_at_qp = std::max(e.max_abs_at_qp, std::abs(ue - uh));
+    });
   }
   e.l2 = std::sqrt(e.l2), e.h1 = std::sqrt(e.h1), e.l2_exact = std::sqrt(e.l2_exact), e.h1_exact = std::sqrt(e.h1_exact);
   return e;
@@ -282,37 +282,28 @@ double multipatch_interface_jump(const std::vector<Interface>& interfaces, const
 std::vector<std::vector<double>> multipatch_estimate(const std::vector<const TSplineMap*>& maps,
                                                      const MultiPatchSolution& S, const PoissonProblem& problem) {
   std::vector<std::vector<double>> eta(maps.size());
-  std::vector<QuadraturePoint> qp;
-  BasisValues bv;
   for (std::size_t p = 0; p < maps.size(); ++p) {
-    const AnalysisSpace& sp = *S.spaces[p];
-    const TMesh& mesh = sp.mesh();
+    const TMesh& mesh = S.spaces[p]->mesh();
     eta[p].assign(mesh.num_cells(), 0.0);
+    for_each_point(*maps[p], *S.spaces[p], 4, 2, [&](int c, const MapDerivatives& d, double w, const BasisValues& bv) {
+      Eigen::Vector2d gxi = Eigen::Vector2d::Zero();
+      Eigen::Matrix2d hxi = Eigen::Matrix2d::Zero();
+      for (std::size_t i = 0; i < bv.ids.size(); ++i) {
+        const double v = S.values[S.global[p][bv.ids[i]]];
+        gxi += v * Eigen::Vector2d(bv.R_xi[i], bv.R_eta[i]);
+        hxi(0, 0) += v * bv.R_xixi[i], hxi(0, 1) += v * bv.R_xieta[i], hxi(1, 1) += v * bv.R_etaeta[i];
+      }
+      hxi(1, 0) = hxi(0, 1);
+      const Eigen::Vector2d gx = d.J.inverse().transpose() * gxi;
+      const double r = value_of(problem.f, "f", d.x) + physical_hessian(gx, hxi, d).trace();
+      eta[p][c] += w * r * r;  // h_e^2 applied below
+    });
     for (int c = 0; c < static_cast<int>(mesh.num_cells()); ++c) {
-      const Eigen::Vector2d lo = mesh.cell_min(c), hi = mesh.cell_max(c);
-      const int g = sp.geometry_cell(c);
       // h_e: the longer diagonal of the image of the cell's corners.
+      const Eigen::Vector2d lo = mesh.cell_min(c), hi = mesh.cell_max(c);
       const double h = std::max((maps[p]->point(hi) - maps[p]->point(lo)).norm(),
                                 (maps[p]->point({hi.x(), lo.y()}) - maps[p]->point({lo.x(), hi.y()})).norm());
-      qp.clear();
-      box_quadrature(lo, hi, 4, qp, maps[p]->basis(), g);
-      double sum = 0.0;
-      for (const QuadraturePoint& q : qp) {
-        const MapDerivatives d = maps[p]->derivatives(q.uv, 2, g);
-        sp.basis().evaluate(c, q.uv, bv, 2);
-        Eigen::Vector2d gxi = Eigen::Vector2d::Zero();
-        Eigen::Matrix2d hxi = Eigen::Matrix2d::Zero();
-        for (std::size_t i = 0; i < bv.ids.size(); ++i) {
-          const double v = S.values[S.global[p][bv.ids[i]]];
-          gxi += v * Eigen::Vector2d(bv.R_xi[i], bv.R_eta[i]);
-          hxi(0, 0) += v * bv.R_xixi[i], hxi(0, 1) += v * bv.R_xieta[i], hxi(1, 1) += v * bv.R_etaeta[i];
-        }
-        hxi(1, 0) = hxi(0, 1);
-        const Eigen::Vector2d gx = d.J.inverse().transpose() * gxi;
-        const double r = value_of(problem.f, "f", d.x) + physical_hessian(gx, hxi, d).trace();
-        sum += q.weight * std::abs(d.J.determinant()) * h * h * r * r;
-      }
-      eta[p][c] = std::sqrt(sum);
+      eta[p][c] = h * std::sqrt(eta[p][c]);
     }
   }
   return eta;

@@ -70,15 +70,9 @@ void write_multipatch_file(const std::string& path, const std::vector<const TSpl
 }
 
 LoadedMaps read_maps_file(const std::string& path) {
-  std::error_code ec;
-  if (std::filesystem::is_directory(path, ec)) throw IoError("cannot read '" + path + "': it is a directory");
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw IoError("cannot open '" + path + "' for reading: " + std::strerror(errno));
-  std::ostringstream ss;
-  ss << in.rdbuf();
   json doc;
   try {
-    doc = json::parse(ss.str());
+    doc = json::parse(read_text_file(path));
   } catch (const json::exception&) {
     doc = nullptr;
   }

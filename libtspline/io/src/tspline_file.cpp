@@ -356,7 +356,9 @@ class Reader {
   std::string file_;
 };
 
-std::string read_text(const std::string& path) {
+}  // namespace
+
+std::string read_text_file(const std::string& path) {
   std::error_code ec;
   if (std::filesystem::is_directory(path, ec)) throw IoError("cannot read '" + path + "': it is a directory");
   std::ifstream in(path, std::ios::binary);
@@ -366,6 +368,8 @@ std::string read_text(const std::string& path) {
   if (in.bad()) throw IoError("cannot read '" + path + "'");
   return ss.str();
 }
+
+namespace {
 
 // "[json.exception.parse_error.101] parse error at line 1, ..." -> "parse error at line 1, ..."
 std::string strip_id(std::string what) {
@@ -377,7 +381,7 @@ std::string strip_id(std::string what) {
 }  // namespace
 
 LoadedTSpline read_tspline_file(const std::string& path) {
-  const std::string text = read_text(path);
+  const std::string text = read_text_file(path);
   json doc;
   try {
     doc = json::parse(text);

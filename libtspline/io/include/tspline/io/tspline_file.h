@@ -37,6 +37,9 @@ struct LoadedTSpline {
 /// inconsistent or non-finite data; the message names the JSON path).
 LoadedTSpline read_tspline_file(const std::string& path);
 
+/// The whole content of a file. \throw IoError (a directory, unreadable).
+std::string read_text_file(const std::string& path);
+
 /// Same, from a parsed version-1 document (`name` prefixes the messages, e.g.
 /// "FILE: /patches/2").
 LoadedTSpline tspline_from_json(const nlohmann::json& doc, const std::string& name);
