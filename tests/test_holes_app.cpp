@@ -76,6 +76,16 @@ TEST_SUITE("holes_app") {
     CHECK(no_patch.exit_code == 1);
     CHECK(contains(no_patch.err, "give --patch P"));
 
+    // Bezier export: one document per patch, 416 elements in all as in the report.
+    const auto bez = test_support::run_app(
+        "export " + quoted(out / "tspline.json") + " -q --bezier " + quoted(d / "bezier.json"), d);
+    REQUIRE(bez.exit_code == 0);
+    const nlohmann::json bdoc = nlohmann::json::parse(test_support::slurp(d / "bezier.json"));
+    std::size_t elements = 0;
+    for (const auto& p : bdoc["patches"]) elements += p["elements"].size();
+    CHECK(elements == rep["totals"]["bezier_elements"].get<std::size_t>());
+    CHECK(bdoc["interfaces"].size() == 4);
+
     // Poisson with C0 coupling, uniform refinement: the solution is continuous across the cuts.
     const auto pois = test_support::run_app("poisson " + quoted(out / "tspline.json") +
                                                 " --problem sinsin --refine uniform --steps 2 -q --out " +
