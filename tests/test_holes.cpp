@@ -219,6 +219,21 @@ TEST_SUITE("holes") {
     CHECK(R.layout.interfaces.size() == R.layout.cuts.size());
   }
 
+  TEST_CASE("two holes in line in a disk: chords from cut ends into the rings where no chord between cut ends fits") {
+    auto circle = [](double cx, double cy, double r, int n) {
+      std::vector<Eigen::Vector2d> v;
+      for (int k = 0; k < n; ++k)
+        v.emplace_back(cx + r * std::cos(2 * std::numbers::pi * k / n), cy + r * std::sin(2 * std::numbers::pi * k / n));
+      return make_polygon(v);
+    };
+    const Domain d{circle(0, 0, 5, 80), {circle(-2, 0, 1, 32), circle(2, 0, 1, 32)}};
+    const tspline::MultiPatchResult R = tspline::run_multipatch_parameterization(d, std::nullopt, {}, {});
+    CHECK(R.certified_valid());
+    CHECK(std::abs(R.map_area - R.domain_area) < 1e-3 * R.domain_area);
+    CHECK(R.max_gap() <= 1e-12 * R.diameter);
+    for (const tspline::Patch& p : R.layout.patches) CHECK(p.corners.size() == 4);
+  }
+
   TEST_CASE("GeoJSON polygon with an interior ring: the hole is read and projected with the outer ring") {
     const tspline::io::DomainInput in = tspline::io::read_domain(holes_file("corsica_lake_lonlat.geojson"));
     REQUIRE(in.holes.size() == 1);

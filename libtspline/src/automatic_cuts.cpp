@@ -161,31 +161,89 @@ std::vector<Candidate> hole_candidates(const Context& cx, std::size_t h) {
   return out;
 }
 
-// Cheapest chord between cut ends i and i+3 of a face with more than four.
+// First hit of the ray a + s u (s > 0) with the edges of face f that do not
+// touch vertex i: (edge index, s), or edge -1.
+std::pair<int, double> cast_ray(const LayoutFace& f, std::size_t i, const Eigen::Vector2d& u) {
+  const Eigen::Vector2d a = f.points[i];
+  const std::size_t n = f.points.size();
+  std::pair<int, double> best{-1, std::numeric_limits<double>::infinity()};
+  for (std::size_t e = 0; e < n; ++e) {
+    const std::size_t e1 = (e + 1) % n;
+    if (e == i || e1 == i) continue;
+    const Eigen::Vector2d p = f.points[e], d = f.points[e1] - p;
+    const double den = cross(u, d);
+    if (den == 0.0) continue;
+    const double s = cross(p - a, d) / den, t = cross(p - a, u) / den;
+    if (s > 0 && t >= 0 && t <= 1 && s < best.second) best = {static_cast<int>(e), s};
+  }
+  return best;
+}
+
+// Cheapest chord that cuts a four-sided patch off a face with more than four
+// cut ends: between cut ends k and k+3 (the rest keeps c - 2 of its c cut
+// ends; only for even c, so that the rest stays even), or from cut end k into
+// the ring side between cut ends k+2 and k+3, or k-3 and k-2 (the rest keeps
+// c - 1), along the bisector of the face angle at k or within 30 degrees of it.
+// The node-to-ring chords only where no node-to-node chord fits (odd c, or
+// cut ends in line).
 bool best_chord(const Context& cx, const LayoutFace& f, Cut& chord) {
   std::vector<std::size_t> nodes;
   for (std::size_t i = 0; i < f.points.size(); ++i)
     if (f.is_node[i]) nodes.push_back(i);
+  const std::size_t c = nodes.size();
   const Loop F(f.points);
   double best = std::numeric_limits<double>::infinity();
-  for (std::size_t k = 0; k < nodes.size(); ++k) {
-    const std::size_t i = nodes[k], j = nodes[(k + 3) % nodes.size()];
-    const Eigen::Vector2d a = f.points[i], b = f.points[j];
+  auto consider = [&](const Eigen::Vector2d& a, double s_a, const Eigen::Vector2d& b, double s_b) {
     const double len = (b - a).norm();
-    if (!(len > 0)) continue;
-    bool ok = true;
-    for (std::size_t e = 0; e < f.points.size() && ok; ++e) {
-      const std::size_t e1 = (e + 1) % f.points.size();
-      if (e == i || e1 == i || e == j || e1 == j) continue;
-      if (segments_meet(a, b, f.points[e], f.points[e1])) ok = false;
-    }
-    if (!ok || !domain_contains(cx.d, 0.5 * (a + b))) continue;
-    // Inside this face: the chord leaves a between its two face edges.
+    if (!(len > 0)) return;
     const double h = std::min(0.3 * len, F.length() / 40);
-    const double pa = end_penalty(F, F.arc_of_vertex(i), b - a, h), pb = end_penalty(F, F.arc_of_vertex(j), a - b, h);
-    if (pa >= 4.0 || pb >= 4.0) continue;
+    const double pa = end_penalty(F, s_a, b - a, h), pb = end_penalty(F, s_b, a - b, h);
+    if (pa >= 4.0 || pb >= 4.0) return;
     const double cost = len / cx.scale + pa + pb;
     if (cost < best) best = cost, chord = {a, b};
+  };
+  for (std::size_t k = 0; k < c; ++k) {
+    const std::size_t i = nodes[k];
+    const Eigen::Vector2d a = f.points[i];
+    if (c % 2 == 0) {  // node to node
+      const std::size_t j = nodes[(k + 3) % c];
+      const Eigen::Vector2d b = f.points[j];
+      bool ok = true;
+      for (std::size_t e = 0; e < f.points.size() && ok; ++e) {
+        const std::size_t e1 = (e + 1) % f.points.size();
+        if (e == i || e1 == i || e == j || e1 == j) continue;
+        if (segments_meet(a, b, f.points[e], f.points[e1])) ok = false;
+      }
+      if (ok && domain_contains(cx.d, 0.5 * (a + b))) consider(a, F.arc_of_vertex(i), b, F.arc_of_vertex(j));
+    }
+  }
+  // Node-to-node chords first: they add no new corner on a ring side.
+  if (std::isfinite(best)) return true;
+  for (std::size_t k = 0; k < c; ++k) {
+    const std::size_t i = nodes[k];
+    const Eigen::Vector2d a = f.points[i];
+    // Node to ring: rays around the bisector of the face angle at a.
+    const std::size_t n = f.points.size();
+    const Eigen::Vector2d fwd = (f.points[(i + 1) % n] - a).normalized(), back = (f.points[(i + n - 1) % n] - a).normalized();
+    const double theta = ccw_angle(fwd, back);
+    const std::size_t lo1 = nodes[(k + 2) % c], hi1 = nodes[(k + 3) % c];
+    const std::size_t lo2 = nodes[(k + c - 3) % c], hi2 = nodes[(k + c - 2) % c];
+    auto between = [&](std::size_t e, std::size_t from, std::size_t to) {  // edge e on the face path from..to
+      return from <= to ? (e >= from && e < to) : (e >= from || e < to);
+    };
+    for (int deg = -30; deg <= 30; deg += 10) {
+      const double phi = theta / 2 + deg * kPi / 180;
+      if (phi <= 0 || phi >= theta) continue;
+      const Eigen::Vector2d u(std::cos(phi) * fwd.x() - std::sin(phi) * fwd.y(),
+                              std::sin(phi) * fwd.x() + std::cos(phi) * fwd.y());
+      const auto [e, dist] = cast_ray(f, i, u);
+      if (e < 0 || f.edge_cut[e] != -1) continue;
+      const auto ue = static_cast<std::size_t>(e);
+      if (!between(ue, lo1, hi1) && !between(ue, lo2, hi2)) continue;
+      const Eigen::Vector2d b = a + dist * u;
+      if (!domain_contains(cx.d, 0.5 * (a + b))) continue;
+      consider(a, F.arc_of_vertex(i), b, F.closest(b).first);
+    }
   }
   return std::isfinite(best);
 }
@@ -266,7 +324,6 @@ std::optional<std::vector<Cut>> variant(const Context& cx, const std::vector<std
     for (const LayoutFace& f : faces)
       if (f.nodes() > 4) big = &f;
     if (!big) return cuts;
-    if (big->nodes() % 2 == 1) return std::nullopt;
     Cut chord;
     if (!best_chord(cx, *big, chord)) return std::nullopt;
     cuts.push_back(chord);

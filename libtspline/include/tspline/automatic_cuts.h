@@ -5,8 +5,10 @@
 // another ring and to the sharp convex vertices of other rings. A layout takes
 // k cuts per hole (k = 2, 3, 4, each tried; cheapest first, or those into sharp
 // vertices first), joins every hole to the outer ring, then splits every patch
-// with more than four cut ends by chords between its cut ends (each chord makes
-// a four-sided patch and leaves two cut ends fewer). The layout kept is the
+// with more than four cut ends by chords that cut a four-sided patch off it:
+// between two of its cut ends (the rest keeps two cut ends fewer), or from a
+// cut end along the bisector of its angle (within 30 degrees) into the ring
+// side that makes the piece four-sided (the rest keeps one fewer). The layout kept is the
 // cheapest by
 //   sum of cut lengths / sqrt(area)
 //   + sum over corners of ((angle - 90 deg) / 90 deg)^2
