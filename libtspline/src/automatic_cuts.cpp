@@ -248,9 +248,23 @@ bool best_chord(const Context& cx, const LayoutFace& f, Cut& chord) {
   return std::isfinite(best);
 }
 
+// Counts the sharp convex ring vertices of a face as nodes (corners that a
+// side should not pass through): inner angle at most 120 degrees both at the
+// vertex and between chords to 1/50 of the face's perimeter on either side.
+void mark_sharp_vertices(LayoutFace& f) {
+  const Loop F(f.points);
+  const std::size_t n = f.points.size();
+  for (std::size_t i = 0; i < n; ++i) {
+    if (f.is_node[i]) continue;
+    const Eigen::Vector2d a = f.points[(i + n - 1) % n] - f.points[i], b = f.points[(i + 1) % n] - f.points[i];
+    const double sharp = kPi * 120.0 / 180.0;
+    if (ccw_angle(b, a) <= sharp && F.angle_at(F.arc_of_vertex(i), F.length() / 50) <= sharp) f.is_node[i] = 1;
+  }
+}
+
 // One variant: k cut ends per hole, sharp-vertex cuts first or not.
 std::optional<std::vector<Cut>> variant(const Context& cx, const std::vector<std::vector<Candidate>>& cands, int k,
-                                        bool sharp_first) {
+                                        bool sharp_first, bool sharp_nodes) {
   const std::size_t rings = cx.loops.size();
   std::vector<Candidate> chosen;
   std::vector<std::vector<std::pair<double, double>>> ends(rings);  // per ring: (arc position, cut length)
@@ -320,6 +334,8 @@ std::optional<std::vector<Cut>> variant(const Context& cx, const std::vector<std
     } catch (const InputError&) {
       return std::nullopt;
     }
+    if (sharp_nodes)
+      for (LayoutFace& f : faces) mark_sharp_vertices(f);
     const LayoutFace* big = nullptr;
     for (const LayoutFace& f : faces)
       if (f.nodes() > 4) big = &f;
@@ -360,15 +376,17 @@ AutomaticCuts automatic_cuts(const Domain& d) {
   AutomaticCuts best;
   best.cost = std::numeric_limits<double>::infinity();
   for (int k = 2; k <= 4; ++k)
-    for (bool sharp_first : {false, true}) {
-      const auto cuts = variant(cx, cands, k, sharp_first);
+    for (int v = 0; v < 4; ++v) {
+      const bool sharp_first = v % 2 == 1, sharp_nodes = v >= 2;
+      const auto cuts = variant(cx, cands, k, sharp_first, sharp_nodes);
       if (!cuts) continue;
       try {
         const PatchLayout L = build_patch_layout(d, *cuts);
         const double cost = layout_cost(d, L);
         if (cost < best.cost) {
           std::ostringstream s;
-          s << k << " cut ends per hole" << (sharp_first ? ", cuts into sharp vertices first" : "") << ", "
+          s << k << " cut ends per hole" << (sharp_first ? ", cuts into sharp vertices first" : "")
+            << (sharp_nodes ? ", sharp vertices as corners" : "") << ", "
             << L.cuts.size() << " cuts, " << L.patches.size() << " patches, layout cost " << cost;
           best = {*cuts, cost, s.str()};
         }

@@ -8,7 +8,9 @@
 // with more than four cut ends by chords that cut a four-sided patch off it:
 // between two of its cut ends (the rest keeps two cut ends fewer), or from a
 // cut end along the bisector of its angle (within 30 degrees) into the ring
-// side that makes the piece four-sided (the rest keeps one fewer). The layout kept is the
+// side that makes the piece four-sided (the rest keeps one fewer); in half of
+// the variants the sharp convex ring vertices (<= 120 degrees) count as cut
+// ends there, so that patches get them as corners. The layout kept is the
 // cheapest by
 //   sum of cut lengths / sqrt(area)
 //   + sum over corners of ((angle - 90 deg) / 90 deg)^2
