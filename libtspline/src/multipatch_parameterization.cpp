@@ -173,10 +173,6 @@ MultiPatchResult run_multipatch_parameterization(const Domain& input, const std:
 
   std::vector<BorderParams> required(P);
   std::vector<char> stale(P, 1);
-  R.patches.resize(P, ParameterizationResult{FrontResult(BoundaryMap(
-                                                 R.layout.patches[0].polygon,
-                                                 Corners{R.layout.patches[0].corners, "", {}})),
-                                             std::nullopt, {}, {}, {}, {}, {}, 0, false, {}, {}, false, {}, 0});
   for (int round = 0;; ++round) {
     for (std::size_t p = 0; p < P; ++p) {
       if (!stale[p]) continue;
@@ -191,7 +187,9 @@ MultiPatchResult run_multipatch_parameterization(const Domain& input, const std:
       po.log = patch_log ? std::function<void(const std::string&)>(
                                [patch_log, p](const std::string& s) { patch_log("patch " + std::to_string(p) + ": " + s); })
                          : nullptr;
-      R.patches[p] = run_parameterization(patch.polygon, po, adaptive);
+      ParameterizationResult run = run_parameterization(patch.polygon, po, adaptive);
+      if (round == 0) R.patches.push_back(std::move(run));  // round 0 runs every patch, in order
+      else R.patches[p] = std::move(run);
       if (!R.patches[p].map) throw NumericalError("patch " + std::to_string(p) + ": no map was produced");
       stale[p] = 0;
     }
