@@ -59,7 +59,7 @@ int run_param(const std::string& input, const std::string& out_dir, const std::s
   if (samples < 1 || samples > 64) throw tspline::InputError("--samples must be in [1, 64]");
   tspline_app::Progress progress(mode);
   const bool quiet = mode != tspline_app::OutputMode::Human;
-  opt.log = [&progress](const std::string& line) { progress.log(line); };
+  opt.progress = [&progress](const tspline::ProgressEvent& e) { progress.report(e); };
   // Fail on an unwritable output directory before any computation.
   tspline::io::ensure_writable_directory(out_dir);
   std::string warnings;
@@ -81,13 +81,13 @@ int run_param(const std::string& input, const std::string& out_dir, const std::s
         progress.progress("adaptive rounds", it + 1, adaptive.max_adapt + 1);
       });
   series.finish();
-  nlohmann::json report = tspline::io::param_report(result, input, adaptive);
+  nlohmann::json report = tspline::io::param_report(result, input);
   report["input_geometry"] = domain.description;  // format, layer, CRS, projection (gis_reader.h)
   tspline::io::write_param_outputs(result, out_dir, report, samples);
   progress.settle();
   progress.event({{"event", "result"},
                   {"valid", result.valid()},
-                  {"good", result.good(adaptive.min_jacobian)},
+                  {"good", result.good()},
                   {"certified_valid", result.certified_valid()},
                   {"min_mean_ratio_jacobian", result.quality.min_mean_ratio},
                   {"cells", result.map ? result.map->mesh().num_cells() : 0},
@@ -127,7 +127,7 @@ int run_param(const std::string& input, const std::string& out_dir, const std::s
               << " (files written; run 'tspline check' on tspline.json for the elements)" << std::endl;
     return 3;
   }
-  if (!result.good(adaptive.min_jacobian) && !quiet)
+  if (!result.good() && !quiet)
     std::cout << "warning: min J_r " << result.quality.min_mean_ratio << " is below --min-jacobian "
               << adaptive.min_jacobian << "; adaptive refinement stopped: " << result.stop_reason
               << " (the corner choice fixes the map's aspect ratio: try other --corners)" << std::endl;

@@ -268,7 +268,7 @@ double MapEnergy::evaluate(const double* xv, double eps, double* gradient, std::
         const double f = n2 / c1, gA = (1.0 + D * D) / c1;
         const double term = (1.0 - theta) * f + theta * gA;
         // With a power p: omega term^p, so dE = p term^(p-1) omega d(term).
-        const double tp = power == 1.0 ? term : std::pow(term, power);
+        const double tp = power == 1.0 ? term : power == 4.0 ? (term * term) * (term * term) : std::pow(term, power);
         F += omega * tp;
         if (!g) continue;
         const double chain = power == 1.0 ? 1.0 : power * tp / term;

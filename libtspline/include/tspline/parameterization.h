@@ -15,6 +15,7 @@
 #include "tspline/boundary_refinement.h"
 #include "tspline/mesh_quality.h"
 #include "tspline/polygon.h"
+#include "tspline/progress_event.h"
 #include "tspline/tmesh.h"
 
 namespace tspline {
@@ -45,8 +46,8 @@ struct ParameterizationOptions {
   BorderParams border_params;
   /// Node optimization settings (libmeshopt).
   meshopt::SmoothingOptions smoothing;
-  /// Progress lines (stage names, counts); may be empty.
-  std::function<void(const std::string&)> log;
+  /// Progress events (progress_event.h); may be empty.
+  ProgressCallback progress;
 };
 
 struct StageTime {
@@ -85,6 +86,9 @@ struct FrontResult {
   std::vector<std::size_t> removed_vertices;
   std::vector<std::string> cleaning_notes;
 };
+
+/// \throw InputError naming the first option out of range (options_validation.cpp).
+void validate_options(const ParameterizationOptions& options);
 
 /// Runs the front half on a polygon as read from a file (not yet validated).
 /// \throw InputError for invalid polygons, corners or options.
