@@ -29,7 +29,7 @@ int run_multipatch_param(const tspline::io::DomainInput& input_domain, const std
         progress.event({{"event", "patch"}, {"patch", p}, {"round", round}});
       });
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  nlohmann::json report = tspline::io::multipatch_report(R, input, adaptive, seconds);
+  nlohmann::json report = tspline::io::multipatch_report(R, input, seconds);
   report["input_geometry"] = input_domain.description;
   tspline::io::write_multipatch_outputs(R, out_dir, report, samples);
   progress.settle();

@@ -204,7 +204,7 @@ TEST_SUITE("holes") {
 
     SUBCASE("format version 2 reads back bit-identically; the version-1 reader refuses it") {
       const auto dir = test_support::scratch_dir("holes", "v2");
-      const nlohmann::json report = tspline::io::multipatch_report(R, "plate_with_hole.txt", {}, 0.0);
+      const nlohmann::json report = tspline::io::multipatch_report(R, "plate_with_hole.txt", 0.0);
       tspline::io::write_multipatch_outputs(R, dir.string(), report, 2);
       const tspline::io::LoadedMaps m = tspline::io::read_maps_file((dir / "tspline.json").string());
       CHECK(m.version == 2);

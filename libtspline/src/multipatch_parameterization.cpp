@@ -148,9 +148,7 @@ MultiPatchResult run_multipatch_parameterization(const Domain& input, const std:
                                                  const AdaptiveOptions& adaptive, const MultiPatchOptions& multi,
                                                  const PatchCallback& on_patch) {
   if (multi.max_sync_rounds < 0) throw InputError("the number of interface rounds must be >= 0");
-  auto log = [&](const std::string& s) {
-    if (options.log) options.log(s);
-  };
+  auto log = [&](const std::string& s) { report_step(options.progress, "patches", s); };
   MultiPatchResult R;
   R.domain = validate_domain(input);
   if (cuts) {
@@ -183,10 +181,13 @@ MultiPatchResult run_multipatch_parameterization(const Domain& input, const std:
       for (int k = 0; k < 4; ++k) (*po.corners)[k] = static_cast<long long>(patch.corners[k]);
       po.corner_trials = 1;
       po.border_params = required[p];
-      auto patch_log = options.log;
-      po.log = patch_log ? std::function<void(const std::string&)>(
-                               [patch_log, p](const std::string& s) { patch_log("patch " + std::to_string(p) + ": " + s); })
-                         : nullptr;
+      // The patch's events, its text prefixed with the patch.
+      if (options.progress)
+        po.progress = [cb = options.progress, p](const ProgressEvent& e) {
+          ProgressEvent f = e;
+          f.text = "patch " + std::to_string(p) + ": " + e.text;
+          cb(f);
+        };
       ParameterizationResult run = run_parameterization(patch.polygon, po, adaptive);
       if (round == 0) R.patches.push_back(std::move(run));  // round 0 runs every patch, in order
       else R.patches[p] = std::move(run);

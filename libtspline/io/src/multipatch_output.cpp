@@ -62,8 +62,7 @@ VtuMesh merge_patches(const std::vector<VtuMesh>& parts) {
   return out;
 }
 
-json multipatch_report(const MultiPatchResult& R, const std::string& input_path, const AdaptiveOptions& ad,
-                       double seconds) {
+json multipatch_report(const MultiPatchResult& R, const std::string& input_path, double seconds) {
   json rep;
   rep["input"] = input_path;
   rep["patches_count"] = R.patches.size();
@@ -75,7 +74,7 @@ json multipatch_report(const MultiPatchResult& R, const std::string& input_path,
     functions += r.map->basis().size();
     elements += r.certification.elements;
     certified += r.certification.certified;
-    patches.push_back(param_report(r, input_path, ad));
+    patches.push_back(param_report(r, input_path));
   }
   json faces = json::array();
   for (std::size_t i = 0; i < R.interfaces.size(); ++i) {

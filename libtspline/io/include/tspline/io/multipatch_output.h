@@ -19,8 +19,7 @@ VtuMesh merge_patches(const std::vector<VtuMesh>& parts);
 /// Report: per patch the single-patch report (param_report), per interface the
 /// gap and knots, and the totals (cells, elements, functions, certification,
 /// whole-map min J_r, areas, seconds).
-nlohmann::json multipatch_report(const MultiPatchResult& result, const std::string& input_path,
-                                 const AdaptiveOptions& adaptive, double seconds);
+nlohmann::json multipatch_report(const MultiPatchResult& result, const std::string& input_path, double seconds);
 
 /// Writes tspline.json (version 2), surface.vtu, control_net.vtu,
 /// parametric_tmesh.vtu (patch p shifted by 1.25 p in xi), physical_tmesh.vtu,
