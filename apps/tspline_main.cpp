@@ -16,6 +16,7 @@
 #include <string>
 
 #include "commands.h"
+#include "param_multipatch.h"
 #include "progress.h"
 #include "tspline/errors.h"
 #include "tspline/io/atomic_file.h"
@@ -52,7 +53,8 @@ std::array<long long, 4> parse_corners(const std::string& text) {
 
 int run_param(const std::string& input, const std::string& out_dir, const std::string& corners_text,
               tspline::ParameterizationOptions opt, const tspline::AdaptiveOptions& adaptive, int samples,
-              const tspline::io::DomainReadOptions& domain_options, tspline_app::OutputMode mode) {
+              const tspline::io::DomainReadOptions& domain_options, tspline_app::OutputMode mode,
+              const std::string& cuts_file) {
   if (!corners_text.empty()) opt.corners = parse_corners(corners_text);
   if (samples < 1 || samples > 64) throw tspline::InputError("--samples must be in [1, 64]");
   tspline_app::Progress progress(mode);
@@ -64,6 +66,8 @@ int run_param(const std::string& input, const std::string& out_dir, const std::s
   const tspline::io::DomainInput domain = tspline::io::read_domain(input, domain_options, &warnings);
   const tspline::Polygon& polygon = domain.outer;
   if (!warnings.empty()) progress.log("note: " + warnings);
+  if (!domain.holes.empty() || !cuts_file.empty())
+    return tspline_app::run_multipatch_param(domain, input, out_dir, cuts_file, opt, adaptive, samples, progress);
   tspline::io::AdaptSeriesWriter series(out_dir, samples);
   const tspline::ParameterizationResult result = tspline::run_parameterization(
       polygon, opt, adaptive,
@@ -150,6 +154,10 @@ int main(int argc, char** argv) {
                     "(Shapefile, GeoPackage, KML, GML, GeoJSON, ...; longitude/latitude are projected to metres)")
       ->required();
   param->add_option("--out", out_dir, "Output directory (created if missing)")->required();
+  std::string cuts_file;
+  param->add_option("--cuts", cuts_file,
+                    "Domain with holes: the cuts into four-sided patches as polylines ('x y' per line, cuts "
+                    "separated by blank lines; ends on rings or at ends of other cuts); default: automatic");
   param->add_option("--corners", corners,
                     "Four vertex indices i,j,k,l (0-based, the file's own numbering, in cyclic file order) "
                     "mapped to (0,0),(1,0),(1,1),(0,1); default: automatic choice explained in report.json");
@@ -237,7 +245,7 @@ int main(int argc, char** argv) {
       if (layer_opt->count() > 0) domain_options.layer = layer;
       if (feature_opt->count() > 0) domain_options.feature = feature;
       return run_param(input, out_dir, corners, opt, adaptive, samples, domain_options,
-                       tspline_app::output_mode(quiet, json_events));
+                       tspline_app::output_mode(quiet, json_events), cuts_file);
     }
   } catch (const tspline::InputError& e) {
     std::cerr << "tspline: error: " << e.what() << std::endl;

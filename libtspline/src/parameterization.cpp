@@ -170,6 +170,7 @@ FrontResult optimize_front(BoundaryMap boundary, const ParameterizationOptions& 
     if (k == 0) r.mesh = TMesh(st.level[0]);
     refine_below(r.mesh, st.level[k]);
     const BoundaryRefinementReport rep = refine_to_boundary(r.mesh, r.boundary, {st.tol[k], opt.max_level});
+    refine_to_border_params(r.mesh, opt.border_params, opt.max_level);
     if (last) r.refinement = rep;
     clock.stop("tmesh");
     if (last) {

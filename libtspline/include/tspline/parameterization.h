@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "meshopt/node_smoother.h"
+#include "tspline/border_knots.h"
 #include "tspline/boundary_map.h"
 #include "tspline/boundary_refinement.h"
 #include "tspline/mesh_quality.h"
@@ -40,6 +41,9 @@ struct ParameterizationOptions {
   /// Optimize on a nested sequence of coarser T-meshes first (same final mesh,
   /// far fewer sweeps on fine meshes). false: optimize the final mesh from Coons.
   bool nested_optimization = true;
+  /// Border parameters per side that must be T-mesh vertices from the first
+  /// mesh on (multi-patch maps: both sides of an interface get the same knots).
+  BorderParams border_params;
   /// Node optimization settings (libmeshopt).
   meshopt::SmoothingOptions smoothing;
   /// Progress events (progress_event.h); may be empty.
