@@ -10,7 +10,9 @@
 
 #include "commands.h"
 #include "tspline/errors.h"
+#include "tspline/io/multipatch_file.h"
 #include "tspline/io/tspline_file.h"
+#include "tspline/multipatch_parameterization.h"
 #include "tspline/map_certification.h"
 #include "tspline/map_quality.h"
 
@@ -24,8 +26,8 @@ struct CheckArgs {
   std::size_t max_listed = 20;
 };
 
-int run_check(const CheckArgs& args) {
-  const tspline::io::LoadedTSpline t = tspline::io::read_tspline_file(args.file);
+// Prints the certification of one map; true if certified valid.
+bool check_map(const tspline::io::LoadedTSpline& t, const CheckArgs& args) {
   tspline::CertificationOptions opt;
   opt.max_depth = args.depth;
   const tspline::MapCertification c = tspline::certify_map(t.map, opt);
@@ -53,7 +55,7 @@ int run_check(const CheckArgs& args) {
   std::printf("seconds: %.3f\n", c.seconds);
   if (c.certified_valid()) {
     std::printf("result: certified valid (det J > 0 everywhere)\n");
-    return 0;
+    return true;
   }
   std::printf("result: NOT certified valid (%zu cells affected)\n", failed_cells);
   std::size_t listed = 0;
@@ -75,7 +77,25 @@ int run_check(const CheckArgs& args) {
   std::cerr << "tspline: error: the map is not certified valid: " << c.elements - c.certified << " of "
             << c.elements << " elements not certified (" << c.invalid << " with det J < 0 proven, "
             << c.undecided << " undecided)" << std::endl;
-  return 3;
+  return false;
+}
+
+int run_check(const CheckArgs& args) {
+  const tspline::io::LoadedMaps maps = tspline::io::read_maps_file(args.file);
+  if (maps.version == 1) return check_map(maps.patches.front(), args) ? 0 : 3;
+  // Multi-patch: every patch, then the interfaces (the two images of each cut).
+  bool all = true;
+  for (std::size_t p = 0; p < maps.patches.size(); ++p) {
+    std::printf("patch %zu:\n", p);
+    all = check_map(maps.patches[p], args) && all;
+  }
+  double gap = 0.0;
+  for (const tspline::Interface& f : maps.interfaces)
+    gap = std::max(gap, tspline::interface_gap(maps.patches[f.patch_a].map, f.side_a, maps.patches[f.patch_b].map,
+                                               f.side_b));
+  std::printf("interfaces: %zu, largest gap between the two images of a cut: %.6g\n", maps.interfaces.size(), gap);
+  std::printf("result: %s\n", all ? "every patch certified valid" : "NOT every patch certified valid");
+  return all ? 0 : 3;
 }
 
 }  // namespace

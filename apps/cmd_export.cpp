@@ -9,15 +9,46 @@
 #include "tspline/io/atomic_file.h"
 #include "tspline/io/bezier_export.h"
 #include "tspline/io/msh_export.h"
+#include "tspline/io/multipatch_file.h"
 #include "tspline/io/tspline_file.h"
 
 namespace tspline_app {
 
+namespace {
+
+struct ExportArgs {
+  std::string file, bezier, msh;
+  bool quiet = false;
+};
+
+// Version 2: one Bezier document per patch (docs/bezier_format.md, "Multi-patch maps").
+int export_multipatch(const tspline::io::LoadedMaps& maps, const ExportArgs& a) {
+  if (!a.msh.empty())
+    throw tspline::InputError("--msh: " + a.file + " is a multi-patch map; the Gmsh export takes one patch (use --bezier)");
+  nlohmann::json doc = {{"format", "tspline-bezier-multipatch"}, {"version", 1}, {"source", a.file}};
+  std::size_t elements = 0;
+  for (std::size_t p = 0; p < maps.patches.size(); ++p) {
+    doc["patches"].push_back(tspline::io::bezier_document(maps.patches[p].map, a.file + " patch " + std::to_string(p)));
+    elements += doc["patches"].back()["elements"].size();
+  }
+  doc["interfaces"] = nlohmann::json::array();
+  for (const tspline::Interface& f : maps.interfaces)
+    doc["interfaces"].push_back({{"patch_a", f.patch_a},
+                                 {"side_a", tspline::io::side_name(f.side_a)},
+                                 {"patch_b", f.patch_b},
+                                 {"side_b", tspline::io::side_name(f.side_b)},
+                                 {"orientation", "reversed"}});
+  tspline::io::write_text_atomic(a.bezier, doc.dump() + "\n");
+  if (!a.quiet)
+    std::cout << "wrote " << a.bezier << ": " << elements << " Bezier elements on " << maps.patches.size()
+              << " patches" << std::endl;
+  return 0;
+}
+
+}  // namespace
+
 void add_export_command(CLI::App& app, CommandAction& action) {
-  struct Args {
-    std::string file, bezier, msh;
-    bool quiet = false;
-  };
+  using Args = ExportArgs;
   auto a = std::make_shared<Args>();
   CLI::App* cmd = app.add_subcommand(
       "export", "Write the T-spline as rational Bezier elements with their extraction operators (Scott et al. "
@@ -31,7 +62,9 @@ void add_export_command(CLI::App& app, CommandAction& action) {
   cmd->callback([a, &action] {
     if (a->bezier.empty() && a->msh.empty()) throw CLI::ValidationError("export", "give --bezier and/or --msh");
     action = [a] {
-      const tspline::io::LoadedTSpline t = tspline::io::read_tspline_file(a->file);
+      const tspline::io::LoadedMaps maps = tspline::io::read_maps_file(a->file);
+      if (maps.version == 2) return export_multipatch(maps, *a);
+      const tspline::io::LoadedTSpline& t = maps.patches.front();
       if (!a->bezier.empty()) {
         const nlohmann::json doc = tspline::io::bezier_document(t.map, a->file);
         tspline::io::write_text_atomic(a->bezier, doc.dump() + "\n");

@@ -32,7 +32,9 @@
 #include "tspline/errors.h"
 #include "tspline/io/atomic_file.h"
 #include "tspline/io/convergence_plot.h"
+#include "tspline/io/multipatch_file.h"
 #include "tspline/io/tspline_file.h"
+#include "poisson_multipatch.h"
 #include "tspline/io/cell_grid.h"
 #include "tspline/io/vtu_writer.h"
 #include "petsc_session.h"
@@ -442,7 +444,15 @@ class PoissonOutput {
 int run_poisson_process(const PoissonArgs& args, const PetscSession& session,
                         std::chrono::steady_clock::time_point t_start) {
   const bool root = session.rank() == 0;
-  const tspline::io::LoadedTSpline t = tspline::io::read_tspline_file(args.file);
+  const tspline::io::LoadedMaps maps = tspline::io::read_maps_file(args.file);
+  if (maps.version == 2) {  // multi-patch map: C0 coupling across the interfaces (poisson_multipatch.h)
+    const ProblemSetup mp = make_problem(args, maps.patches.front().map);
+    return root ? tspline_app::run_multipatch_poisson(
+                      maps, {args.refine, args.steps, args.gamma, args.max_dofs, args.out_dir, args.quiet || args.json},
+                      mp.problem, mp.description)
+                : 0;
+  }
+  const tspline::io::LoadedTSpline& t = maps.patches.front();
   const ProblemSetup setup = make_problem(args, t.map);
 
   tspline::AdaptiveSolveOptions opt;

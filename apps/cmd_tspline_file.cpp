@@ -8,23 +8,23 @@
 #include <cstdlib>
 #include <limits>
 #include <memory>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
 
 #include "commands.h"
 #include "tspline/errors.h"
+#include "tspline/io/multipatch_file.h"
 #include "tspline/io/tspline_file.h"
 
 namespace tspline_app {
 
 namespace {
 
-// The format version read_tspline_file accepts (docs/tspline_format.md).
-constexpr int kTSplineFormatVersion = 1;
-
 struct EvalArgs {
   std::string file;
+  std::optional<std::size_t> patch;
   std::vector<std::pair<std::string, std::string>> at;
   bool derivatives = false;
 };
@@ -45,7 +45,15 @@ int run_eval(const EvalArgs& args) {
   // Validate the points before reading a possibly large file.
   std::vector<Eigen::Vector2d> points;
   for (const auto& [u, v] : args.at) points.emplace_back(parse_coordinate(u, "U"), parse_coordinate(v, "V"));
-  const tspline::io::LoadedTSpline t = tspline::io::read_tspline_file(args.file);
+  const tspline::io::LoadedMaps maps = tspline::io::read_maps_file(args.file);
+  const std::size_t n = maps.patches.size();
+  if (!args.patch && n > 1)
+    throw tspline::InputError(args.file + " is a multi-patch map (" + std::to_string(n) +
+                              " patches): give --patch P, P in [0, " + std::to_string(n - 1) + "]");
+  if (args.patch && *args.patch >= n)
+    throw tspline::InputError("--patch " + std::to_string(*args.patch) + " is out of range: " + args.file + " has " +
+                              std::to_string(n) + " patch(es)");
+  const tspline::io::LoadedTSpline& t = maps.patches[args.patch.value_or(0)];
   for (const Eigen::Vector2d& uv : points) {
     if (args.derivatives) {
       const tspline::MapDerivatives d = t.map.derivatives(uv, 1);
@@ -74,14 +82,11 @@ void print_box(const char* label, const Box& b) {
   std::printf("%s: [%.17g, %.17g] x [%.17g, %.17g]\n", label, b.lo.x(), b.hi.x(), b.lo.y(), b.hi.y());
 }
 
-int run_info(const std::string& file) {
-  const tspline::io::LoadedTSpline t = tspline::io::read_tspline_file(file);
+int print_patch_info(const tspline::io::LoadedTSpline& t) {
   const tspline::TMesh& mesh = t.map.mesh();
   const tspline::TSplineBasis& basis = t.map.basis();
   std::size_t by_kind[3] = {0, 0, 0};
   for (const tspline::BlendingFunction& f : basis.functions()) ++by_kind[static_cast<int>(f.kind)];
-  std::printf("format: tspline version %d (degree 3)\n", kTSplineFormatVersion);
-  std::printf("source: %s\n", t.meta.source.c_str());
   std::printf("cells: %zu\n", mesh.num_cells());
   std::printf("vertices: %zu\n", mesh.num_vertices());
   std::printf("hanging vertices: %zu\n", mesh.num_hanging_vertices());
@@ -109,6 +114,23 @@ int run_info(const std::string& file) {
   return 0;
 }
 
+int run_info(const std::string& file) {
+  const tspline::io::LoadedMaps maps = tspline::io::read_maps_file(file);
+  std::printf("format: tspline version %d (degree 3)\n", maps.version);
+  std::printf("source: %s\n", maps.source.c_str());
+  if (maps.version == 1) return print_patch_info(maps.patches.front());
+  std::printf("patches: %zu\n", maps.patches.size());
+  std::printf("interfaces: %zu (cuts %zu)\n", maps.interfaces.size(), maps.cuts.size());
+  for (const tspline::Interface& f : maps.interfaces)
+    std::printf("interface along cut %zu: patch %zu side %s = patch %zu side %s, reversed\n", f.cut, f.patch_a,
+                tspline::io::side_name(f.side_a), f.patch_b, tspline::io::side_name(f.side_b));
+  for (std::size_t p = 0; p < maps.patches.size(); ++p) {
+    std::printf("patch %zu:\n", p);
+    print_patch_info(maps.patches[p]);
+  }
+  return 0;
+}
+
 }  // namespace
 
 void add_tspline_file_commands(CLI::App& app, CommandAction& action) {
@@ -125,6 +147,9 @@ void add_tspline_file_commands(CLI::App& app, CommandAction& action) {
                    "printed in the given order")
       ->type_name("U V")
       ->required();
+  eval->add_option("--patch", eval_args->patch,
+                   "Multi-patch file (format version 2): the patch to evaluate (0-based); required there")
+      ->type_name("P");
   eval->add_flag("--derivatives,-d", eval_args->derivatives,
                  "Also print the Jacobian columns dS/du = (dx/du, dy/du), dS/dv = (dx/dv, dy/dv) and det J");
   eval->callback([eval_args, &action] { action = [eval_args] { return run_eval(*eval_args); }; });

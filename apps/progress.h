@@ -8,11 +8,15 @@
 //  * Quiet (--quiet): nothing but errors (on stderr).
 //  * Json (--json): one JSON object per line on stdout (NDJSON), for programs:
 //    {"event":"log","message":...}, {"event":"progress","task":...,"done":k,"total":n},
+//    the library's progress events (log lines with "stage" and "kind", and
+//    {"event":"sweep",...}, {"event":"untangling_stage",...}),
 //    and the command's own events ({"event":"iteration",...}, {"event":"step",...},
 //    {"event":"result",...}). Errors still go to stderr as one line, with the exit code.
 #include <nlohmann/json.hpp>
 #include <ostream>
 #include <string>
+
+#include "tspline/progress_event.h"
 
 namespace tspline_app {
 
@@ -31,9 +35,15 @@ class Progress {
   OutputMode mode() const { return mode_; }
   bool human() const { return mode_ == OutputMode::Human; }
 
-  /// A log line. Lines that start with two spaces and "sweep" are transient.
-  /// log() and progress() throw toolkit::Interrupted after a SIGINT (interrupt.h).
+  /// A log line (stays).
+  /// log(), report() and progress() throw toolkit::Interrupted after a SIGINT (interrupt.h).
   void log(const std::string& line);
+  /// A library progress event: steps and notes are log lines; sweeps and
+  /// untangling stages are transient in human mode, and in Json mode
+  /// {"event":"log","kind":"step"|"note","stage":...,"message":...} and
+  /// {"event":"sweep"|"untangling_stage","stage":...,...}
+  /// (sweeps: the first three and every 50th, like the human log off a terminal).
+  void report(const tspline::ProgressEvent& e);
   /// A progress bar "task [#####.....] done/total" (transient in human mode).
   void progress(const std::string& task, long done, long total);
   /// A structured event: printed in Json mode only (its "event" key names it).

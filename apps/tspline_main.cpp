@@ -20,6 +20,7 @@
 #include "commands.h"
 #include "exit_codes.h"
 #include "interrupt.h"
+#include "param_multipatch.h"
 #include "progress.h"
 #include "tspline/errors.h"
 #include "tspline/io/atomic_file.h"
@@ -56,18 +57,21 @@ std::array<long long, 4> parse_corners(const std::string& text) {
 
 int run_param(const std::string& input, const std::string& out_dir, const std::string& corners_text,
               tspline::ParameterizationOptions opt, const tspline::AdaptiveOptions& adaptive, int samples,
-              const tspline::io::DomainReadOptions& domain_options, tspline_app::OutputMode mode) {
+              const tspline::io::DomainReadOptions& domain_options, tspline_app::OutputMode mode,
+              const std::string& cuts_file) {
   if (!corners_text.empty()) opt.corners = parse_corners(corners_text);
   if (samples < 1 || samples > 64) throw tspline::InputError("--samples must be in [1, 64]");
   tspline_app::Progress progress(mode);
   const bool quiet = mode != tspline_app::OutputMode::Human;
-  opt.log = [&progress](const std::string& line) { progress.log(line); };
+  opt.progress = [&progress](const tspline::ProgressEvent& e) { progress.report(e); };
   // Fail on an unwritable output directory before any computation.
   tspline::io::ensure_writable_directory(out_dir);
   std::string warnings;
   const tspline::io::DomainInput domain = tspline::io::read_domain(input, domain_options, &warnings);
   const tspline::Polygon& polygon = domain.outer;
   if (!warnings.empty()) progress.log("note: " + warnings);
+  if (!domain.holes.empty() || !cuts_file.empty())
+    return tspline_app::run_multipatch_param(domain, input, out_dir, cuts_file, opt, adaptive, samples, progress);
   tspline::io::AdaptSeriesWriter series(out_dir, samples);
   const tspline::ParameterizationResult result = tspline::run_parameterization(
       polygon, opt, adaptive,
@@ -81,13 +85,13 @@ int run_param(const std::string& input, const std::string& out_dir, const std::s
         progress.progress("adaptive rounds", it + 1, adaptive.max_adapt + 1);
       });
   series.finish();
-  nlohmann::json report = tspline::io::param_report(result, input, adaptive);
+  nlohmann::json report = tspline::io::param_report(result, input);
   report["input_geometry"] = domain.description;  // format, layer, CRS, projection (gis_reader.h)
   tspline::io::write_param_outputs(result, out_dir, report, samples);
   progress.settle();
   progress.event({{"event", "result"},
                   {"valid", result.valid()},
-                  {"good", result.good(adaptive.min_jacobian)},
+                  {"good", result.good()},
                   {"certified_valid", result.certified_valid()},
                   {"min_mean_ratio_jacobian", result.quality.min_mean_ratio},
                   {"cells", result.map ? result.map->mesh().num_cells() : 0},
@@ -127,7 +131,7 @@ int run_param(const std::string& input, const std::string& out_dir, const std::s
               << " (files written; run 'tspline check' on tspline.json for the elements)" << std::endl;
     return 3;
   }
-  if (!result.good(adaptive.min_jacobian) && !quiet)
+  if (!result.good() && !quiet)
     std::cout << "warning: min J_r " << result.quality.min_mean_ratio << " is below --min-jacobian "
               << adaptive.min_jacobian << "; adaptive refinement stopped: " << result.stop_reason
               << " (the corner choice fixes the map's aspect ratio: try other --corners)" << std::endl;
@@ -154,6 +158,10 @@ int main(int argc, char** argv) {
                     "(Shapefile, GeoPackage, KML, GML, GeoJSON, ...; longitude/latitude are projected to metres)")
       ->required();
   param->add_option("--out", out_dir, "Output directory (created if missing)")->required();
+  std::string cuts_file;
+  param->add_option("--cuts", cuts_file,
+                    "Domain with holes: the cuts into four-sided patches as polylines ('x y' per line, cuts "
+                    "separated by blank lines; ends on rings or at ends of other cuts); default: automatic");
   param->add_option("--corners", corners,
                     "Four vertex indices i,j,k,l (0-based, the file's own numbering, in cyclic file order) "
                     "mapped to (0,0),(1,0),(1,1),(0,1); default: automatic choice explained in report.json");
@@ -244,7 +252,7 @@ int main(int argc, char** argv) {
       if (layer_opt->count() > 0) domain_options.layer = layer;
       if (feature_opt->count() > 0) domain_options.feature = feature;
       return run_param(input, out_dir, corners, opt, adaptive, samples, domain_options,
-                       tspline_app::output_mode(quiet, json_events));
+                       tspline_app::output_mode(quiet, json_events), cuts_file);
     }
   } catch (...) {
     return tspline_app::report_current_exception("tspline");

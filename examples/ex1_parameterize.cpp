@@ -39,13 +39,13 @@ int run(int argc, char** argv) {
   const tspline::ParameterizationResult result = tspline::run_parameterization(polygon, options, adaptive);
 
   // 4. Write tspline.json, the ParaView files and report.json (atomically).
-  tspline::io::write_param_outputs(result, out, tspline::io::param_report(result, input, adaptive), 4);
+  tspline::io::write_param_outputs(result, out, tspline::io::param_report(result, input), 4);
 
   std::printf("cells %zu\nfunctions %zu\nvalid %d\nmin_jr %.6f\nmean_jr %.6f\n", result.map->mesh().num_cells(),
               result.map->basis().size(), result.valid() ? 1 : 0, result.quality.min_mean_ratio,
               result.quality.mean_mean_ratio);
   // A valid map has det J > 0 at every Gauss point; "good" also has J_r >= delta.
-  return result.good(adaptive.min_jacobian) ? 0 : 1;
+  return result.good() ? 0 : 1;
 }
 
 // Library errors are exceptions with a message that names the problem:

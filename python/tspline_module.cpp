@@ -117,7 +117,7 @@ Map parameterize(const py::object& domain, py::kwargs kwargs) {
   }
   tspline::ParameterizationResult r = tspline::run_parameterization(polygon, opt, adaptive, {});
   if (!r.map) throw tspline::NumericalError("the parameterization produced no map");
-  nlohmann::json report = tspline::io::param_report(r, source, adaptive);
+  nlohmann::json report = tspline::io::param_report(r, source);
   report["input_geometry"] = input;
   tspline::io::TSplineFileMeta meta;
   meta.source = source;

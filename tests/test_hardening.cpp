@@ -207,7 +207,7 @@ TEST_SUITE("hardening") {
     } cases[] = {{"--omega 2.5", "--omega must be in [1, 2)"},
                  {"--omega nan", "--omega"},
                  {"--max-sweeps -1", "--max-sweeps must be >= 1"},
-                 {"--sweep-tol -1", "--sweep-tol must be > 0"},
+                 {"--sweep-tol -1", "--sweep-tol must be a positive finite number"},
                  {"--max-cells 0", "--max-cells must be >= 1"}};
     for (const auto& c : cases) {
       const auto r = param(square, d, c.args);

@@ -1,8 +1,9 @@
 // Global untangling of the T-spline map (map_energy.h, map_untangling.h): the
 // energy's gradient against central differences, chi without cancellation, a
 // folded map untangled to a certified one with its boundary curve unchanged,
-// folds between the samples found through the certificate, and the quality
-// phase never leaving a certified map uncertified.
+// folds between the samples found through the certificate and removed (by a
+// local problem, or by finer samples), a local energy against the full one,
+// and the quality phase never leaving a certified map uncertified.
 #include <doctest/doctest.h>
 
 #include <Eigen/LU>
@@ -145,10 +146,60 @@ TEST_SUITE("map_untangling") {
       if (e.stats(e.variables(map).data()).nonpositive == 0 && tspline::certify_map(map).invalid > 0) found = map;
     }
     REQUIRE(found);
-    const tspline::MapUntanglingReport r = tspline::untangle_map(*found, uo);
-    CHECK(r.before.nonpositive == 0);
-    CHECK(r.certified);
-    CHECK(tspline::certify_map(*found).certified_valid());
+    // Both ways out: the local problem around the failing elements (default),
+    // and finer samples on the whole map's continuation. Few iterations per
+    // stage, so that the first stage does not already remove the fold.
+    uo.max_iterations_per_stage = 2;
+    for (bool local : {true, false}) {
+      CAPTURE(local);
+      TSplineMap map = *found;
+      uo.local_repair = local;
+      const tspline::MapUntanglingReport r = tspline::untangle_map(map, uo);
+      CHECK(r.before.nonpositive == 0);
+      CHECK(r.certified);
+      CHECK(tspline::certify_map(map).certified_valid());
+      if (local)
+        CHECK(r.local_repairs_certified >= 1);
+      else
+        CHECK(r.local_repairs == 0);
+    }
+  }
+
+  TEST_CASE("a local energy (movable functions) is the full energy minus a constant, with the same gradient") {
+    const TSplineMap map = perturbed_map(4, 0.1);
+    const MapEnergy full(map);
+    tspline::MapEnergyOptions lo;
+    lo.movable.assign(map.basis().size(), 0);
+    for (std::size_t a = 0; a < lo.movable.size(); a += 3) lo.movable[a] = 1;
+    const MapEnergy local(map, lo);
+    REQUIRE(local.free_functions().size() > 3);
+    REQUIRE(local.free_functions().size() < full.free_functions().size());
+    CHECK(local.length_scale() == full.length_scale());  // normalized by the whole domain's area
+    // Position of each local variable among the full ones.
+    std::vector<int> full_index(map.basis().size(), -1);
+    for (std::size_t i = 0; i < full.free_functions().size(); ++i) full_index[full.free_functions()[i]] = 2 * static_cast<int>(i);
+    Eigen::VectorXd xf = full.variables(map), xl = local.variables(map);
+    std::mt19937 rng(8);
+    std::uniform_real_distribution<double> u(-0.01, 0.01);
+    std::optional<double> offset;
+    for (int trial = 0; trial < 3; ++trial) {
+      for (std::size_t i = 0; i < local.free_functions().size(); ++i) {
+        const int j = full_index[local.free_functions()[i]];
+        REQUIRE(j >= 0);
+        const double dx = u(rng), dy = u(rng);
+        xl[2 * i] += dx, xl[2 * i + 1] += dy, xf[j] += dx, xf[j + 1] += dy;
+      }
+      Eigen::VectorXd gf(xf.size()), gl(xl.size());
+      const double Ef = full.evaluate(xf.data(), 0.1, gf.data()), El = local.evaluate(xl.data(), 0.1, gl.data());
+      // The elements without a movable function add a constant, to round-off of the sums.
+      if (!offset) offset = Ef - El;
+      CHECK(Ef - El == doctest::Approx(*offset).epsilon(1e-12).scale(std::abs(Ef)));
+      for (std::size_t i = 0; i < local.free_functions().size(); ++i) {
+        const int j = full_index[local.free_functions()[i]];
+        CHECK(gl[2 * i] == doctest::Approx(gf[j]).epsilon(1e-12).scale(gf.cwiseAbs().maxCoeff()));
+        CHECK(gl[2 * i + 1] == doctest::Approx(gf[j + 1]).epsilon(1e-12).scale(gf.cwiseAbs().maxCoeff()));
+      }
+    }
   }
 
   TEST_CASE("a fold at a corner of the square, which only the boundary decides, is reported, not hidden") {

@@ -141,8 +141,10 @@ MapEnergy::MapEnergy(const TSplineMap& map, const MapEnergyOptions& opt)
   // Free functions and normalized control points.
   const TSplineBasis& basis = map.basis();
   variable_of_.assign(basis.size(), -1);
+  if (!opt.movable.empty() && opt.movable.size() != basis.size())
+    throw std::invalid_argument("MapEnergy: movable must have one flag per basis function");
   for (int a = 0; a < static_cast<int>(basis.size()); ++a)
-    if (!touches_border(basis.function(a))) {
+    if (!touches_border(basis.function(a)) && (opt.movable.empty() || opt.movable[a])) {
       variable_of_[a] = static_cast<int>(2 * free_functions_.size());
       free_functions_.push_back(a);
     }
@@ -162,6 +164,8 @@ MapEnergy::MapEnergy(const TSplineMap& map, const MapEnergyOptions& opt)
     d.hx = e.hi.x() - e.lo.x();
     d.hy = e.hi.y() - e.lo.y();
     d.weight = opt.weighting == ElementWeighting::Area ? d.hx * d.hy : 1.0;
+    d.active = false;
+    for (int a : e.functions) d.active = d.active || variable_of_[a] >= 0;
   }
 
   // L^2 = area of the domain = integral of det J over the square (exact up to
@@ -251,6 +255,7 @@ double MapEnergy::evaluate(const double* xv, double eps, double* gradient, std::
     for (std::size_t k = b; k < e_end; ++k) {
       const BezierElement& e = es[k];
       const Element& d = elements_[k];
+      if (!d.active) continue;
       const Pattern& pat = patterns_[d.level];
       const Eigen::Index nf = e.C.rows();
       std::array<double, 16> X, Y;
@@ -268,7 +273,7 @@ double MapEnergy::evaluate(const double* xv, double eps, double* gradient, std::
         const double f = n2 / c1, gA = (1.0 + D * D) / c1;
         const double term = (1.0 - theta) * f + theta * gA;
         // With a power p: omega term^p, so dE = p term^(p-1) omega d(term).
-        const double tp = power == 1.0 ? term : std::pow(term, power);
+        const double tp = power == 1.0 ? term : power == 4.0 ? (term * term) * (term * term) : std::pow(term, power);
         F += omega * tp;
         if (!g) continue;
         const double chain = power == 1.0 ? 1.0 : power * tp / term;
@@ -322,6 +327,7 @@ SampleStats MapEnergy::stats(const double* xv) const {
   double wsum = 0.0, jsum = 0.0;
   for (std::size_t k = 0; k < es.size(); ++k) {
     const Element& d = elements_[k];
+    if (!d.active) continue;
     const Pattern& pat = patterns_[d.level];
     std::array<double, 16> X, Y;
     element_coefficients(k, xv, X, Y);

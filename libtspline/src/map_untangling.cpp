@@ -39,6 +39,27 @@ class EnergyFunction final : public ceres::FirstOrderFunction {
   int* evaluations_;
 };
 
+// The local problem for hidden folds: the functions of the failing elements
+// and of the elements sharing a function with them move, nothing else.
+MapUntanglingOptions local_repair_options(const TSplineMap& map, const MapEnergy& energy,
+                                          const MapCertification& cert, const MapUntanglingOptions& opt) {
+  const std::vector<BezierElement>& es = energy.extraction().elements();
+  std::vector<char> failing_function(map.basis().size(), 0);
+  for (const CertificationFailure& f : cert.failures)
+    for (int a : es[f.element].functions) failing_function[a] = 1;
+  MapUntanglingOptions lo = opt;
+  lo.energy.movable.assign(map.basis().size(), 0);
+  for (const BezierElement& e : es) {
+    bool near = false;
+    for (int a : e.functions) near = near || failing_function[a];
+    if (near)
+      for (int a : e.functions) lo.energy.movable[a] = 1;
+  }
+  lo.local_repair = false;
+  lo.progress = nullptr;
+  return lo;
+}
+
 }  // namespace
 
 MapUntanglingReport untangle_map(TSplineMap& map, const MapUntanglingOptions& opt) {
@@ -72,9 +93,11 @@ MapUntanglingReport untangle_map(TSplineMap& map, const MapUntanglingOptions& op
     return rep;
   }
 
-  // Garanzha et al. start from eps = 1 (det J is normalized to 1 on average);
-  // a map valid at every sample starts at the floor (quality phase only).
-  double eps = rep.before.nonpositive > 0 ? 1.0 : opt.eps_floor;
+  // A map valid at every sample starts at the floor (quality phase only).
+  // Garanzha et al. start from eps = 1 (det J is normalized to 1 on average)
+  // and their code from 0.2 |D_min|; the smaller of the two keeps a map with
+  // a few shallow folds close to where it is.
+  double eps = rep.before.nonpositive > 0 ? std::clamp(0.2 * std::abs(rep.before.min_det), 1e-3, 1.0) : opt.eps_floor;
   ceres::GradientProblemSolver::Options so;
   so.line_search_direction_type = ceres::LBFGS;
   so.logging_type = ceres::SILENT;
@@ -127,6 +150,22 @@ MapUntanglingReport untangle_map(TSplineMap& map, const MapUntanglingOptions& op
             energy.set_sample_level(f.element, level + 1);
             ++rep.sample_refinements;
             resampled = true;
+          }
+        }
+        if (opt.local_repair && opt.energy.movable.empty()) {
+          ++rep.local_repairs;
+          TSplineMap local = map;
+          local.set_control_points(energy.control_points(x.data()));
+          const MapUntanglingReport lr = untangle_map(local, local_repair_options(map, energy, cert, opt));
+          rep.iterations += lr.iterations;
+          rep.evaluations += lr.evaluations;
+          if (lr.certified) {
+            ++rep.local_repairs_certified;
+            x = energy.variables(local);
+            certified_now = true;
+            best = x;
+            best_cert = lr.certification;
+            resampled = false;  // the finer samples of the failing elements stay; they are positive now
           }
         }
       }

@@ -1,11 +1,16 @@
 #include "tspline/parameterization.h"
 
 #include <algorithm>
+#include <atomic>
+#include <exception>
+#include <mutex>
 #include <chrono>
 #include <cmath>
 #include <limits>
 #include <optional>
 #include <sstream>
+#include <thread>
+#include <utility>
 
 #include "tspline/coons.h"
 #include "tspline/corners.h"
@@ -87,33 +92,58 @@ double bbox_diagonal(const Polygon& p) {
   return (hi - lo).norm();
 }
 
+// Runs body(0), ..., body(n - 1) on up to hardware_concurrency threads; the
+// first exception thrown by a body is rethrown here once all have finished.
+template <class Body>
+void for_each_concurrently(std::size_t n, Body&& body) {
+  const std::size_t threads = std::min<std::size_t>(n, std::max(1u, std::thread::hardware_concurrency()));
+  std::atomic<std::size_t> next{0};
+  std::vector<std::exception_ptr> errors(n);
+  auto work = [&] {
+    for (std::size_t k; (k = next.fetch_add(1)) < n;) {
+      try {
+        body(k);
+      } catch (...) {
+        errors[k] = std::current_exception();
+      }
+    }
+  };
+  std::vector<std::thread> pool;
+  for (std::size_t t = 1; t < threads; ++t) pool.emplace_back(work);
+  work();
+  for (std::thread& t : pool) t.join();
+  for (const std::exception_ptr& e : errors)
+    if (e) std::rethrow_exception(e);
+}
+
 }  // namespace
 
 namespace {
 
 // Everything after the corners: adapted T-mesh, Coons start, nested optimization
-// and repair. `clock` may be null (trial runs).
-FrontResult optimize_front(BoundaryMap boundary, const ParameterizationOptions& opt, StageClock* clock_or_null) {
-  auto log = [&](const std::string& s) {
-    if (opt.log) opt.log(s);
-  };
-  std::vector<StageTime> scratch_times;
-  StageClock scratch(scratch_times);
-  StageClock& clock = clock_or_null ? *clock_or_null : scratch;
+// and repair; the stage times go to the result's `times`.
+FrontResult optimize_front(BoundaryMap boundary, const ParameterizationOptions& opt) {
+  auto log = [&](const char* stage, const std::string& s) { report_step(opt.progress, stage, s); };
   FrontResult r{std::move(boundary)};
+  StageClock clock(r.times);
 
   r.tolerance_is_relative = !opt.tolerance_absolute.has_value();
   const double diag = bbox_diagonal(r.boundary.polygon());
   r.tolerance_area = opt.tolerance_absolute ? *opt.tolerance_absolute : opt.tolerance_relative * diag * diag;
 
   meshopt::SmoothingOptions sopt = opt.smoothing;
-  if (!sopt.progress && opt.log) {
+  if (!sopt.progress && opt.progress) {
     sopt.progress = [&](int sweep, double move, std::size_t tangled) {
-      if (sweep < 3 || sweep % 50 == 0) {
-        std::ostringstream s;
-        s << "  sweep " << sweep << ": max relative move " << move << ", tangled nodes " << tangled;
-        opt.log(s.str());
-      }
+      ProgressEvent e;
+      e.kind = ProgressEvent::Kind::Sweep;
+      e.stage = "optimization";
+      e.count = sweep;
+      e.value = move;
+      e.defects = tangled;
+      std::ostringstream s;
+      s << "sweep " << sweep << ": max relative move " << move << ", tangled nodes " << tangled;
+      e.text = s.str();
+      opt.progress(e);
     };
   }
   auto optimize = [&](const std::string& what) {
@@ -127,7 +157,7 @@ FrontResult optimize_front(BoundaryMap boundary, const ParameterizationOptions& 
       << (r.smoothing.converged ? "" : " (not converged)") << ", " << r.quality_optimized.inverted_cells
       << " inverted cells, min/mean quality " << r.quality_optimized.min_quality << " / "
       << r.quality_optimized.mean_quality;
-    log(s.str());
+    log("optimization", s.str());
   };
 
   // Nested iteration: optimize on a coarse mesh, then refine, carry the
@@ -140,7 +170,9 @@ FrontResult optimize_front(BoundaryMap boundary, const ParameterizationOptions& 
     TMesh coarse = k == 0 ? TMesh(st.level[0]) : r.mesh;
     if (k == 0) r.mesh = TMesh(st.level[0]);
     refine_below(r.mesh, st.level[k]);
-    const BoundaryRefinementReport rep = refine_to_boundary(r.mesh, r.boundary, {st.tol[k], opt.max_level, opt.max_cells});
+    const BoundaryRefinementReport rep =
+        refine_to_boundary(r.mesh, r.boundary, {st.tol[k], opt.max_level, opt.max_cells});
+    refine_to_border_params(r.mesh, opt.border_params, opt.max_level);
     if (last) r.refinement = rep;
     clock.stop("tmesh");
     if (last) {
@@ -148,14 +180,17 @@ FrontResult optimize_front(BoundaryMap boundary, const ParameterizationOptions& 
       s << "t-mesh: " << r.mesh.num_cells() << " cells, " << r.mesh.num_vertices() << " vertices ("
         << r.mesh.num_hanging_vertices() << " hanging), max level " << r.mesh.max_level() << ", tolerance "
         << r.tolerance_area;
-      log(s.str());
+      log("tmesh", s.str());
       if (rep.edges_over_tolerance > 0)
-        log("warning: " + std::to_string(rep.edges_over_tolerance) +
-            " boundary edges still exceed the tolerance at the maximum level " + std::to_string(opt.max_level));
+        report_step(opt.progress, "tmesh",
+                    "warning: " + std::to_string(rep.edges_over_tolerance) +
+                        " boundary edges still exceed the tolerance at the maximum level " +
+                        std::to_string(opt.max_level),
+                    -1, ProgressEvent::Kind::Note);
       // The Coons start of the final T-mesh, for the report (and the start if not nested).
       r.coons = coons_positions(r.mesh, r.boundary);
       r.quality_coons = mesh_quality(r.mesh, r.coons);
-      log("coons: " + std::to_string(r.quality_coons.inverted_cells) + " inverted cells");
+      log("coons", "coons: " + std::to_string(r.quality_coons.inverted_cells) + " inverted cells");
       clock.stop("coons");
     }
     // Carry the previous stage over only if it was untangled: a coarse stage
@@ -178,28 +213,24 @@ FrontResult optimize_front(BoundaryMap boundary, const ParameterizationOptions& 
   sopt.max_sweeps = opt.smoothing.max_sweeps;
   for (int round = 0; round < opt.max_repair_rounds && r.quality_optimized.inverted_cells > 0; ++round) {
     const std::vector<CellQuality> q = cell_qualities(r.mesh, r.optimized);
-    const TMesh coarse = r.mesh;
-    std::size_t refined = 0;
-    for (int c = 0; c < static_cast<int>(q.size()); ++c) {
-      if (q[c].valid || coarse.cell_level(c) >= opt.max_level) continue;
-      r.mesh.refine(coarse.cell_node(c));
-      ++refined;
-    }
-    if (refined == 0) {
+    std::vector<int> inverted;
+    for (int c = 0; c < static_cast<int>(q.size()); ++c)
+      if (!q[c].valid && r.mesh.cell_level(c) < opt.max_level) inverted.push_back(c);
+    if (inverted.empty()) {
       r.repair_stop_reason = "the " + std::to_string(r.quality_optimized.inverted_cells) +
                              " inverted cells are at --max-level " + std::to_string(opt.max_level);
-      log("repair stopped: " + r.repair_stop_reason);
+      log("repair", "repair stopped: " + r.repair_stop_reason);
       break;
     }
-    r.mesh.balance();
-    r.mesh.build_topology();
-    if (r.mesh.num_cells() > opt.max_cells) {
+    const std::size_t refined = inverted.size();
+    TMesh finer = refine_cells(r.mesh, inverted);
+    if (finer.num_cells() > opt.max_cells) {
       // The domain needs a finer mesh than allowed (typically a long thin
       // part): say so and stop rather than go on with a tangled mesh.
       std::ostringstream s;
       s << "the polygon needs more than " << opt.max_cells << " cells (--max-cells): after " << round
-        << " repair round(s) " << r.quality_optimized.inverted_cells << " of " << coarse.num_cells()
-        << " T-mesh cells are still inverted, and refining them makes " << r.mesh.num_cells()
+        << " repair round(s) " << r.quality_optimized.inverted_cells << " of " << r.mesh.num_cells()
+        << " T-mesh cells are still inverted, and refining them makes " << finer.num_cells()
         << " cells; raise --max-cells, or check the polygon for long thin parts (spikes, narrow channels)";
       throw InputError(s.str());
     }
@@ -207,9 +238,10 @@ FrontResult optimize_front(BoundaryMap boundary, const ParameterizationOptions& 
     std::vector<Eigen::Vector2d> before = r.optimized;
     const MeshQualityStats quality_before = r.quality_optimized;
     const meshopt::SmoothingReport smoothing_before = r.smoothing;
+    const TMesh coarse = std::exchange(r.mesh, std::move(finer));
     r.optimized = transfer_positions(coarse, r.optimized, r.mesh, r.boundary);
     r.repair_refined_cells.push_back(refined);
-    log("repair round " + std::to_string(round + 1) + ": refined " + std::to_string(refined) +
+    log("repair", "repair round " + std::to_string(round + 1) + ": refined " + std::to_string(refined) +
         " inverted cells, now " + std::to_string(r.mesh.num_cells()) + " cells");
     optimize("repair " + std::to_string(round + 1));
     clock.stop("repair");
@@ -225,7 +257,7 @@ FrontResult optimize_front(BoundaryMap boundary, const ParameterizationOptions& 
       r.quality_optimized = quality_before;
       r.smoothing = smoothing_before;
       r.repair_refined_cells.pop_back();
-      log("repair stopped: " + r.repair_stop_reason);
+      log("repair", "repair stopped: " + r.repair_stop_reason);
       break;
     }
   }
@@ -247,29 +279,21 @@ std::size_t best_corner_trial(const std::vector<CornerTrial>& trials) {
 }
 
 FrontResult run_front(const Polygon& input, const ParameterizationOptions& opt) {
-  auto log = [&](const std::string& s) {
-    if (opt.log) opt.log(s);
-  };
-  if (opt.initial_level < 0 || opt.initial_level > 10)  // 2^10 x 2^10 = 10^6 cells, about 1 GB
-    throw InputError("--init-level must be in [0, 10], got " + std::to_string(opt.initial_level));
-  if (opt.max_level < std::max(1, opt.initial_level) || opt.max_level > TMesh::kMaxLevel)
-    throw InputError("--max-level must be in [max(1, init-level), " + std::to_string(TMesh::kMaxLevel) + "]");
-  if (opt.tolerance_absolute && !(*opt.tolerance_absolute > 0.0 && std::isfinite(*opt.tolerance_absolute)))
-    throw InputError("--tol must be a positive finite area");
-  if (!(opt.tolerance_relative > 0.0 && std::isfinite(opt.tolerance_relative)))
-    throw InputError("--tol-rel must be a positive finite number");
-  if (opt.max_repair_rounds < 0) throw InputError("the number of repair rounds must be >= 0");
-  if (opt.corner_trials < 1) throw InputError("--corner-trials must be >= 1");
-  if (opt.max_cells < 1) throw InputError("--max-cells must be >= 1");
+  auto log = [&](const char* stage, const std::string& s) { report_step(opt.progress, stage, s); };
+  validate_options(opt);
 
   std::vector<StageTime> times;
   StageClock clock(times);
   PolygonCleaning cleaning = clean_polygon(input);
   for (const std::string& note : cleaning.notes)
-    if (opt.log) opt.log("note: " + note);
+    report_step(opt.progress, "cleaning", "note: " + note, -1, ProgressEvent::Kind::Note);
   Polygon poly = validate_polygon(std::move(cleaning.polygon));
+  clock.stop("boundary");
   Corners corners;
   std::vector<CornerTrial> trials;
+  bool trial_is_run = false;             // the corner trials ran at the run's own resolution
+  std::optional<FrontResult> kept_trial;  // then the kept choice's result, not computed again
+  std::vector<ProgressEvent> kept_events;
   if (opt.corners) {
     corners = corners_from_file_indices(poly, *opt.corners);
   } else {
@@ -281,40 +305,77 @@ FrontResult run_front(const Polygon& input, const ParameterizationOptions& opt) 
       // the fewest inverted cells, then the highest min + mean triangle quality
       // (the minimum guards validity margins, the mean the overall distortion).
       ParameterizationOptions topt = opt;
-      topt.log = nullptr;
       topt.smoothing.progress = nullptr;
       topt.corner_trials = 1;
       // Trials at most at the default resolution (level <= 5, tolerance no finer
       // than the default 1e-5 diag^2): for the default options that is the run
       // itself; for fine user settings it keeps the trials cheap.
       topt.initial_level = std::min(opt.initial_level, 5);
-      {
-        const double d = bbox_diagonal(poly);
-        const double tol = opt.tolerance_absolute ? *opt.tolerance_absolute : opt.tolerance_relative * d * d;
-        topt.tolerance_absolute = std::max(tol, 1e-5 * d * d);
-      }
-      std::optional<InputError> failed;  // the first trial that needed more than --max-cells
-      for (std::size_t k = 0; k < cands.size(); ++k) {
-        log("corners: trying automatic choice " + std::to_string(k + 1) + " of " + std::to_string(cands.size()));
+      const double d = bbox_diagonal(poly);
+      const double tol = opt.tolerance_absolute ? *opt.tolerance_absolute : opt.tolerance_relative * d * d;
+      topt.tolerance_absolute = std::max(tol, 1e-5 * d * d);
+      trial_is_run = topt.initial_level == opt.initial_level && *topt.tolerance_absolute == tol;
+      // The trials are independent front halves: they run concurrently, each
+      // collecting its log lines (replayed for the kept one if it is the run).
+      // Each finished trial is reported at once (from its worker thread, one
+      // event at a time); the sweeps of concurrent trials are not.
+      std::vector<std::optional<FrontResult>> results(cands.size());
+      std::vector<std::vector<ProgressEvent>> events(cands.size());
+      std::mutex report_mutex;
+      std::size_t finished = 0;
+      // A trial that needs more than --max-cells with its corners (an
+      // InputError; the options were validated above) ranks last.
+      std::vector<std::exception_ptr> over_budget(cands.size());
+      for_each_concurrently(cands.size(), [&](std::size_t k) {
+        ParameterizationOptions o = topt;
+        o.progress = nullptr;
+        if (opt.progress)
+          o.progress = [&events, k](const ProgressEvent& e) {
+            if (e.kind == ProgressEvent::Kind::Step || e.kind == ProgressEvent::Kind::Note) events[k].push_back(e);
+          };
         try {
-          const FrontResult t = optimize_front(BoundaryMap(poly, cands[k]), topt, nullptr);
-          trials.push_back({cands[k].index, t.quality_optimized.inverted_cells, t.quality_optimized.min_quality,
-                            t.quality_optimized.mean_quality});
+          results[k].emplace(optimize_front(BoundaryMap(poly, cands[k]), o));
         } catch (const InputError& e) {
-          // Over the cell budget with these corners: ranked last (the options
-          // themselves were validated above, so that is the only InputError).
-          if (!failed) failed.emplace(e);
-          constexpr double kWorst = -std::numeric_limits<double>::infinity();
-          trials.push_back({cands[k].index, std::numeric_limits<std::size_t>::max(), kWorst, kWorst});
+          over_budget[k] = std::current_exception();
+          if (!opt.progress) return;
+          const std::lock_guard<std::mutex> lock(report_mutex);
+          report_step(opt.progress, "corners",
+                      "corners: trial " + std::to_string(++finished) + " of " + std::to_string(cands.size()) +
+                          " failed (choice " + std::to_string(k + 1) + "): " + e.what());
+          return;
         }
+        if (!opt.progress) return;
+        const FrontResult& t = *results[k];
+        std::ostringstream s;
+        const std::lock_guard<std::mutex> lock(report_mutex);
+        s << "corners: trial " << ++finished << " of " << cands.size() << " done (choice " << k + 1 << "): "
+          << t.quality_optimized.inverted_cells << " inverted cells, min/mean quality "
+          << t.quality_optimized.min_quality << " / " << t.quality_optimized.mean_quality;
+        report_step(opt.progress, "corners", s.str());
+      });
+      for (std::size_t k = 0; k < cands.size(); ++k) {
+        constexpr double kWorst = -std::numeric_limits<double>::infinity();
+        if (!results[k]) {
+          trials.push_back({cands[k].index, std::numeric_limits<std::size_t>::max(), kWorst, kWorst});
+          continue;
+        }
+        const FrontResult& t = *results[k];
+        trials.push_back({cands[k].index, t.quality_optimized.inverted_cells, t.quality_optimized.min_quality,
+                          t.quality_optimized.mean_quality});
       }
       const std::size_t best = best_corner_trial(trials);
-      if (failed && trials[best].inverted_cells == std::numeric_limits<std::size_t>::max()) throw *failed;
+      if (!results[best]) std::rethrow_exception(over_budget[best]);  // every trial needed more cells
+      clock.stop("corner_trials");
+      if (trial_is_run) {
+        kept_trial = std::move(results[best]);
+        kept_trial->tolerance_is_relative = !opt.tolerance_absolute.has_value();
+        kept_events = std::move(events[best]);
+      }
       corners = cands[best];
       corners.explanation += " Of the " + std::to_string(cands.size()) +
                              " best automatic choices, tried on the T-mesh, this one gave the fewest inverted "
                              "cells and the best min + mean triangle quality (choice " + std::to_string(best + 1) + ").";
-      log("corners: tried " + std::to_string(cands.size()) + " automatic choices, kept choice " +
+      log("corners", "corners: tried " + std::to_string(cands.size()) + " automatic choices, kept choice " +
           std::to_string(best + 1));
     }
   }
@@ -340,10 +401,22 @@ FrontResult run_front(const Polygon& input, const ParameterizationOptions& opt) 
       << poly.file_index[corners.index[0]] << "," << poly.file_index[corners.index[1]] << ","
       << poly.file_index[corners.index[2]] << "," << poly.file_index[corners.index[3]]
       << (opt.corners ? " (given)" : " (automatic)");
-    log(s.str());
+    log("boundary", s.str());
   }
   clock.stop("boundary");
-  FrontResult r = optimize_front(BoundaryMap(std::move(poly), std::move(corners)), opt, &clock);
+  FrontResult r = kept_trial ? std::move(*kept_trial)
+                             : optimize_front(BoundaryMap(std::move(poly), std::move(corners)), opt);
+  if (kept_trial) {
+    r.boundary = BoundaryMap(r.boundary.polygon(), corners);  // the same corners, with their explanation
+    if (opt.progress)
+      for (const ProgressEvent& e : kept_events) opt.progress(e);
+    // The kept trial's stages were part of the trials' wall time.
+    double kept = 0.0;
+    for (const StageTime& t : r.times) kept += t.seconds;
+    for (StageTime& t : times)
+      if (t.stage == "corner_trials") t.seconds = std::max(0.0, t.seconds - kept);
+  }
+  times.insert(times.end(), r.times.begin(), r.times.end());
   r.removed_vertices = cleaning.removed_file_indices;
   r.cleaning_notes = cleaning.notes;
   r.corner_trials = std::move(trials);

@@ -118,18 +118,6 @@ std::vector<int> mark_cells(const std::vector<double>& eta, double gamma) {
   return marked;
 }
 
-TMesh refine_cells(const TMesh& mesh, const std::vector<int>& cells) {
-  TMesh out = mesh;
-  std::vector<int> nodes;
-  nodes.reserve(cells.size());
-  for (int c : cells) nodes.push_back(mesh.cell_node(c));  // node ids stay valid: refine() appends
-  for (int n : nodes)
-    if (out.node(n).is_leaf()) out.refine(n);
-  out.balance();
-  out.build_topology();
-  return out;
-}
-
 std::vector<PoissonStep> solve_adaptive(const TSplineMap& map, const PoissonProblem& problem,
                                         const AdaptiveSolveOptions& options, const PoissonStepCallback& callback) {
   if (options.steps < 1) throw InputError("Poisson: steps must be at least 1");

@@ -256,4 +256,15 @@ std::string TMesh::check_invariants() const {
   return err.str();
 }
 
+TMesh refine_cells(const TMesh& mesh, const std::vector<int>& cells) {
+  TMesh out = mesh;
+  for (int c : cells) {
+    const int n = mesh.cell_node(c);  // node ids stay valid: refine() appends children
+    if (out.node(n).is_leaf()) out.refine(n);
+  }
+  out.balance();
+  out.build_topology();
+  return out;
+}
+
 }  // namespace tspline

@@ -18,6 +18,7 @@
 #include <functional>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "tspline/map_certification.h"
@@ -82,6 +83,7 @@ struct AdaptIteration {
 };
 
 struct ParameterizationResult {
+  explicit ParameterizationResult(FrontResult f) : front(std::move(f)) {}
   FrontResult front;  ///< mesh/optimized/quality_optimized are those of the kept T-mesh
   std::optional<TSplineMap> map;
   FitReport fit;
@@ -102,15 +104,23 @@ struct ParameterizationResult {
   /// Refinement rounds made only because of the certification: the map was
   /// valid and good at every Gauss point but not certified on every element.
   int certification_rounds = 0;
+  /// The options this result was computed with (without the progress
+  /// callback), so that reports and writers need nothing else.
+  ParameterizationOptions options;
+  AdaptiveOptions adaptive;
   bool valid() const { return quality.nonpositive_det == 0; }
   bool certified_valid() const { return certification.certified_valid(); }
-  bool good(double min_jacobian) const { return valid() && quality.min_mean_ratio >= min_jacobian; }
+  /// Valid and J_r >= adaptive.min_jacobian at every Gauss point (the paper's criterion).
+  bool good() const { return valid() && quality.min_mean_ratio >= adaptive.min_jacobian; }
 };
 
 /// Called after each fit with the iteration number (0 = first fit), the T-mesh,
 /// its physical vertex positions, the map and its per-cell quality.
 using IterationCallback = std::function<void(int, const TMesh&, const std::vector<Eigen::Vector2d>&,
                                              const TSplineMap&, const std::vector<CellMapQuality>&)>;
+
+/// \throw InputError naming the first option out of range (options_validation.cpp).
+void validate_options(const AdaptiveOptions& options);
 
 /// \throw InputError for invalid input or options; NumericalError if a fit fails.
 ParameterizationResult run_parameterization(const Polygon& polygon, const ParameterizationOptions& options,

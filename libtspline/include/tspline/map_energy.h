@@ -68,6 +68,11 @@ struct MapEnergyOptions {
   ElementWeighting weighting = ElementWeighting::Uniform;
   /// Threads for the energy and gradient (0: std::thread::hardware_concurrency).
   int threads = 0;
+  /// Per basis function: may it move? Empty: every function not touching the
+  /// border. Otherwise only those marked (and not touching the border) are
+  /// variables, and only the elements they touch enter the energy (a local
+  /// problem: the rest of the map is fixed and adds a constant).
+  std::vector<char> movable;
 };
 
 /// Statistics over the current sample points (not a certificate).
@@ -123,6 +128,7 @@ class MapEnergy {
     double hx = 1.0, hy = 1.0;   // parametric size
     double weight = 1.0;
     int level = 0;
+    bool active = true;  // touches a variable (else constant: left out)
   };
   // X and Y Bernstein coefficients of element k at the variables x.
   void element_coefficients(std::size_t k, const double* x, std::array<double, 16>& X,

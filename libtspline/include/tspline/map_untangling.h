@@ -66,6 +66,12 @@ struct MapUntanglingOptions {
   /// 20 L-BFGS iterations per stage, and reached the same certified map).
   double min_decrease = 0.25;
   CertificationOptions certification;
+  /// When every sample is positive but some elements are not certified (folds
+  /// hidden between their samples): first untangle the control points of
+  /// those elements and of one ring of elements around them alone, with the
+  /// rest of the map fixed and finer samples there (a small problem), instead
+  /// of continuing on the whole map from a raised eps.
+  bool local_repair = true;
   std::function<void(const UntanglingProgress&)> progress;
 };
 
@@ -78,6 +84,8 @@ struct MapUntanglingReport {
   int iterations = 0;   ///< L-BFGS iterations
   int evaluations = 0;  ///< energy + gradient evaluations
   int sample_refinements = 0;  ///< elements whose sample level was raised
+  int local_repairs = 0;        ///< local problems solved for hidden folds (see local_repair)
+  int local_repairs_certified = 0;  ///< of which certified the map
   SampleStats before, after;   ///< at the initial samples / at the final samples, of the returned map
   bool certified = false;
   MapCertification certification;  ///< of the returned map

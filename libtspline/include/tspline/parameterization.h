@@ -10,10 +10,12 @@
 #include <vector>
 
 #include "meshopt/node_smoother.h"
+#include "tspline/border_knots.h"
 #include "tspline/boundary_map.h"
 #include "tspline/boundary_refinement.h"
 #include "tspline/mesh_quality.h"
 #include "tspline/polygon.h"
+#include "tspline/progress_event.h"
 #include "tspline/tmesh.h"
 
 namespace tspline {
@@ -43,10 +45,13 @@ struct ParameterizationOptions {
   /// Optimize on a nested sequence of coarser T-meshes first (same final mesh,
   /// far fewer sweeps on fine meshes). false: optimize the final mesh from Coons.
   bool nested_optimization = true;
+  /// Border parameters per side that must be T-mesh vertices from the first
+  /// mesh on (multi-patch maps: both sides of an interface get the same knots).
+  BorderParams border_params;
   /// Node optimization settings (libmeshopt).
   meshopt::SmoothingOptions smoothing;
-  /// Progress lines (stage names, counts); may be empty.
-  std::function<void(const std::string&)> log;
+  /// Progress events (progress_event.h); may be empty.
+  ProgressCallback progress;
 };
 
 struct StageTime {
@@ -93,6 +98,9 @@ struct FrontResult {
   std::vector<std::size_t> removed_vertices;
   std::vector<std::string> cleaning_notes;
 };
+
+/// \throw InputError naming the first option out of range (options_validation.cpp).
+void validate_options(const ParameterizationOptions& options);
 
 /// Runs the front half on a polygon as read from a file (not yet validated).
 /// \throw InputError for invalid polygons, corners or options.

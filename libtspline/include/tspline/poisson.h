@@ -202,9 +202,6 @@ std::vector<int> refinement_patch(const TMesh& mesh, const std::vector<int>& mar
 /// Cells with eta_e > gamma * max eta (none if max eta is 0). \throw InputError unless 0 <= gamma <= 1.
 std::vector<int> mark_cells(const std::vector<double>& eta, double gamma);
 
-/// A copy of `mesh` with the given cells split, balanced, topology rebuilt.
-TMesh refine_cells(const TMesh& mesh, const std::vector<int>& cells);
-
 struct AdaptiveSolveOptions {
   enum class Refine { Adaptive, Uniform };
   Refine refine = Refine::Adaptive;

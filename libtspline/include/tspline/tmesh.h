@@ -132,4 +132,12 @@ class TMesh {
   std::unordered_map<std::uint64_t, int> vertex_lookup_;
 };
 
+/// The one refine-and-rebalance step of every adaptive loop (the front's repair,
+/// the boundary-curve and adaptive rounds of the map, the Poisson estimator):
+/// a copy of `mesh` with the given cells (numbering of `mesh`) split into four,
+/// re-balanced 2:1 and its topology rebuilt. Repeated cells are split once.
+/// \pre mesh has its topology; \throw std::logic_error for a cell at kMaxLevel
+/// (callers filter by their own maximum level first).
+TMesh refine_cells(const TMesh& mesh, const std::vector<int>& cells);
+
 }  // namespace tspline

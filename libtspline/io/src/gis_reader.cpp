@@ -154,11 +154,12 @@ DomainInput read_domain(const std::string& path, const DomainReadOptions& option
   if (!is_gis_file(path)) {
     if (options.layer || options.feature)
       throw InputError(path + ": --layer and --feature apply to GIS files, not to a text polygon");
-    PolygonReadOptions ropt;
-    ropt.polygon_index = options.polygon_index;
-    out.outer = read_polygon(path, ropt, warnings);
+    // Rings separated by blank lines: the first is the outer boundary, the others are holes.
+    std::vector<Polygon> rings = read_text_rings(path);
+    out.outer = std::move(rings.front());
+    out.holes.assign(std::make_move_iterator(rings.begin() + 1), std::make_move_iterator(rings.end()));
     out.description = {{"format", "text"}, {"crs", nullptr}, {"projection", nullptr}, {"units", "as in the file"},
-                       {"holes", 0}};
+                       {"holes", out.holes.size()}};
     return out;
   }
   {
@@ -286,10 +287,6 @@ DomainInput read_domain(const std::string& path, const DomainReadOptions& option
                        {"proj", proj4 ? proj4 : ""}};
     CPLFree(proj4);
     d["units"] = "m";
-  }
-  if (!chosen.holes.empty() && warnings) {
-    if (!warnings->empty()) *warnings += "; ";
-    *warnings += std::to_string(chosen.holes.size()) + " hole(s) of the polygon are read but ignored (outer ring used)";
   }
   out.outer = to_polygon(chosen.outer);
   for (const auto& h : chosen.holes) out.holes.push_back(to_polygon(h));

@@ -47,8 +47,13 @@ Polygon finish(Ring ring, const std::string& source) {
   return p;
 }
 
-Polygon parse_text(const std::string& content, const std::string& source) {
+// Vertex lines in file order; `ring_starts` (if given) receives the index of
+// the first vertex of every ring, rings being separated by blank lines (a
+// line holding only a comment does not separate).
+Ring parse_text_vertices(const std::string& content, const std::string& source,
+                         std::vector<std::size_t>* ring_starts = nullptr) {
   Ring ring;
+  bool after_blank = true;
   std::size_t line_no = 0, pos = 0;
   while (pos <= content.size()) {
     std::size_t end = content.find('\n', pos);
@@ -57,9 +62,12 @@ Polygon parse_text(const std::string& content, const std::string& source) {
     pos = end + 1;
     ++line_no;
     if (line_no == 1 && line.substr(0, 3) == "\xEF\xBB\xBF") line.remove_prefix(3);  // UTF-8 BOM
+    if (trim(line).empty()) after_blank = true;
     if (const auto hash = line.find('#'); hash != std::string_view::npos) line = line.substr(0, hash);
     line = trim(line);
     if (line.empty()) continue;
+    if (after_blank && ring_starts) ring_starts->push_back(ring.size());
+    after_blank = false;
     // Two tokens separated by whitespace and/or one comma.
     std::vector<std::string_view> tok;
     int commas = 0;
@@ -83,7 +91,11 @@ Polygon parse_text(const std::string& content, const std::string& source) {
     if (!std::isfinite(x) || !std::isfinite(y)) throw InputError(where + "coordinate is not finite");
     ring.emplace_back(x, y);
   }
-  return finish(std::move(ring), source);
+  return ring;
+}
+
+Polygon parse_text(const std::string& content, const std::string& source) {
+  return finish(parse_text_vertices(content, source), source);
 }
 
 // ---- GeoJSON ---------------------------------------------------------------
@@ -196,6 +208,20 @@ Polygon parse_geojson(const std::string& content, const std::string& source, con
 
 }  // namespace
 
+std::vector<Polygon> parse_text_rings(const std::string& content, const std::string& source_name) {
+  std::vector<std::size_t> starts;
+  const Ring all = parse_text_vertices(content, source_name, &starts);
+  if (all.empty()) throw InputError(source_name + ": empty (no vertices)");
+  std::vector<Polygon> rings;
+  for (std::size_t k = 0; k < starts.size(); ++k) {
+    const std::size_t end = k + 1 < starts.size() ? starts[k + 1] : all.size();
+    Polygon p = finish(Ring(all.begin() + static_cast<long>(starts[k]), all.begin() + static_cast<long>(end)),
+                       source_name + " ring " + std::to_string(k));
+    rings.push_back(std::move(p));
+  }
+  return rings;
+}
+
 Polygon parse_polygon(const std::string& content, const std::string& source_name,
                       const PolygonReadOptions& options, std::string* warnings) {
   std::size_t first = content.find_first_not_of(" \t\r\n\f\v");
@@ -206,7 +232,9 @@ Polygon parse_polygon(const std::string& content, const std::string& source_name
   return parse_text(content, source_name);
 }
 
-Polygon read_polygon(const std::string& path, const PolygonReadOptions& options, std::string* warnings) {
+namespace {
+
+std::string read_whole_file(const std::string& path) {
   std::error_code ec;
   if (std::filesystem::is_directory(path, ec))
     throw IoError("cannot read '" + path + "': " + std::strerror(EISDIR));
@@ -219,7 +247,15 @@ Polygon read_polygon(const std::string& path, const PolygonReadOptions& options,
   std::ostringstream ss;
   ss << in.rdbuf();
   if (in.bad()) throw IoError("cannot read '" + path + "': " + (errno ? std::strerror(errno) : "read error"));
-  return parse_polygon(ss.str(), path, options, warnings);
+  return ss.str();
 }
+
+}  // namespace
+
+Polygon read_polygon(const std::string& path, const PolygonReadOptions& options, std::string* warnings) {
+  return parse_polygon(read_whole_file(path), path, options, warnings);
+}
+
+std::vector<Polygon> read_text_rings(const std::string& path) { return parse_text_rings(read_whole_file(path), path); }
 
 }  // namespace tspline::io

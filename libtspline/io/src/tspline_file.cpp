@@ -69,6 +69,10 @@ void check_meta(const TSplineMap& map, const TSplineFileMeta& meta) {
 }  // namespace
 
 void write_tspline_file(const std::string& path, const TSplineMap& map, const TSplineFileMeta& meta) {
+  write_text_atomic(path, tspline_file_text(map, meta));
+}
+
+std::string tspline_file_text(const TSplineMap& map, const TSplineFileMeta& meta) {
   check_meta(map, meta);
   const TMesh& mesh = map.mesh();
   const TSplineBasis& basis = map.basis();
@@ -108,7 +112,7 @@ void write_tspline_file(const std::string& path, const TSplineMap& map, const TS
         << json(meta.corners).dump() << "\n  }";
   }
   out << "\n}\n";
-  write_text_atomic(path, out.str());
+  return out.str();
 }
 
 // ------------------------------------------------------------------ reading
@@ -352,7 +356,9 @@ class Reader {
   std::string file_;
 };
 
-std::string read_text(const std::string& path) {
+}  // namespace
+
+std::string read_text_file(const std::string& path) {
   std::error_code ec;
   if (std::filesystem::is_directory(path, ec)) throw IoError("cannot read '" + path + "': it is a directory");
   std::ifstream in(path, std::ios::binary);
@@ -363,6 +369,8 @@ std::string read_text(const std::string& path) {
   return ss.str();
 }
 
+namespace {
+
 // "[json.exception.parse_error.101] parse error at line 1, ..." -> "parse error at line 1, ..."
 std::string strip_id(std::string what) {
   const auto close = what.find("] ");
@@ -372,7 +380,7 @@ std::string strip_id(std::string what) {
 
 }  // namespace
 
-LoadedTSpline read_tspline_file(const std::string& path) { return parse_tspline_file(read_text(path), path); }
+LoadedTSpline read_tspline_file(const std::string& path) { return parse_tspline_file(read_text_file(path), path); }
 
 LoadedTSpline parse_tspline_file(const std::string& text, const std::string& path) {
   json doc;
@@ -383,7 +391,11 @@ LoadedTSpline parse_tspline_file(const std::string& text, const std::string& pat
   } catch (const json::exception& e) {  // e.g. a number too large for a double
     throw InputError(path + ": /: invalid JSON: " + strip_id(e.what()));
   }
-  const Reader r(path);
+  return tspline_from_json(doc, path);
+}
+
+LoadedTSpline tspline_from_json(const nlohmann::json& doc, const std::string& name) {
+  const Reader r(name);
   r.header(doc);
   TSplineFileMeta meta = r.meta(doc);
   TMesh mesh = r.tmesh(doc);

@@ -41,9 +41,9 @@ class AdaptSeriesWriter {
 
 /// Full report: the front-half report plus the T-spline (functions, control
 /// points, interpolation residual), J_r min/mean, quadrature points with
-/// det J <= 0, the adaptive iterations and the per-stage times.
-nlohmann::json param_report(const ParameterizationResult& result, const std::string& input_path,
-                            const AdaptiveOptions& adaptive);
+/// det J <= 0, the adaptive iterations and the per-stage times (the options
+/// are those stored in the result).
+nlohmann::json param_report(const ParameterizationResult& result, const std::string& input_path);
 
 /// Writes parametric_tmesh.vtu, physical_tmesh.vtu, boundary.vtu, tspline.json,
 /// surface.vtu, control_net.vtu and report.json into out_dir (each atomically).

@@ -2,6 +2,7 @@
 // Reading polygons from text files and GeoJSON.
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "tspline/polygon.h"
 
@@ -29,5 +30,15 @@ Polygon read_polygon(const std::string& path, const PolygonReadOptions& options 
 /// Same, from a string already in memory (`source_name` is used in messages).
 Polygon parse_polygon(const std::string& content, const std::string& source_name,
                       const PolygonReadOptions& options = {}, std::string* warnings = nullptr);
+
+/// Text with several rings: rings are separated by one or more blank lines
+/// (lines holding only a comment do not separate), each ring as in a text
+/// polygon; the first ring is the outer boundary, the others are holes. Every
+/// ring keeps its own file numbering (0-based within the ring). Not validated
+/// (see validate_domain). \throw InputError as parse_polygon (for an empty file).
+std::vector<Polygon> parse_text_rings(const std::string& content, const std::string& source_name);
+
+/// Same, from a file. \throw IoError if the file cannot be read.
+std::vector<Polygon> read_text_rings(const std::string& path);
 
 }  // namespace tspline::io

@@ -3,6 +3,7 @@
 // another program can read (see docs/tspline_format.md).
 #include <array>
 #include <cstddef>
+#include <nlohmann/json.hpp>
 #include <string>
 
 #include "tspline/polygon.h"
@@ -21,6 +22,10 @@ struct TSplineFileMeta {
 /// \throw IoError.
 void write_tspline_file(const std::string& path, const TSplineMap& map, const TSplineFileMeta& meta);
 
+/// The text write_tspline_file writes (a version-1 document).
+/// \throw InputError for inconsistent metadata.
+std::string tspline_file_text(const TSplineMap& map, const TSplineFileMeta& meta);
+
 struct LoadedTSpline {
   TSplineMap map;
   TSplineFileMeta meta;
@@ -35,5 +40,12 @@ LoadedTSpline read_tspline_file(const std::string& path);
 /// The same from the file's content; `source_name` stands for the path in
 /// messages. \throw InputError.
 LoadedTSpline parse_tspline_file(const std::string& text, const std::string& source_name);
+
+/// The whole content of a file. \throw IoError (a directory, unreadable).
+std::string read_text_file(const std::string& path);
+
+/// Same, from a parsed version-1 document (`name` prefixes the messages, e.g.
+/// "FILE: /patches/2").
+LoadedTSpline tspline_from_json(const nlohmann::json& doc, const std::string& name);
 
 }  // namespace tspline::io

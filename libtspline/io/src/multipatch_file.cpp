@@ -1,0 +1,124 @@
+#include "tspline/io/multipatch_file.h"
+
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "tspline/errors.h"
+#include "tspline/io/atomic_file.h"
+
+namespace tspline::io {
+namespace {
+
+using json = nlohmann::json;
+constexpr int kVersion = 2;
+const char* const kSides[4] = {"bottom", "right", "top", "left"};
+
+int side_index(const json& v, const std::string& where) {
+  if (v.is_string())
+    for (int k = 0; k < 4; ++k)
+      if (v.get<std::string>() == kSides[k]) return k;
+  throw InputError(where + ": expected \"bottom\", \"right\", \"top\" or \"left\", found " + v.dump());
+}
+
+std::size_t index_in(const json& v, std::size_t n, const std::string& where) {
+  if (!v.is_number_integer() || v.get<long long>() < 0 || v.get<std::size_t>() >= n)
+    throw InputError(where + ": expected an integer in [0, " + std::to_string(n) + "), found " + v.dump());
+  return v.get<std::size_t>();
+}
+
+const json& member(const json& o, const char* key, const std::string& where) {
+  if (!o.is_object() || !o.contains(key)) throw InputError(where + ": missing \"" + key + "\"");
+  return o[key];
+}
+
+}  // namespace
+
+const char* side_name(int side) { return kSides[side & 3]; }
+
+void write_multipatch_file(const std::string& path, const std::vector<const TSplineMap*>& maps,
+                           const std::vector<TSplineFileMeta>& metas, const std::vector<Interface>& interfaces,
+                           const std::vector<Cut>& cuts, const std::string& source) {
+  if (maps.size() != metas.size() || maps.empty())
+    throw InputError("write_multipatch_file: one metadata record per map is required");
+  std::ostringstream out;
+  out << "{\n  \"format\": \"tspline\",\n  \"version\": " << kVersion << ",\n  \"degree\": 3,\n";
+  out << "  \"source\": " << json(source).dump() << ",\n  \"patches\": [\n";
+  for (std::size_t p = 0; p < maps.size(); ++p) out << (p ? ",\n" : "") << tspline_file_text(*maps[p], metas[p]);
+  out << "  ],\n  \"interfaces\": [";
+  for (std::size_t i = 0; i < interfaces.size(); ++i) {
+    const Interface& f = interfaces[i];
+    if (f.patch_a >= maps.size() || f.patch_b >= maps.size() || f.cut >= cuts.size())
+      throw InputError("write_multipatch_file: interface " + std::to_string(i) + " is out of range");
+    out << (i ? ",\n    " : "\n    ") << json({{"cut", f.cut},
+                                              {"patch_a", f.patch_a},
+                                              {"side_a", side_name(f.side_a)},
+                                              {"patch_b", f.patch_b},
+                                              {"side_b", side_name(f.side_b)},
+                                              {"orientation", "reversed"}})
+                                            .dump();
+  }
+  out << "\n  ],\n  \"cuts\": [";
+  for (std::size_t c = 0; c < cuts.size(); ++c) {
+    json pts = json::array();
+    for (const auto& p : cuts[c]) pts.push_back({p.x(), p.y()});
+    out << (c ? ",\n    " : "\n    ") << pts.dump();
+  }
+  out << "\n  ]\n}\n";
+  write_text_atomic(path, out.str());
+}
+
+LoadedMaps read_maps_file(const std::string& path) {
+  json doc;
+  try {
+    doc = json::parse(read_text_file(path));
+  } catch (const json::exception&) {
+    doc = nullptr;
+  }
+  LoadedMaps out;
+  // Version 1 (or anything that is not a version-2 document): the single-patch reader and its messages.
+  if (!doc.is_object() || !doc.contains("version") || doc["version"] != kVersion) {
+    out.patches.push_back(read_tspline_file(path));
+    out.source = out.patches.front().meta.source;
+    return out;
+  }
+  out.version = kVersion;
+  if (member(doc, "format", path + ": /") != "tspline") throw InputError(path + ": /format: expected \"tspline\"");
+  if (doc.contains("source") && doc["source"].is_string()) out.source = doc["source"].get<std::string>();
+  const json& patches = member(doc, "patches", path + ": /");
+  if (!patches.is_array() || patches.empty()) throw InputError(path + ": /patches: expected a non-empty array");
+  for (std::size_t p = 0; p < patches.size(); ++p)
+    out.patches.push_back(tspline_from_json(patches[p], path + ": /patches/" + std::to_string(p)));
+  const json& cuts = member(doc, "cuts", path + ": /");
+  if (!cuts.is_array()) throw InputError(path + ": /cuts: expected an array");
+  for (std::size_t c = 0; c < cuts.size(); ++c) {
+    Cut cut;
+    const std::string where = path + ": /cuts/" + std::to_string(c);
+    if (!cuts[c].is_array()) throw InputError(where + ": expected an array of points");
+    for (const json& q : cuts[c]) {
+      if (!q.is_array() || q.size() != 2 || !q[0].is_number() || !q[1].is_number())
+        throw InputError(where + ": expected points [x, y]");
+      cut.emplace_back(q[0].get<double>(), q[1].get<double>());
+    }
+    out.cuts.push_back(std::move(cut));
+  }
+  const json& faces = member(doc, "interfaces", path + ": /");
+  if (!faces.is_array()) throw InputError(path + ": /interfaces: expected an array");
+  for (std::size_t i = 0; i < faces.size(); ++i) {
+    const std::string where = path + ": /interfaces/" + std::to_string(i);
+    const json& f = faces[i];
+    Interface itf;
+    itf.cut = index_in(member(f, "cut", where), out.cuts.size(), where + "/cut");
+    itf.patch_a = index_in(member(f, "patch_a", where), out.patches.size(), where + "/patch_a");
+    itf.patch_b = index_in(member(f, "patch_b", where), out.patches.size(), where + "/patch_b");
+    itf.side_a = side_index(member(f, "side_a", where), where + "/side_a");
+    itf.side_b = side_index(member(f, "side_b", where), where + "/side_b");
+    if (member(f, "orientation", where) != "reversed")
+      throw InputError(where + "/orientation: expected \"reversed\"");
+    out.interfaces.push_back(itf);
+  }
+  return out;
+}
+
+}  // namespace tspline::io

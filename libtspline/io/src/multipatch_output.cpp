@@ -1,0 +1,147 @@
+#include "tspline/io/multipatch_output.h"
+
+#include <filesystem>
+
+#include "tspline/io/atomic_file.h"
+#include "tspline/io/front_output.h"
+#include "tspline/io/multipatch_file.h"
+#include "tspline/io/param_output.h"
+
+namespace tspline::io {
+namespace {
+
+using json = nlohmann::json;
+
+template <class Map>
+void keep_common(Map& into, const Map& part) {
+  for (auto it = into.begin(); it != into.end();) it = part.count(it->first) ? std::next(it) : into.erase(it);
+}
+
+template <class Map>
+void append(Map& into, const Map& part) {
+  for (auto& [name, values] : into) {
+    const auto& more = part.at(name);
+    values.insert(values.end(), more.begin(), more.end());
+  }
+}
+
+}  // namespace
+
+VtuMesh merge_patches(const std::vector<VtuMesh>& parts) {
+  VtuMesh out;
+  if (parts.empty()) return out;
+  out.quads_as_polygons = parts.front().quads_as_polygons;
+  out.point_scalars = parts.front().point_scalars, out.cell_scalars = parts.front().cell_scalars;
+  out.cell_ints = parts.front().cell_ints, out.point_ints = parts.front().point_ints;
+  out.point_vectors = parts.front().point_vectors;
+  for (auto& [k, v] : out.point_scalars) v.clear();
+  for (auto& [k, v] : out.cell_scalars) v.clear();
+  for (auto& [k, v] : out.cell_ints) v.clear();
+  for (auto& [k, v] : out.point_ints) v.clear();
+  for (auto& [k, v] : out.point_vectors) v.clear();
+  for (const VtuMesh& p : parts) {
+    keep_common(out.point_scalars, p.point_scalars), keep_common(out.cell_scalars, p.cell_scalars);
+    keep_common(out.cell_ints, p.cell_ints), keep_common(out.point_ints, p.point_ints);
+    keep_common(out.point_vectors, p.point_vectors);
+  }
+  std::vector<int> patch;
+  for (std::size_t k = 0; k < parts.size(); ++k) {
+    const VtuMesh& p = parts[k];
+    const int offset = static_cast<int>(out.points.size());
+    out.points.insert(out.points.end(), p.points.begin(), p.points.end());
+    for (std::vector<int> c : p.cells) {
+      for (int& i : c) i += offset;
+      out.cells.push_back(std::move(c));
+      patch.push_back(static_cast<int>(k));
+    }
+    append(out.point_scalars, p.point_scalars), append(out.cell_scalars, p.cell_scalars);
+    append(out.cell_ints, p.cell_ints), append(out.point_ints, p.point_ints);
+    append(out.point_vectors, p.point_vectors);
+  }
+  out.cell_ints["patch"] = std::move(patch);
+  return out;
+}
+
+json multipatch_report(const MultiPatchResult& R, const std::string& input_path, double seconds) {
+  json rep;
+  rep["input"] = input_path;
+  rep["patches_count"] = R.patches.size();
+  rep["cuts"] = {{"count", R.layout.cuts.size()}, {"choice", R.cuts_explanation}};
+  std::size_t cells = 0, functions = 0, elements = 0, certified = 0;
+  json patches = json::array();
+  for (const auto& r : R.patches) {
+    cells += r.map->mesh().num_cells();
+    functions += r.map->basis().size();
+    elements += r.certification.elements;
+    certified += r.certification.certified;
+    patches.push_back(param_report(r, input_path));
+  }
+  json faces = json::array();
+  for (std::size_t i = 0; i < R.interfaces.size(); ++i) {
+    const Interface& f = R.layout.interfaces[i];
+    faces.push_back({{"cut", f.cut},
+                     {"patch_a", f.patch_a},
+                     {"side_a", side_name(f.side_a)},
+                     {"patch_b", f.patch_b},
+                     {"side_b", side_name(f.side_b)},
+                     {"max_gap", R.interfaces[i].max_gap},
+                     {"knots_a", R.interfaces[i].knots_a},
+                     {"knots_b", R.interfaces[i].knots_b},
+                     {"same_knots", R.interfaces[i].same_knots}});
+  }
+  rep["totals"] = {{"cells", cells},
+                   {"functions", functions},
+                   {"bezier_elements", elements},
+                   {"certified_elements", certified},
+                   {"certified_valid", R.certified_valid()},
+                   {"valid", R.valid()},
+                   {"min_relative_det_lower_bound", R.min_relative_det_bound()},
+                   {"min_mean_ratio_whole_map", R.min_mean_ratio_dense()},
+                   {"min_mean_ratio_gauss", R.min_mean_ratio_gauss()},
+                   {"domain_area", R.domain_area},
+                   {"map_area", R.map_area},
+                   {"area_relative_error", std::abs(R.map_area - R.domain_area) / R.domain_area},
+                   {"max_interface_gap", R.max_gap()},
+                   {"max_interface_gap_relative", R.max_gap() / R.diameter},
+                   {"interface_rounds", R.sync_rounds},
+                   {"seconds", seconds}};
+  rep["interfaces"] = std::move(faces);
+  rep["patches"] = std::move(patches);
+  return rep;
+}
+
+void write_multipatch_outputs(const MultiPatchResult& R, const std::string& out_dir, const json& report,
+                              int samples) {
+  const std::filesystem::path dir(out_dir);
+  std::vector<const TSplineMap*> maps;
+  std::vector<TSplineFileMeta> metas;
+  std::vector<VtuMesh> surface, net, param, phys, boundary;
+  for (std::size_t p = 0; p < R.patches.size(); ++p) {
+    const ParameterizationResult& r = R.patches[p];
+    maps.push_back(&*r.map);
+    TSplineFileMeta meta;
+    meta.source = report.value("input", "");
+    meta.boundary = r.front.boundary.polygon();
+    meta.corners = r.front.boundary.corners().index;
+    metas.push_back(std::move(meta));
+    surface.push_back(surface_vtu(*r.map, samples));
+    net.push_back(control_net_vtu(*r.map));
+    const TMesh& mesh = r.front.mesh;
+    std::vector<Eigen::Vector2d> uv(mesh.num_vertices());
+    for (int v = 0; v < static_cast<int>(uv.size()); ++v)
+      uv[v] = mesh.vertex_param(v) + Eigen::Vector2d(1.25 * static_cast<double>(p), 0.0);
+    param.push_back(tmesh_vtu(mesh, uv));
+    phys.push_back(tmesh_vtu(mesh, r.front.optimized));
+    boundary.push_back(boundary_vtu(r.front.boundary));
+  }
+  write_multipatch_file((dir / "tspline.json").string(), maps, metas, R.layout.interfaces, R.layout.cuts,
+                        report.value("input", ""));
+  write_vtu((dir / "surface.vtu").string(), merge_patches(surface));
+  write_vtu((dir / "control_net.vtu").string(), merge_patches(net));
+  write_vtu((dir / "parametric_tmesh.vtu").string(), merge_patches(param));
+  write_vtu((dir / "physical_tmesh.vtu").string(), merge_patches(phys));
+  write_vtu((dir / "boundary.vtu").string(), merge_patches(boundary));
+  write_text_atomic((dir / "report.json").string(), report.dump(2) + "\n");
+}
+
+}  // namespace tspline::io
