@@ -168,7 +168,6 @@ int run_remesh(const RemeshArgs& a) {
         {"output", seconds_output}}},
       {"outputs", {{"mesh", a.out}, {"vtu", a.vtu}, {"report", report}}}};
   tspline::io::write_text_atomic(report, j.dump(2) + "\n");
-  out.event({{"event", "result"}, {"report", j}});
   char buf[512];
   std::snprintf(buf, sizeof buf,
                 "meshopt remesh: %zu patches, %zu feature curves, L %g, s %g\n"
@@ -186,6 +185,7 @@ int run_remesh(const RemeshArgs& a) {
                 rep.collapses, rep.flips, rep.smoothing_moves, rep.seconds_sampling, rep.seconds_optimizing);
   out.log(buf);
   out.log("wrote " + a.out + (a.vtu.empty() ? "" : ", " + a.vtu) + ", " + report);
+  out.event({{"event", "result"}, {"report", j}});
   return 0;
 }
 
