@@ -150,6 +150,29 @@ TEST_CASE("meshopt smooth: bad input gives one clear error and exit 1") {
     REQUIRE(!tags.empty());
     gmsh::model::mesh::setNode(tags[0], {xyz[0], xyz[1], xyz[2]}, {hi[0] + 1.0, uv[1]});
     write_msh(dir / "outside.msh", true);
+    gmsh::model::mesh::setNode(tags[0], {xyz[0], xyz[1], xyz[2]}, {uv[0], uv[1]});
+    // A node moved into a trimmed-away part of a face (inside its parameter box):
+    // the sphere, cut where the cylinder enters it.
+    bool trimmed = false;
+    gmsh::vectorpair faces;
+    gmsh::model::getEntities(faces, 2);
+    for (const auto& [d, f] : faces) {
+      std::vector<std::size_t> ft;
+      std::vector<double> fx, fuv, flo, fhi;
+      gmsh::model::mesh::getNodes(ft, fx, fuv, 2, f, false, true);
+      gmsh::model::getParametrizationBounds(2, f, flo, fhi);
+      for (int i = 1; i < 20 && !trimmed && !ft.empty(); ++i)
+        for (int j = 1; j < 20 && !trimmed; ++j) {
+          const std::vector<double> p{flo[0] + (fhi[0] - flo[0]) * i / 20.0, flo[1] + (fhi[1] - flo[1]) * j / 20.0};
+          if (gmsh::model::isInside(2, f, p) != 0) continue;
+          std::vector<double> x;
+          gmsh::model::getValue(2, f, p, x);
+          gmsh::model::mesh::setNode(ft[0], x, p);
+          trimmed = true;
+        }
+    }
+    REQUIRE(trimmed);
+    write_msh(dir / "trimmed.msh", true);
   }
   {
     // A sphere with a node inside it moved onto its pole (phi_u = 0 there).
@@ -186,6 +209,8 @@ TEST_CASE("meshopt smooth: bad input gives one clear error and exit 1") {
        "no parametric coordinates for the nodes inside surface"},
       {std::string("smooth ") + model + " --mesh '" + (dir / "outside.msh").string() + "'" + out,
        "is outside the surface's parameter range"},
+      {std::string("smooth ") + model + " --mesh '" + (dir / "trimmed.msh").string() + "'" + out,
+       "lies outside the trimmed face"},
       {std::string("smooth '") + (dir / "sphere.brep").string() + "' --mesh '" + (dir / "pole.msh").string() + "'" + out,
        "lies at a degenerate point of the surface"},
       {std::string("smooth ") + model + " --measure angle" + out, "--measure must be shape, size or size-shape"},

@@ -164,9 +164,11 @@ GmshSurfaceMesh read_surface_mesh() {
       const SurfacePoint p = face.evaluate(m.u[n], 1);
       if (unit_normal(p).isZero())
         throw InputError(cat(where, " lies at a degenerate point of the surface (phi_u x phi_v = 0)"));
-      if (!face.contains_exactly(m.u[n]))
+      if (!face.contains(m.u[n]))
         throw InputError(cat(where, " is outside the surface's parameter range [", face.lower().x(), ", ",
                              face.upper().x(), "] x [", face.lower().y(), ", ", face.upper().y(), "]"));
+      if (!face.contains_exactly(m.u[n]))
+        throw InputError(cat(where, " lies outside the trimmed face (in a trimmed-away part of its parameter range)"));
       const double scale = std::max(1.0, p.x.norm());
       if (!((p.x - m.x[n]).norm() <= 1e-6 * scale))
         throw InputError(cat(where, ": the surface at these parametric coordinates is ", (p.x - m.x[n]).norm(),
