@@ -78,13 +78,25 @@ double Remesher::pair_energy(const std::array<int, 3>& t1, const std::array<int,
   return e;
 }
 
-std::vector<int> Remesher::near_faces(std::initializer_list<int> vs) const {
-  std::vector<int> out;
-  for (int v : vs)
-    if (m_.vertices[v].kind == VertexKind::surface &&
-        std::find(out.begin(), out.end(), m_.vertices[v].on.entity) == out.end())
-      out.push_back(m_.vertices[v].on.entity);
-  return out;
+ProjectionHint Remesher::hint(const std::vector<int>& tris, std::initializer_list<int> first) const {
+  ProjectionHint h;
+  auto add_face = [&](int v) {
+    const RemeshVertex& vv = m_.vertices[v];
+    if (vv.kind == VertexKind::surface && std::find(h.faces.begin(), h.faces.end(), vv.on.entity) == h.faces.end())
+      h.faces.push_back(vv.on.entity);
+  };
+  for (int v : first) add_face(v);
+  for (int t : tris) {
+    std::array<GeometryPoint, 3> corners;
+    for (int k = 0; k < 3; ++k) {
+      const int v = m_.triangles[t].v[k];
+      add_face(v);
+      const RemeshVertex& vv = m_.vertices[v];
+      corners[k] = {vv.x, vv.kind == VertexKind::surface ? vv.on.entity : -1, vv.on.param};
+    }
+    h.triangles.push_back(corners);
+  }
+  return h;
 }
 
 Edge Remesher::extreme_edge(int t, bool longest) const {
@@ -112,7 +124,7 @@ int Remesher::split(int a, int b) {
     nv.on = g_.project_to_curve(curve, mid);
   } else {
     nv.kind = VertexKind::surface;
-    nv.on = g_.project_to_patch(m_.triangles[ts[0]].patch, mid, near_faces({a, b}));
+    nv.on = g_.project_to_patch(m_.triangles[ts[0]].patch, mid, hint(ts, {a, b}));
   }
   nv.x = nv.on.x;
   // A projection far from the edge means the model is not where the mesh is.
@@ -313,12 +325,7 @@ bool Remesher::move_vertex(int v, const Eigen::Vector3d& target) {
   if (old.kind == VertexKind::curve) {
     nv.on = g_.project_to_curve(old.on.entity, target);
   } else {
-    std::vector<int> faces = near_faces({v});
-    for (int w : m_.neighbours(v))
-      if (m_.vertices[w].kind == VertexKind::surface &&
-          std::find(faces.begin(), faces.end(), m_.vertices[w].on.entity) == faces.end())
-        faces.push_back(m_.vertices[w].on.entity);
-    nv.on = g_.project_to_patch(old.normals.front().first, target, faces);
+    nv.on = g_.project_to_patch(old.normals.front().first, target, hint(star, {v}));
   }
   nv.x = nv.on.x;
   if (!nv.x.allFinite()) return false;

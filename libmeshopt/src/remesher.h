@@ -51,7 +51,8 @@ class Remesher {
   double min_angle(const std::array<int, 3>& t, int patch) const;
   /// Eq. 5 for the two triangles t1, t2 (given as corner triples in one patch).
   double pair_energy(const std::array<int, 3>& t1, const std::array<int, 3>& t2, int patch) const;
-  std::vector<int> near_faces(std::initializer_list<int> vs) const;
+  /// The projection hint of triangles `tris`, with the faces of `first` first.
+  ProjectionHint hint(const std::vector<int>& tris, std::initializer_list<int> first) const;
 
   RemeshMesh& m_;
   const RemeshGeometry& g_;

@@ -9,6 +9,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "meshopt/parametric_star.h"
 #include "meshopt/surface_objective.h"
 #include "meshopt/triangle_measure.h"
 #include "newton_descent.h"
@@ -110,29 +111,13 @@ double global_objective(const SurfaceMesh& m, const std::vector<Eigen::Vector3d>
   return F;
 }
 
-// True if uv point p lies in triangle (a, b, c) of either orientation (boundary included).
-bool in_triangle(const Eigen::Vector2d& p, const Eigen::Vector2d& a, const Eigen::Vector2d& b, const Eigen::Vector2d& c) {
-  auto cross = [](const Eigen::Vector2d& o, const Eigen::Vector2d& x, const Eigen::Vector2d& y) {
-    return (x - o).x() * (y - o).y() - (x - o).y() * (y - o).x();
-  };
-  const double d0 = cross(a, b, p), d1 = cross(b, c, p), d2 = cross(c, a, p);
-  return (d0 >= 0.0 && d1 >= 0.0 && d2 >= 0.0) || (d0 <= 0.0 && d1 <= 0.0 && d2 <= 0.0);
-}
-
-// Distance from p to segment [a, b] in the parameter plane.
-double segment_distance(const Eigen::Vector2d& p, const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
-  const Eigen::Vector2d ab = b - a;
-  const double t = ab.squaredNorm() > 0.0 ? std::clamp((p - a).dot(ab) / ab.squaredNorm(), 0.0, 1.0) : 0.0;
-  return (p - a - t * ab).norm();
-}
-
 // Whether a free node may move to uv point `un` of its face. The exact test of a
 // trimmed face (gmsh::model::isInside, 10-100 us per call on OCC faces) is
 // skipped when `un` lies in one of the node's elements in parameter space and is
 // not near one of their edges between two fixed nodes. Such an element has its
 // corners in the face, and the face's trimming curves pass through the mesh
 // only along chains of edges between fixed nodes, from which they deviate by a
-// sagitta: a quarter of the edge is kept as the margin where isInside decides.
+// sagitta: within kTrimmingMargin of such an edge isInside decides.
 bool may_move_to(const SurfaceMesh& m, const std::vector<Corner>& corners, const ParametricSurface& surface,
                  const Eigen::Vector2d& un) {
   if (!surface.contains(un)) return false;
@@ -147,7 +132,7 @@ bool may_move_to(const SurfaceMesh& m, const std::vector<Corner>& corners, const
     for (int k = 0; k < el.nv; ++k) {
       const int l = (k + 1) % el.nv;
       if (m.free_face[el.v[k]] < 0 && m.free_face[el.v[l]] < 0 &&
-          segment_distance(un, uv[k], uv[l]) < 0.25 * (uv[l] - uv[k]).norm())
+          segment_distance(un, uv[k], uv[l]) < kTrimmingMargin * (uv[l] - uv[k]).norm())
         return surface.contains_exactly(un);
     }
     for (int k = 1; k + 1 < el.nv && !in_star; ++k) in_star = in_triangle(un, uv[0], uv[k], uv[k + 1]);

@@ -182,6 +182,14 @@ CadFeatures detect_features(double feature_angle) {
     }
   }
   std::sort(f.feature_curves.begin(), f.feature_curves.end());
+  for (int tag : face_tags) {
+    bool smooth = false;
+    for (int c : f.face_curves[tag]) {
+      const std::vector<int>& fs = f.curve_faces[c];
+      smooth = smooth || (!f.is_feature(c) && fs.size() == 2 && fs[0] != fs[1]);  // a junction, not a seam
+    }
+    f.smooth_boundary[tag] = smooth;
+  }
   std::map<int, int> patch_of_root;
   for (std::size_t i = 0; i < face_tags.size(); ++i) {
     const int root = find_root(parent, static_cast<int>(i));
@@ -206,8 +214,8 @@ CadFeatures detect_features(double feature_angle) {
 }
 
 GeometryPoint GmshRemeshGeometry::project_to_patch(int patch, const Eigen::Vector3d& x,
-                                                   std::span<const int> near_faces) const {
-  // Candidates: the given faces of the patch and their neighbours in it (a point
+                                                   const ProjectionHint& hint) const {
+  // Candidates: the hint's faces of the patch and their neighbours in it (a point
   // near a smooth junction may belong to the face on the other side).
   std::vector<int> cand;
   auto add = [&](int face) {
@@ -215,23 +223,31 @@ GeometryPoint GmshRemeshGeometry::project_to_patch(int patch, const Eigen::Vecto
     if (it != f_.patch_of_face.end() && it->second == patch && std::find(cand.begin(), cand.end(), face) == cand.end())
       cand.push_back(face);
   };
-  for (int face : near_faces) {
+  for (int face : hint.faces) {
     add(face);
     for (int c : f_.face_curves.at(face))
       if (!f_.is_feature(c))
         for (int g : f_.curve_faces.at(c)) add(g);
   }
   if (cand.empty()) cand = f_.patch_faces.at(patch);
-  GeometryPoint best;
-  double best_d = kInf;
+  // Closest points on the untrimmed faces, nearest first; the first inside its
+  // trimmed face wins (the hint's mesh triangles spare most exact tests).
+  std::vector<std::pair<double, GeometryPoint>> found;
   for (int face : cand) {
     const auto [y, uv] = closest_point(2, face, x);
-    const double d = (y - x).norm();
-    if (d < best_d && this->face(face).contains_exactly(uv)) {
-      best_d = d;
-      best = {y, face, uv};
-    }
+    found.push_back({(y - x).norm(), GeometryPoint{y, face, uv}});
   }
+  std::sort(found.begin(), found.end(), [](const auto& p, const auto& q) { return p.first < q.first; });
+  GeometryPoint best;
+  double best_d = kInf;
+  for (const auto& [d, p] : found)
+    if (hint.proves_inside(p.entity, p.param, 0.5 * (face(p.entity).upper() - face(p.entity).lower()),
+                           f_.smooth_boundary.at(p.entity)) ||
+        face(p.entity).contains_exactly(p.param)) {
+      best_d = d;
+      best = p;
+      break;
+    }
   if (best_d < kInf) return best;
   // x projects onto a trimmed-away part of every candidate: its closest point is
   // then on a boundary curve of one of them.
@@ -366,7 +382,8 @@ CentroidProjection project_centroids(const RemeshMesh& m, const GmshRemeshGeomet
       out.on.push_back({});
       continue;
     }
-    std::vector<int> near;
+    ProjectionHint hint;
+    std::vector<int>& near = hint.faces;
     for (int v : t.v)
       if (m.vertices[v].kind == VertexKind::surface) near.push_back(m.vertices[v].on.entity);
     const Eigen::Vector3d c = (m.vertices[t.v[0]].x + m.vertices[t.v[1]].x + m.vertices[t.v[2]].x) / 3.0;
@@ -375,7 +392,7 @@ CentroidProjection project_centroids(const RemeshMesh& m, const GmshRemeshGeomet
         for (int face : m.vertices[v].kind == VertexKind::curve ? g.features().curve_faces.at(m.vertices[v].on.entity)
                                                                  : g.features().point_faces.at(m.vertices[v].on.entity))
           near.push_back(face);
-    const GeometryPoint p = g.project_to_patch(t.patch, c, near);
+    const GeometryPoint p = g.project_to_patch(t.patch, c, hint);
     out.face.push_back(p.entity);
     out.distance.push_back((p.x - c).norm());
     out.on.push_back(p);

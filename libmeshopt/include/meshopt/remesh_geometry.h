@@ -7,7 +7,8 @@
 // smooth curves. Feature curves (sharp, or bounding a single face) separate
 // patches and stay chains of mesh edges; their end points are fixed corners.
 #include <Eigen/Core>
-#include <span>
+#include <array>
+#include <vector>
 
 namespace meshopt {
 
@@ -27,13 +28,28 @@ struct GeometryPoint {
   Eigen::Vector2d param = Eigen::Vector2d::Zero();
 };
 
+/// What the mesh knows around a point to be projected onto a patch: the CAD
+/// faces of nearby vertices (where to look first), and the mesh triangles around
+/// it with their corners' classification (entity = the face of a surface
+/// vertex, -1 for other vertices; param = its (u, v) there).
+struct ProjectionHint {
+  std::vector<int> faces;
+  std::vector<std::array<GeometryPoint, 3>> triangles;
+  /// True if (u, v) on `face` lies in one of the triangles whose corners are all
+  /// surface vertices of `face`, spanning less than `max_span` in (u, v) (not
+  /// across a periodic face's seam): then it is inside the trimmed face without
+  /// an exact test. A face with smooth (non-feature) boundary curves, which the
+  /// mesh crosses freely, needs `trimmed_inside` true: (u, v) must then also not
+  /// lie within kTrimmingMargin of an edge of those triangles that two of them do
+  /// not share, where such a curve could bulge into them.
+  bool proves_inside(int face, const Eigen::Vector2d& uv, const Eigen::Vector2d& max_span, bool trimmed_inside) const;
+};
+
 class RemeshGeometry {
  public:
   virtual ~RemeshGeometry() = default;
-  /// The point of patch `patch` closest to x. `near_faces`: CAD faces of mesh
-  /// vertices close to x (where to look first; may be empty).
-  virtual GeometryPoint project_to_patch(int patch, const Eigen::Vector3d& x,
-                                         std::span<const int> near_faces) const = 0;
+  /// The point of patch `patch` closest to x.
+  virtual GeometryPoint project_to_patch(int patch, const Eigen::Vector3d& x, const ProjectionHint& hint) const = 0;
   /// The point of feature curve `curve` closest to x.
   virtual GeometryPoint project_to_curve(int curve, const Eigen::Vector3d& x) const = 0;
   /// The unit normal of patch `patch` at point p of its closure, classified as

@@ -24,6 +24,7 @@ struct CadFeatures {
   std::map<int, double> curve_dihedral;          ///< largest angle between the normals across a curve (radians)
   std::vector<int> feature_curves;               ///< sorted
   std::vector<int> corners;                      ///< sorted: points of feature curves
+  std::map<int, bool> smooth_boundary;           ///< face tag -> has a smooth junction curve (crossed freely)
   std::map<int, int> face_sign;                  ///< +1 / -1: Gmsh's triangles about +/- phi_u x phi_v
   double diagonal = 0.0;                         ///< of the model's bounding box
   bool is_feature(int curve) const;
@@ -38,7 +39,7 @@ class GmshRemeshGeometry final : public RemeshGeometry {
  public:
   explicit GmshRemeshGeometry(CadFeatures features);
   const CadFeatures& features() const { return f_; }
-  GeometryPoint project_to_patch(int patch, const Eigen::Vector3d& x, std::span<const int> near_faces) const override;
+  GeometryPoint project_to_patch(int patch, const Eigen::Vector3d& x, const ProjectionHint& hint) const override;
   GeometryPoint project_to_curve(int curve, const Eigen::Vector3d& x) const override;
   Eigen::Vector3d patch_normal(int patch, VertexKind kind, const GeometryPoint& p) const override;
   /// (u, v) on `face` of a point p of one of its boundary curves (kind curve,
