@@ -273,11 +273,11 @@ void Remesher::improve_by_flips(std::vector<Edge> stack) {
           if (w != a && w != b) opp[k] = w;
       if (flip(a, b)) {
         flipped = true;
-        // The link edges of the new triangles may now flip too.
+        // The link edges of the new triangles may now flip too. (The paper retries
+        // every unflipped edge; an edge whose two triangles did not change decides
+        // the same way again, so only these need another look.)
         for (const Edge& e : {Edge{a, opp[0]}, Edge{a, opp[1]}, Edge{b, opp[0]}, Edge{b, opp[1]}})
           if (in_retry.insert(RemeshMesh::key(e[0], e[1])).second) retry.push_back(e);
-      } else if (in_retry.insert(RemeshMesh::key(a, b)).second) {
-        retry.push_back({a, b});
       }
     }
     if (!flipped) break;

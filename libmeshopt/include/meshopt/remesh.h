@@ -31,7 +31,7 @@ struct RemeshOptions {
   int inner = 4;            ///< J (Algorithm 2)
   double smooth_fraction = 0.3;  ///< vertices smoothed per pass (Algorithm 2, line 3)
   double inversion_angle = std::numbers::pi / 2.0;  ///< alpha (Definition 3.4)
-  int max_flip_passes = 20;  ///< cap of each edge-flip loop (passes over its stack)
+  int max_flip_passes = 50;  ///< cap of each edge-flip loop (waves of link edges after the first pass)
   /// Called at each phase with (round, phase name); may be empty.
   std::function<void(int, const std::string&)> progress;
 };
