@@ -54,7 +54,8 @@ Deviation deviation(const std::vector<double>& d) {
 }
 
 void write_vtu(const std::string& path, const meshopt::RemeshMesh& m, double length, double s,
-               const meshopt::gmsh_io::CurvatureAlignment& align, const std::vector<int>& faces) {
+               const meshopt::gmsh_io::CurvatureAlignment& align, const meshopt::gmsh_io::CentroidProjection& centroids) {
+  const std::vector<int>& faces = centroids.face;
   tspline::io::VtuMesh v;
   for (const meshopt::RemeshVertex& x : m.vertices) v.points3d.push_back(x.x);
   std::vector<int> patch, face;
@@ -66,6 +67,7 @@ void write_vtu(const std::string& path, const meshopt::RemeshMesh& m, double len
   v.cell_scalars["aspect_ratio3d"] = meshopt::triangle_aspect_ratios(m);
   v.cell_scalars["length6d_over_L"] = meshopt::triangle_length_ratios(m, length, s);
   v.cell_scalars["angle_to_curvature_direction"] = align.angle_degrees;
+  v.cell_scalars["chordal_deviation"] = centroids.distance;
   v.cell_ints["patch"] = patch;
   v.cell_ints["surface"] = face;
   std::vector<int> kind;
@@ -127,7 +129,7 @@ int run_remesh(const RemeshArgs& a) {
   const double seconds_analysis = since(t0);
   t0 = Clock::now();
   meshopt::gmsh_io::write_remesh_mesh(a.out, mesh, centroids.face);
-  if (!a.vtu.empty()) write_vtu(a.vtu, mesh, opt.length, opt.anisotropy, align, centroids.face);
+  if (!a.vtu.empty()) write_vtu(a.vtu, mesh, opt.length, opt.anisotropy, align, centroids);
   const double seconds_output = since(t0);
 
   const auto euler_after = mesh.euler_characteristics();

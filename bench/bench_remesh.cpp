@@ -12,6 +12,7 @@
 #include <numbers>
 #include <vector>
 
+#include "cad_fixtures.h"
 #include "meshopt/gmsh/gmsh_mesh.h"
 #include "meshopt/gmsh/gmsh_remesh_model.h"
 #include "meshopt/remesh.h"
@@ -24,13 +25,7 @@ int main(int argc, char** argv) {
     return 1;
   }
   meshopt::gmsh_io::Session session;
-  gmsh::model::add("torus_pipe");
-  gmsh::model::occ::addTorus(0, 0, 0, 2.0, 0.6, 1);
-  gmsh::model::occ::addCylinder(2.0, 0, -1.5, 0, 0, 3.0, 0.3, 2);
-  gmsh::vectorpair out;
-  std::vector<gmsh::vectorpair> map;
-  gmsh::model::occ::fuse({{3, 1}}, {{3, 2}}, out, map);
-  gmsh::model::occ::synchronize();
+  cad_fixtures::add_torus_pipe();
   gmsh::option::setNumber("Mesh.MeshSizeMax", 4.0 * length);
   meshopt::gmsh_io::generate_surface_mesh();
   const meshopt::gmsh_io::GmshRemeshGeometry g(meshopt::gmsh_io::detect_features(30.0 * std::numbers::pi / 180.0));

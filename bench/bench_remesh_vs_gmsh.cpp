@@ -21,6 +21,7 @@
 #include <numbers>
 #include <vector>
 
+#include "cad_fixtures.h"
 #include "meshopt/gmsh/gmsh_mesh.h"
 #include "meshopt/gmsh/gmsh_remesh_model.h"
 #include "meshopt/remesh.h"
@@ -35,13 +36,7 @@ struct Sample {
 
 void make_model() {
   gmsh::clear();
-  gmsh::model::add("torus_pipe");
-  gmsh::model::occ::addTorus(0, 0, 0, 2.0, 0.6, 1);
-  gmsh::model::occ::addCylinder(2.0, 0, -1.5, 0, 0, 3.0, 0.3, 2);
-  gmsh::vectorpair out;
-  std::vector<gmsh::vectorpair> map;
-  gmsh::model::occ::fuse({{3, 1}}, {{3, 2}}, out, map);
-  gmsh::model::occ::synchronize();
+  cad_fixtures::add_torus_pipe();
 }
 
 double max_deviation(const meshopt::RemeshMesh& m, const meshopt::gmsh_io::GmshRemeshGeometry& g) {
@@ -63,7 +58,7 @@ Sample gmsh_mesh(const std::function<void()>& configure, double parameter) {
 /// cheapest mesh with deviation <= target.
 Sample bisect(double lo, double hi, double target, bool geometric, const std::function<Sample(double)>& mesh) {
   Sample best = mesh(hi);
-  for (int it = 0; it < 10; ++it) {
+  for (int it = 0; it < 8; ++it) {
     const double mid = geometric ? std::sqrt(lo * hi) : 0.5 * (lo + hi);
     const Sample s = mesh(mid);
     if (s.deviation <= target) {
@@ -81,6 +76,7 @@ Sample bisect(double lo, double hi, double target, bool geometric, const std::fu
 int main(int argc, char** argv) {
   const double length = argc > 1 ? std::atof(argv[1]) : 0.2;
   const double s = argc > 2 ? std::atof(argv[2]) : 1.0;
+  std::setvbuf(stdout, nullptr, _IOLBF, 0);
   meshopt::gmsh_io::Session session;
   make_model();
   gmsh::option::setNumber("Mesh.MeshSizeMax", 2.0 * length);
@@ -96,7 +92,7 @@ int main(int argc, char** argv) {
   const double target = max_deviation(m, g);
   std::printf("remesh: L %g s %g triangles %zu deviation %.4g seconds %.1f\n", length, s, m.live_triangles(), target,
               seconds);
-  const Sample uniform = bisect(1.0, 0.005, target, true, [](double h) {
+  const Sample uniform = bisect(0.5, 0.02, target, true, [](double h) {
     return gmsh_mesh(
         [h] {
           gmsh::option::setNumber("Mesh.MeshSizeMax", h);
@@ -107,7 +103,7 @@ int main(int argc, char** argv) {
   });
   std::printf("uniform: size %.4g triangles %zu deviation %.4g\n", uniform.parameter, uniform.triangles,
               uniform.deviation);
-  const Sample curved = bisect(4.0, 400.0, target, true, [](double n) {
+  const Sample curved = bisect(6.0, 150.0, target, true, [](double n) {
     return gmsh_mesh(
         [n] {
           gmsh::option::setNumber("Mesh.MeshSizeMin", 0.0);

@@ -12,53 +12,13 @@
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
-#include <random>
 #include <string>
 #include <vector>
 
+#include "cad_fixtures.h"
 #include "meshopt/gmsh/gmsh_mesh.h"
 #include "meshopt/surface_smoother.h"
 
-namespace {
-
-void make_model() {
-  gmsh::model::add("torus_pipe");
-  gmsh::model::occ::addTorus(0, 0, 0, 2.0, 0.6, 1);
-  gmsh::model::occ::addCylinder(2.0, 0, -1.5, 0, 0, 3.0, 0.3, 2);
-  gmsh::vectorpair out;
-  std::vector<gmsh::vectorpair> map;
-  gmsh::model::occ::fuse({{3, 1}}, {{3, 2}}, out, map);
-  gmsh::model::occ::synchronize();
-}
-
-/// Moves every `stride`-th node inside each face by up to 3% of the face's
-/// parametric extent, keeping it inside the (trimmed) face.
-void tangle(int stride, unsigned seed) {
-  std::mt19937_64 rng(seed);
-  std::uniform_real_distribution<double> U(-1.0, 1.0);
-  gmsh::vectorpair faces;
-  gmsh::model::getEntities(faces, 2);
-  for (const auto& [dim, tag] : faces) {
-    std::vector<double> lo, hi;
-    gmsh::model::getParametrizationBounds(2, tag, lo, hi);
-    std::vector<std::size_t> tags;
-    std::vector<double> xyz, uv;
-    gmsh::model::mesh::getNodes(tags, xyz, uv, 2, tag, false, true);
-    for (std::size_t i = 0; i < tags.size(); i += stride)
-      for (int attempt = 0; attempt < 20; ++attempt) {
-        const std::vector<double> p{uv[2 * i] + 0.03 * (hi[0] - lo[0]) * U(rng),
-                                    uv[2 * i + 1] + 0.03 * (hi[1] - lo[1]) * U(rng)};
-        if (p[0] <= lo[0] || p[0] >= hi[0] || p[1] <= lo[1] || p[1] >= hi[1]) continue;
-        if (gmsh::model::isInside(2, tag, p) == 0) continue;
-        std::vector<double> x;
-        gmsh::model::getValue(2, tag, p, x);
-        gmsh::model::mesh::setNode(tags[i], x, p);
-        break;
-      }
-  }
-}
-
-}  // namespace
 
 int main(int argc, char** argv) {
   const double size = argc > 1 ? std::atof(argv[1]) : 0.12;
@@ -69,7 +29,7 @@ int main(int argc, char** argv) {
     return 1;
   }
   meshopt::gmsh_io::Session session;
-  make_model();
+  cad_fixtures::add_torus_pipe();
   if (!dir.empty()) {
     gmsh::write(dir + "/model.brep");
     gmsh::clear();
@@ -77,7 +37,7 @@ int main(int argc, char** argv) {
   }
   gmsh::option::setNumber("Mesh.MeshSizeMax", size);
   meshopt::gmsh_io::generate_surface_mesh();
-  tangle(stride, 7);
+  cad_fixtures::tangle(stride, 0.03, 7);
   if (!dir.empty()) {
     gmsh::option::setNumber("Mesh.SaveParametric", 1);
     gmsh::write(dir + "/tangled.msh");

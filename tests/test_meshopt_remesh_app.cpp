@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "meshopt/gmsh/gmsh_mesh.h"
+#include "cad_fixtures.h"
 #include "test_support.h"
 
 namespace fs = std::filesystem;
@@ -22,16 +23,10 @@ test_support::AppRun run_meshopt(const std::string& args, const fs::path& dir) {
   return test_support::run_app(args, dir, MESHOPT_APP_PATH);
 }
 
-/// A cylinder (r 0.5, height 2) with a sphere (r 0.8) fused on top, as BRep.
+/// The fused cylinder and sphere of cad_fixtures, as BRep.
 void write_model(const fs::path& brep) {
   meshopt::gmsh_io::Session session;
-  gmsh::model::add("cylinder_sphere");
-  gmsh::model::occ::addCylinder(0, 0, 0, 0, 0, 2, 0.5, 1);
-  gmsh::model::occ::addSphere(0, 0, 2, 0.8, 2);
-  gmsh::vectorpair out;
-  std::vector<gmsh::vectorpair> map;
-  gmsh::model::occ::fuse({{3, 1}}, {{3, 2}}, out, map);
-  gmsh::model::occ::synchronize();
+  cad_fixtures::add_cylinder_sphere();
   gmsh::write(brep.string());
 }
 

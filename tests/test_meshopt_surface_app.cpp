@@ -8,12 +8,12 @@
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
-#include <random>
 #include <string>
 #include <vector>
 
 #include "meshopt/gmsh/gmsh_mesh.h"
 #include "meshopt/surface_smoother.h"
+#include "cad_fixtures.h"
 #include "test_support.h"
 
 #if defined(__SANITIZE_ADDRESS__)
@@ -38,50 +38,16 @@ test_support::AppRun run_meshopt(const std::string& args, const fs::path& dir) {
   return test_support::run_app(args, dir, MESHOPT_APP_PATH);
 }
 
-/// Writes the fused cylinder (r 0.5, height 2) and sphere (r 0.8 at the top) as a
-/// BRep file and reopens it, so that its surface tags are those a reader of the
-/// file sees. \pre a gmsh_io::Session is alive.
+/// Writes the fused cylinder and sphere as a BRep file and reopens it, so that
+/// its surface tags are those a reader of the file sees. \pre a gmsh_io::Session is alive.
 void make_model(const fs::path& brep) {
-  gmsh::model::add("cylinder_sphere");
-  gmsh::model::occ::addCylinder(0, 0, 0, 0, 0, 2, 0.5, 1);
-  gmsh::model::occ::addSphere(0, 0, 2, 0.8, 2);
-  gmsh::vectorpair out;
-  std::vector<gmsh::vectorpair> map;
-  gmsh::model::occ::fuse({{3, 1}}, {{3, 2}}, out, map);
-  gmsh::model::occ::synchronize();
+  cad_fixtures::add_cylinder_sphere();
   gmsh::write(brep.string());
   gmsh::clear();
   gmsh_io::open_model(brep.string());
 }
 
-/// Moves every `stride`-th node inside each surface by a random parametric
-/// offset of up to `amount` times the face's parametric extent, keeping it inside
-/// the face (and the node's position on the surface).
-void tangle(int stride, double amount, unsigned seed) {
-  std::mt19937_64 rng(seed);
-  std::uniform_real_distribution<double> U(-1.0, 1.0);
-  gmsh::vectorpair faces;
-  gmsh::model::getEntities(faces, 2);
-  for (const auto& [dim, tag] : faces) {
-    std::vector<double> lo, hi;
-    gmsh::model::getParametrizationBounds(2, tag, lo, hi);
-    std::vector<std::size_t> tags;
-    std::vector<double> xyz, uv;
-    gmsh::model::mesh::getNodes(tags, xyz, uv, 2, tag, false, true);
-    for (std::size_t i = 0; i < tags.size(); i += stride) {
-      for (int attempt = 0; attempt < 20; ++attempt) {
-        const std::vector<double> p{uv[2 * i] + amount * (hi[0] - lo[0]) * U(rng),
-                                    uv[2 * i + 1] + amount * (hi[1] - lo[1]) * U(rng)};
-        if (p[0] <= lo[0] || p[0] >= hi[0] || p[1] <= lo[1] || p[1] >= hi[1]) continue;
-        if (gmsh::model::isInside(2, tag, p) == 0) continue;
-        std::vector<double> x;
-        gmsh::model::getValue(2, tag, p, x);
-        gmsh::model::mesh::setNode(tags[i], x, p);
-        break;
-      }
-    }
-  }
-}
+using cad_fixtures::tangle;
 
 std::size_t tangled_elements() {
   const gmsh_io::GmshSurfaceMesh g = gmsh_io::read_surface_mesh();

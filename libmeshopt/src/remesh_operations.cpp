@@ -321,6 +321,9 @@ bool Remesher::move_vertex(int v, const Eigen::Vector3d& target) {
     was_inverted.push_back(inverted(m_.triangles[t].v, m_.triangles[t].patch));
     old_min = std::min(old_min, min_angle(t));
   }
+  const std::vector<int> around = m_.neighbours(v);
+  std::vector<double> old_length;
+  for (int w : around) old_length.push_back(length(v, w));
   RemeshVertex nv = old;
   if (old.kind == VertexKind::curve) {
     nv.on = g_.project_to_curve(old.on.entity, target);
@@ -331,10 +334,13 @@ bool Remesher::move_vertex(int v, const Eigen::Vector3d& target) {
   if (!nv.x.allFinite()) return false;
   for (auto& [p, n] : nv.normals) n = g_.patch_normal(p, nv.kind, nv.on);
   vv = nv;
-  // Accepted if no triangle of the star becomes inverted and its smallest 6D
-  // angle stays above min(before, theta_min).
+  // Accepted if no triangle of the star becomes inverted, its smallest 6D angle
+  // stays above min(before, theta_min) and no edge grows beyond 1.5 L (which
+  // only the next sampling would split again).
   double new_min = 10.0;
   bool ok = true;
+  for (std::size_t k = 0; k < around.size() && ok; ++k)
+    ok = length(v, around[k]) <= std::max(1.5 * o_.length, old_length[k]);
   for (std::size_t k = 0; k < star.size() && ok; ++k) {
     const RemeshTriangle& tr = m_.triangles[star[k]];
     if (!was_inverted[k] && inverted(tr.v, tr.patch)) ok = false;
