@@ -132,6 +132,7 @@ int Remesher::split(int a, int b) {
   for (int t : ts) {
     const int p = m_.triangles[t].patch;
     if (nv.normal(p).isZero()) nv.normals.emplace_back(p, g_.patch_normal(p, nv.kind, nv.on));
+    if (!nv.normals.back().second.allFinite() || nv.normals.back().second.isZero()) return -1;
   }
   const int c = m_.add_vertex(nv);
   // The two halves of each triangle; refused if one is inverted and the triangle was not.
@@ -332,7 +333,10 @@ bool Remesher::move_vertex(int v, const Eigen::Vector3d& target) {
   }
   nv.x = nv.on.x;
   if (!nv.x.allFinite()) return false;
-  for (auto& [p, n] : nv.normals) n = g_.patch_normal(p, nv.kind, nv.on);
+  for (auto& [p, n] : nv.normals) {
+    n = g_.patch_normal(p, nv.kind, nv.on);
+    if (!n.allFinite() || n.isZero()) return false;  // the model could not be evaluated there
+  }
   vv = nv;
   // Accepted if no triangle of the star becomes inverted, its smallest 6D angle
   // stays above min(before, theta_min) and no edge grows beyond 1.5 L (which

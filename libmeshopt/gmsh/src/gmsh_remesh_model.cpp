@@ -29,11 +29,19 @@ Eigen::Vector3d vec3(const std::vector<double>& v, std::size_t i = 0) { return {
 /// The closest point of entity (dim, tag) to x and its parametric coordinates.
 /// (Gmsh 4.8's getClosestPoint leaves the parametric coordinates unset for OCC
 /// entities: they come from getParametrization of the closest point.)
+/// Not-a-number point and parameters where Gmsh fails (its inverse mapping may
+/// not converge far from the entity): callers then skip the candidate or
+/// reject the operation.
 std::pair<Eigen::Vector3d, Eigen::Vector2d> closest_point(int dim, int tag, const Eigen::Vector3d& x) {
   std::vector<double> c, p;
-  gmsh::model::getClosestPoint(dim, tag, {x.x(), x.y(), x.z()}, c, p);
-  gmsh::model::getParametrization(dim, tag, c, p);
-  return {vec3(c), Eigen::Vector2d(p.at(0), dim == 2 ? p.at(1) : 0.0)};
+  try {
+    gmsh::model::getClosestPoint(dim, tag, {x.x(), x.y(), x.z()}, c, p);
+    gmsh::model::getParametrization(dim, tag, c, p);
+    return {vec3(c), Eigen::Vector2d(p.at(0), dim == 2 ? p.at(1) : 0.0)};
+  } catch (...) {
+    const double nan = std::numeric_limits<double>::quiet_NaN();
+    return {Eigen::Vector3d::Constant(nan), Eigen::Vector2d::Constant(nan)};
+  }
 }
 
 /// (u, v) on `face` of point x = the point `tag` (dim 0) or curve `tag` at t
@@ -235,10 +243,10 @@ GeometryPoint GmshRemeshGeometry::project_to_patch(int patch, const Eigen::Vecto
   std::vector<std::pair<double, GeometryPoint>> found;
   for (int face : cand) {
     const auto [y, uv] = closest_point(2, face, x);
-    found.push_back({(y - x).norm(), GeometryPoint{y, face, uv}});
+    if (y.allFinite()) found.push_back({(y - x).norm(), GeometryPoint{y, face, uv}});
   }
   std::sort(found.begin(), found.end(), [](const auto& p, const auto& q) { return p.first < q.first; });
-  GeometryPoint best;
+  GeometryPoint best{Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN()), -1, Eigen::Vector2d::Zero()};
   double best_d = kInf;
   for (const auto& [d, p] : found)
     if (hint.proves_inside(p.entity, p.param, 0.5 * (face(p.entity).upper() - face(p.entity).lower()),
