@@ -12,6 +12,7 @@
 
 #include "meshopt/gmsh/gmsh_mesh.h"
 #include "cad_fixtures.h"
+#include "meshopt_app_support.h"
 #include "test_support.h"
 
 namespace fs = std::filesystem;
@@ -19,9 +20,7 @@ using test_support::contains;
 
 namespace {
 
-test_support::AppRun run_meshopt(const std::string& args, const fs::path& dir) {
-  return test_support::run_app(args, dir, MESHOPT_APP_PATH);
-}
+using meshopt_app_test::run_meshopt;
 
 /// The fused cylinder and sphere of cad_fixtures, as BRep.
 void write_model(const fs::path& brep) {
@@ -96,10 +95,7 @@ TEST_CASE("meshopt remesh: bad input gives one clear error and exit 1, unwritabl
   std::ofstream(dir / "garbage.step") << "not a STEP file\n";
   const std::string model = std::string("'") + (dir / "model.brep").string() + "'";
   const std::string out = " --out '" + (dir / "o.msh").string() + "' --quiet";
-  struct Case {
-    std::string args, message;
-  };
-  const std::vector<Case> cases = {
+  const std::vector<meshopt_app_test::BadInput> cases = {
       {"remesh '" + (dir / "missing.step").string() + "' --length 0.1" + out, "cannot read the model"},
       {"remesh '" + (dir / "garbage.step").string() + "' --length 0.1" + out, "cannot load the model"},
       {"remesh " + model + " --length -1" + out, "--length must be positive"},
@@ -109,15 +105,7 @@ TEST_CASE("meshopt remesh: bad input gives one clear error and exit 1, unwritabl
       {"remesh " + model + " --length 0.1 --mesh '" + (dir / "missing.msh").string() + "'" + out,
        "cannot read the mesh"},
   };
-  for (const Case& c : cases) {
-    CAPTURE(c.args);
-    const auto r = run_meshopt(c.args, dir);
-    CAPTURE(r.err);
-    CHECK(r.exit_code == 1);
-    CHECK(contains(r.err, c.message));
-    CHECK(test_support::count_lines(r.err) == 1);
-    CHECK(!fs::exists(dir / "o.msh"));
-  }
+  meshopt_app_test::check_bad_inputs(cases, dir, dir / "o.msh");
   std::ofstream(dir / "file") << "x";
   const auto r = run_meshopt("remesh " + model + " --length 0.3 --out '" + (dir / "file/o.msh").string() + "' --quiet", dir);
   CAPTURE(r.err);

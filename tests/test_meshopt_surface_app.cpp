@@ -14,6 +14,7 @@
 #include "meshopt/gmsh/gmsh_mesh.h"
 #include "meshopt/surface_smoother.h"
 #include "cad_fixtures.h"
+#include "meshopt_app_support.h"
 #include "test_support.h"
 
 #if defined(__SANITIZE_ADDRESS__)
@@ -34,9 +35,7 @@ using test_support::contains;
 
 namespace {
 
-test_support::AppRun run_meshopt(const std::string& args, const fs::path& dir) {
-  return test_support::run_app(args, dir, MESHOPT_APP_PATH);
-}
+using meshopt_app_test::run_meshopt;
 
 /// Writes the fused cylinder and sphere as a BRep file and reopens it, so that
 /// its surface tags are those a reader of the file sees. \pre a gmsh_io::Session is alive.
@@ -165,10 +164,7 @@ TEST_CASE("meshopt smooth: bad input gives one clear error and exit 1") {
   }
   std::ofstream(dir / "garbage.step") << "not a STEP file\n";
   const std::string model = std::string("'") + (dir / "model.brep").string() + "'";
-  struct Case {
-    std::string args, message;
-  };
-  const std::vector<Case> cases = {
+  const std::vector<meshopt_app_test::BadInput> cases = {
       {std::string("smooth '") + (dir / "missing.step").string() + "'" + out, "cannot read the model"},
       {std::string("smooth '") + (dir / "garbage.step").string() + "'" + out, "cannot load the model"},
       {std::string("smooth ") + model + " --mesh '" + (dir / "no_parametric.msh").string() + "'" + out,
@@ -182,13 +178,5 @@ TEST_CASE("meshopt smooth: bad input gives one clear error and exit 1") {
       {std::string("smooth ") + model + " --measure angle" + out, "--measure must be shape, size or size-shape"},
       {std::string("smooth ") + model + " --measure size --size 'x+' " + out, "--size: cannot parse"},
   };
-  for (const Case& c : cases) {
-    CAPTURE(c.args);
-    const auto r = run_meshopt(c.args, dir);
-    CAPTURE(r.err);
-    CHECK(r.exit_code == 1);
-    CHECK(contains(r.err, c.message));
-    CHECK(test_support::count_lines(r.err) == 1);
-    CHECK(!fs::exists(dir / "o.msh"));
-  }
+  meshopt_app_test::check_bad_inputs(cases, dir, dir / "o.msh");
 }
