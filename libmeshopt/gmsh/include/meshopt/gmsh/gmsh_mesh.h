@@ -63,4 +63,8 @@ GmshSurfaceMesh read_surface_mesh();
 /// (temporary file next to `path`, then rename). \throw IoError.
 void write_mesh(const std::string& path, const GmshSurfaceMesh& m);
 
+/// Writes the current model's mesh as MSH 4.1 with parametric coordinates,
+/// atomically (temporary file next to `path`, then rename). \throw IoError.
+void write_current_mesh(const std::string& path);
+
 }  // namespace meshopt::gmsh_io
