@@ -19,6 +19,7 @@
 
 #include "exit_codes.h"
 #include "expression.h"
+#include "meshopt_commands.h"
 #include "meshopt/gmsh/gmsh_mesh.h"
 #include "meshopt/surface_smoother.h"
 #include "toolkit/errors.h"
@@ -173,12 +174,29 @@ int main(int argc, char** argv) {
   smooth->add_option("--max-sweeps", a.max_sweeps, "at most this many sweeps (default 1000)");
   smooth->add_option("--tol", a.tol, "tolerance of the relative move and objective change (default 1e-3)");
   smooth->add_flag("--quiet", a.quiet, "no per-sweep progress");
+  meshopt_app::RemeshArgs r;
+  CLI::App* remesh =
+      app.add_subcommand("remesh", "curvature-adapted anisotropic remeshing in the R^6 embedding (Dassi et al. 2014)");
+  remesh->add_option("MODEL", r.model, "CAD model: STEP, IGES, BRep or Gmsh .geo")->required();
+  remesh->add_option("--out", r.out, "output mesh (.msh, MSH 4.1, nodes on their CAD entities)")->required();
+  remesh->add_option("--length", r.length, "target edge length L in R^6")->required();
+  remesh->add_option("--anisotropy", r.anisotropy, "s in (x, s n) (default 5 L; 0: isotropic)");
+  remesh->add_option("--mesh", r.mesh, "initial mesh of MODEL with parametric coordinates (default: Gmsh meshes it)");
+  remesh->add_option("--feature-angle", r.feature_angle,
+                     "CAD curves with a larger dihedral angle stay edge chains (degrees, default 30)");
+  remesh->add_option("--min-angle", r.min_angle, "theta_min: collapse triangles with a smaller 6D angle (default 20)");
+  remesh->add_option("--rounds", r.rounds, "K: rounds of sampling and optimizing (default 3)");
+  remesh->add_option("--vtu", r.vtu, "ParaView file with aspect ratio, 6D length / L and curvature alignment");
+  remesh->add_option("--report", r.report, "JSON report (default: OUT with extension .json)");
+  remesh->add_flag("--json", r.json, "machine-readable progress and result on stdout (NDJSON)");
+  remesh->add_flag("--quiet", r.quiet, "no progress or summary");
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     return app.exit(e) == 0 ? 0 : 1;
   }
   try {
+    if (remesh->parsed()) return meshopt_app::run_remesh(r);
     return run_smooth(a);
   } catch (...) {
     return tspline_app::report_current_exception("meshopt");

@@ -8,12 +8,13 @@
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
-#include <random>
 #include <string>
 #include <vector>
 
 #include "meshopt/gmsh/gmsh_mesh.h"
 #include "meshopt/surface_smoother.h"
+#include "cad_fixtures.h"
+#include "meshopt_app_support.h"
 #include "test_support.h"
 
 #if defined(__SANITIZE_ADDRESS__)
@@ -34,54 +35,18 @@ using test_support::contains;
 
 namespace {
 
-test_support::AppRun run_meshopt(const std::string& args, const fs::path& dir) {
-  return test_support::run_app(args, dir, MESHOPT_APP_PATH);
-}
+using meshopt_app_test::run_meshopt;
 
-/// Writes the fused cylinder (r 0.5, height 2) and sphere (r 0.8 at the top) as a
-/// BRep file and reopens it, so that its surface tags are those a reader of the
-/// file sees. \pre a gmsh_io::Session is alive.
+/// Writes the fused cylinder and sphere as a BRep file and reopens it, so that
+/// its surface tags are those a reader of the file sees. \pre a gmsh_io::Session is alive.
 void make_model(const fs::path& brep) {
-  gmsh::model::add("cylinder_sphere");
-  gmsh::model::occ::addCylinder(0, 0, 0, 0, 0, 2, 0.5, 1);
-  gmsh::model::occ::addSphere(0, 0, 2, 0.8, 2);
-  gmsh::vectorpair out;
-  std::vector<gmsh::vectorpair> map;
-  gmsh::model::occ::fuse({{3, 1}}, {{3, 2}}, out, map);
-  gmsh::model::occ::synchronize();
+  cad_fixtures::add_cylinder_sphere();
   gmsh::write(brep.string());
   gmsh::clear();
   gmsh_io::open_model(brep.string());
 }
 
-/// Moves every `stride`-th node inside each surface by a random parametric
-/// offset of up to `amount` times the face's parametric extent, keeping it inside
-/// the face (and the node's position on the surface).
-void tangle(int stride, double amount, unsigned seed) {
-  std::mt19937_64 rng(seed);
-  std::uniform_real_distribution<double> U(-1.0, 1.0);
-  gmsh::vectorpair faces;
-  gmsh::model::getEntities(faces, 2);
-  for (const auto& [dim, tag] : faces) {
-    std::vector<double> lo, hi;
-    gmsh::model::getParametrizationBounds(2, tag, lo, hi);
-    std::vector<std::size_t> tags;
-    std::vector<double> xyz, uv;
-    gmsh::model::mesh::getNodes(tags, xyz, uv, 2, tag, false, true);
-    for (std::size_t i = 0; i < tags.size(); i += stride) {
-      for (int attempt = 0; attempt < 20; ++attempt) {
-        const std::vector<double> p{uv[2 * i] + amount * (hi[0] - lo[0]) * U(rng),
-                                    uv[2 * i + 1] + amount * (hi[1] - lo[1]) * U(rng)};
-        if (p[0] <= lo[0] || p[0] >= hi[0] || p[1] <= lo[1] || p[1] >= hi[1]) continue;
-        if (gmsh::model::isInside(2, tag, p) == 0) continue;
-        std::vector<double> x;
-        gmsh::model::getValue(2, tag, p, x);
-        gmsh::model::mesh::setNode(tags[i], x, p);
-        break;
-      }
-    }
-  }
-}
+using cad_fixtures::tangle;
 
 std::size_t tangled_elements() {
   const gmsh_io::GmshSurfaceMesh g = gmsh_io::read_surface_mesh();
@@ -150,6 +115,29 @@ TEST_CASE("meshopt smooth: bad input gives one clear error and exit 1") {
     REQUIRE(!tags.empty());
     gmsh::model::mesh::setNode(tags[0], {xyz[0], xyz[1], xyz[2]}, {hi[0] + 1.0, uv[1]});
     write_msh(dir / "outside.msh", true);
+    gmsh::model::mesh::setNode(tags[0], {xyz[0], xyz[1], xyz[2]}, {uv[0], uv[1]});
+    // A node moved into a trimmed-away part of a face (inside its parameter box):
+    // the sphere, cut where the cylinder enters it.
+    bool trimmed = false;
+    gmsh::vectorpair faces;
+    gmsh::model::getEntities(faces, 2);
+    for (const auto& [d, f] : faces) {
+      std::vector<std::size_t> ft;
+      std::vector<double> fx, fuv, flo, fhi;
+      gmsh::model::mesh::getNodes(ft, fx, fuv, 2, f, false, true);
+      gmsh::model::getParametrizationBounds(2, f, flo, fhi);
+      for (int i = 1; i < 20 && !trimmed && !ft.empty(); ++i)
+        for (int j = 1; j < 20 && !trimmed; ++j) {
+          const std::vector<double> p{flo[0] + (fhi[0] - flo[0]) * i / 20.0, flo[1] + (fhi[1] - flo[1]) * j / 20.0};
+          if (gmsh::model::isInside(2, f, p) != 0) continue;
+          std::vector<double> x;
+          gmsh::model::getValue(2, f, p, x);
+          gmsh::model::mesh::setNode(ft[0], x, p);
+          trimmed = true;
+        }
+    }
+    REQUIRE(trimmed);
+    write_msh(dir / "trimmed.msh", true);
   }
   {
     // A sphere with a node inside it moved onto its pole (phi_u = 0 there).
@@ -176,28 +164,19 @@ TEST_CASE("meshopt smooth: bad input gives one clear error and exit 1") {
   }
   std::ofstream(dir / "garbage.step") << "not a STEP file\n";
   const std::string model = std::string("'") + (dir / "model.brep").string() + "'";
-  struct Case {
-    std::string args, message;
-  };
-  const std::vector<Case> cases = {
+  const std::vector<meshopt_app_test::BadInput> cases = {
       {std::string("smooth '") + (dir / "missing.step").string() + "'" + out, "cannot read the model"},
       {std::string("smooth '") + (dir / "garbage.step").string() + "'" + out, "cannot load the model"},
       {std::string("smooth ") + model + " --mesh '" + (dir / "no_parametric.msh").string() + "'" + out,
        "no parametric coordinates for the nodes inside surface"},
       {std::string("smooth ") + model + " --mesh '" + (dir / "outside.msh").string() + "'" + out,
        "is outside the surface's parameter range"},
+      {std::string("smooth ") + model + " --mesh '" + (dir / "trimmed.msh").string() + "'" + out,
+       "lies outside the trimmed face"},
       {std::string("smooth '") + (dir / "sphere.brep").string() + "' --mesh '" + (dir / "pole.msh").string() + "'" + out,
        "lies at a degenerate point of the surface"},
       {std::string("smooth ") + model + " --measure angle" + out, "--measure must be shape, size or size-shape"},
       {std::string("smooth ") + model + " --measure size --size 'x+' " + out, "--size: cannot parse"},
   };
-  for (const Case& c : cases) {
-    CAPTURE(c.args);
-    const auto r = run_meshopt(c.args, dir);
-    CAPTURE(r.err);
-    CHECK(r.exit_code == 1);
-    CHECK(contains(r.err, c.message));
-    CHECK(test_support::count_lines(r.err) == 1);
-    CHECK(!fs::exists(dir / "o.msh"));
-  }
+  meshopt_app_test::check_bad_inputs(cases, dir, dir / "o.msh");
 }

@@ -41,7 +41,7 @@ std::vector<CornerTriangle> corner_triangles(int nv, double h) {
   return out;
 }
 
-void validate_surface_mesh(const SurfaceMesh& m) {
+void validate_surface_mesh(const SurfaceMesh& m, bool exact_domain) {
   const std::size_t n = m.x.size();
   if (m.u.size() != n || m.free_face.size() != n) fail("x, u and free_face must have one entry per node");
   if (!m.corner_uv.empty() && m.corner_uv.size() != 4 * m.elements.size())
@@ -61,8 +61,11 @@ void validate_surface_mesh(const SurfaceMesh& m) {
     if (unit_normal(p).isZero())
       fail("node " + std::to_string(i) + " lies at a degenerate point of face " + std::to_string(f) + " (u = " +
            uv_string(m.u[i]) + ", phi_u x phi_v = 0)");
-    if (!s.contains_exactly(m.u[i]))
+    if (!s.contains(m.u[i]))
       fail("node " + std::to_string(i) + " at u = " + uv_string(m.u[i]) + " is outside the parameter range of face " +
+           std::to_string(f));
+    if (exact_domain && !s.contains_exactly(m.u[i]))
+      fail("node " + std::to_string(i) + " at u = " + uv_string(m.u[i]) + " lies outside the trimmed face " +
            std::to_string(f));
     const double scale = std::max({1.0, p.x.norm(), m.x[i].norm()});
     if (!((p.x - m.x[i]).norm() <= 1e-6 * scale))

@@ -3,10 +3,12 @@
 
 #include <Eigen/Eigenvalues>
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <string>
 
+#include "meshopt/parametric_star.h"
 #include "meshopt/surface_objective.h"
 #include "meshopt/triangle_measure.h"
 #include "newton_descent.h"
@@ -109,6 +111,35 @@ double global_objective(const SurfaceMesh& m, const std::vector<Eigen::Vector3d>
   return F;
 }
 
+// Whether a free node may move to uv point `un` of its face. The exact test of a
+// trimmed face (gmsh::model::isInside, 10-100 us per call on OCC faces) is
+// skipped when `un` lies in one of the node's elements in parameter space and is
+// not near one of their edges between two fixed nodes. Such an element has its
+// corners in the face, and the face's trimming curves pass through the mesh
+// only along chains of edges between fixed nodes, from which they deviate by a
+// sagitta: within kTrimmingMargin of such an edge isInside decides.
+bool may_move_to(const SurfaceMesh& m, const std::vector<Corner>& corners, const ParametricSurface& surface,
+                 const Eigen::Vector2d& un) {
+  if (!surface.contains(un)) return false;
+  bool in_star = false;
+  std::array<Eigen::Vector2d, 4> uv;
+  for (const Corner& c : corners) {
+    const SurfaceElement& el = m.elements[c.element];
+    for (int k = 0; k < el.nv; ++k) {
+      const int v = el.v[k];
+      uv[k] = m.free_face[v] >= 0 || m.corner_uv.empty() ? m.u[v] : m.corner_uv[4 * static_cast<std::size_t>(c.element) + k];
+    }
+    for (int k = 0; k < el.nv; ++k) {
+      const int l = (k + 1) % el.nv;
+      if (m.free_face[el.v[k]] < 0 && m.free_face[el.v[l]] < 0 &&
+          segment_distance(un, uv[k], uv[l]) < kTrimmingMargin * (uv[l] - uv[k]).norm())
+        return surface.contains_exactly(un);
+    }
+    for (int k = 1; k + 1 < el.nv && !in_star; ++k) in_star = in_triangle(un, uv[0], uv[k], uv[k + 1]);
+  }
+  return in_star || surface.contains_exactly(un);
+}
+
 void validate_surface_options(const SurfaceSmoothingOptions& o) {
   detail::validate_options(o.newton);
   auto bad = [](const std::string& what) { throw toolkit::InputError("meshopt::smooth_surface: " + what); };
@@ -120,7 +151,7 @@ void validate_surface_options(const SurfaceSmoothingOptions& o) {
 }  // namespace
 
 ElementQualities surface_mesh_quality(const SurfaceMesh& mesh, SurfaceMeasure measure, const SizeField& size) {
-  validate_surface_mesh(mesh);
+  validate_surface_mesh(mesh, false);  // measuring needs no trimmed-face test
   const std::vector<Eigen::Vector3d> normals = corner_normals(mesh);
   const std::vector<double> h = node_sizes(mesh, size);
   return element_qualities(mesh, normals, measure, h);
@@ -138,11 +169,21 @@ SurfaceSmoothingReport smooth_surface(SurfaceMesh& m, const SurfaceSmoothingOpti
   double F = global_objective(m, normals, opt.measure, node_size);
   detail::Counters cnt;
   std::vector<SurfaceTerm> terms;
+  // Active nodes: a node is visited again only if it or a neighbour moved by more
+  // than tol_x / 10 (relative) at their last visit, or its submesh is tangled.
+  std::vector<char> active(m.x.size(), 1);
+  auto activate_star = [&](std::size_t i) {
+    for (const Corner& c : corners[i])
+      for (int k = 0; k < m.elements[c.element].nv; ++k) active[m.elements[c.element].v[k]] = 1;
+  };
   for (int sweep = 0; sweep < opt.max_sweeps; ++sweep) {
     double r_x = 0.0;
+    std::size_t visited = 0;
     for (std::size_t i = 0; i < m.x.size(); ++i) {
       const int face = m.free_face[i];
-      if (face < 0 || corners[i].empty()) continue;
+      if (face < 0 || corners[i].empty() || !active[i]) continue;
+      active[i] = 0;
+      ++visited;
       const ParametricSurface& surface = *m.faces[face];
       const double max_edge = build_terms(m, corners[i], normals, node_size, terms);
       if (terms.empty() || !(max_edge > 0.0)) continue;
@@ -156,6 +197,7 @@ SurfaceSmoothingReport smooth_surface(SurfaceMesh& m, const SurfaceSmoothingOpti
                                            .maxCoeff());
       if (!(stretch > 0.0) || !std::isfinite(stretch)) continue;
       const SurfaceNodeObjective obj{surface, terms, opt.measure};
+      if (!(obj.min_sigma(m.u[i]) > 0.0)) active[i] = 1;  // tangled: keep visiting
       Eigen::Vector2d un = detail::newton_descent(m.u[i], obj, opt.newton, max_edge / stretch, cnt);
       // Nonlinear over-relaxation (as in smooth()): taken only if the submesh stays
       // valid and the node inside its face there.
@@ -163,11 +205,13 @@ SurfaceSmoothingReport smooth_surface(SurfaceMesh& m, const SurfaceSmoothingOpti
         const Eigen::Vector2d ur = m.u[i] + opt.newton.over_relaxation * (un - m.u[i]);
         if (obj.min_sigma(un) > 0.0 && obj.min_sigma(ur) > 0.0) un = ur;
       }
-      if (un == m.u[i] || !surface.contains_exactly(un)) continue;
+      if (un == m.u[i] || !may_move_to(m, corners[i], surface, un)) continue;
       const SurfacePoint q = surface.evaluate(un, 1);
       const Eigen::Vector3d n = unit_normal(q);
       if (n.isZero()) continue;  // never move a node onto a degenerate point
-      r_x = std::max(r_x, (q.x - m.x[i]).norm() / max_edge);
+      const double move = (q.x - m.x[i]).norm() / max_edge;
+      r_x = std::max(r_x, move);
+      if (move >= 0.1 * opt.tol_x) activate_star(i);
       m.u[i] = un;
       m.x[i] = q.x;
       for (const Corner& c : corners[i]) normals[4 * static_cast<std::size_t>(c.element) + c.local] = n;
@@ -186,7 +230,7 @@ SurfaceSmoothingReport smooth_surface(SurfaceMesh& m, const SurfaceSmoothingOpti
     rep.last_relative_objective = r_f;
     if (opt.progress)
       opt.progress(sweep, r_x, r_f, element_qualities(m, normals, opt.measure, node_size).tangled);
-    if (r_x < opt.tol_x && r_f < opt.tol_f) {
+    if ((r_x < opt.tol_x && r_f < opt.tol_f) || visited == 0) {
       rep.converged = true;
       break;
     }

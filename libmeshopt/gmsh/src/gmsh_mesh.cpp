@@ -12,37 +12,33 @@
 
 #include <Eigen/Geometry>
 
+#include "gmsh_util.h"
+
 namespace meshopt::gmsh_io {
 namespace fs = std::filesystem;
-using toolkit::InputError;
-using toolkit::IoError;
 
 namespace {
 
-/// Concatenates with operator<< (avoids GCC 12's false -Wrestrict on "literal" + std::string).
-template <class... T>
-std::string cat(const T&... parts) {
-  std::ostringstream s;
-  (s << ... << parts);
-  return s.str();
-}
-
-/// The message of the exception being handled: Gmsh 4.8 throws std::string
-/// (and sometimes int) besides std::exception.
-std::string gmsh_error() {
+/// Mesh node of node tag `nt`, which is used by an element of face `face` but not
+/// classified on that face or its boundary; records its parametric coordinates
+/// on `face` (closest point) in `uv_of`. \throw InputError if it is far from the face.
+template <class NodeIndex>
+int foreign_node(std::size_t nt, int face, NodeIndex& node_index,
+                 std::unordered_map<std::size_t, Eigen::Vector2d>& uv_of) {
+  std::vector<double> xyz, param, closest, uv;
   try {
-    throw;
-  } catch (const std::exception& e) {
-    return e.what();
-  } catch (const std::string& s) {
-    return s;
-  } catch (const char* s) {
-    return s;
-  } catch (int code) {
-    return cat("Gmsh error code ", code);
+    gmsh::model::mesh::getNode(nt, xyz, param);
+    gmsh::model::getClosestPoint(2, face, xyz, closest, uv);
+    gmsh::model::getParametrization(2, face, closest, uv);  // getClosestPoint leaves uv unset (OCC, Gmsh 4.8)
   } catch (...) {
-    return "unknown Gmsh error";
+    throw InputError(cat("element node ", nt, " of surface ", face, ": ", gmsh_error()));
   }
+  const Eigen::Vector3d x(xyz.at(0), xyz.at(1), xyz.at(2)), c(closest.at(0), closest.at(1), closest.at(2));
+  if (!((x - c).norm() <= 1e-6 * std::max(1.0, x.norm())))
+    throw InputError(cat("element node ", nt, " of surface ", face, " is not on that surface (", (x - c).norm(),
+                         " away)"));
+  uv_of[nt] = Eigen::Vector2d(uv.at(0), uv.at(1));
+  return node_index(nt, xyz.data());
 }
 
 void require_readable(const std::string& path, const char* what) {
@@ -124,6 +120,7 @@ GmshSurfaceMesh read_surface_mesh() {
     }
     return it->second;
   };
+  std::vector<int> foreign;  // nodes used by elements of a face they are not on
   gmsh::vectorpair faces;
   gmsh::model::getEntities(faces, 2);
   for (const auto& [dim, tag] : faces) {
@@ -167,9 +164,11 @@ GmshSurfaceMesh read_surface_mesh() {
       const SurfacePoint p = face.evaluate(m.u[n], 1);
       if (unit_normal(p).isZero())
         throw InputError(cat(where, " lies at a degenerate point of the surface (phi_u x phi_v = 0)"));
-      if (!face.contains_exactly(m.u[n]))
+      if (!face.contains(m.u[n]))
         throw InputError(cat(where, " is outside the surface's parameter range [", face.lower().x(), ", ",
                              face.upper().x(), "] x [", face.lower().y(), ", ", face.upper().y(), "]"));
+      if (!face.contains_exactly(m.u[n]))
+        throw InputError(cat(where, " lies outside the trimmed face (in a trimmed-away part of its parameter range)"));
       const double scale = std::max(1.0, p.x.norm());
       if (!((p.x - m.x[n]).norm() <= 1e-6 * scale))
         throw InputError(cat(where, ": the surface at these parametric coordinates is ", (p.x - m.x[n]).norm(),
@@ -185,9 +184,15 @@ GmshSurfaceMesh read_surface_mesh() {
         for (int i = 0; i < nv; ++i) {
           const std::size_t nt = elem_nodes[k][nv * e + i];
           const auto xt = xyz_of.find(nt);
-          if (xt == xyz_of.end())
-            throw InputError(cat("element node ", nt, " of surface ", tag, " is not a node of that surface"));
-          el.v[i] = node_index(nt, &xyz[3 * xt->second]);
+          if (xt != xyz_of.end()) {
+            el.v[i] = node_index(nt, &xyz[3 * xt->second]);
+          } else {
+            // A node classified on another entity (a remeshed element across a
+            // smooth junction between faces): fixed, with its parametric
+            // coordinates on this face from the closest point.
+            el.v[i] = foreign_node(nt, tag, node_index, uv_of);
+            foreign.push_back(el.v[i]);
+          }
           const auto it = uv_of.find(nt);
           if (it == uv_of.end())
             throw InputError(cat("node ", nt, " of surface ", tag, " has no parametric coordinates on it"));
@@ -201,6 +206,7 @@ GmshSurfaceMesh read_surface_mesh() {
     orient_like_the_normal(m, face, first_element);
   }
   if (m.elements.empty()) throw InputError("the mesh has no triangles or quadrangles on the model's surfaces");
+  for (int n : foreign) m.free_face[n] = -1;
   return out;
 }
 
@@ -211,6 +217,10 @@ void write_mesh(const std::string& path, const GmshSurfaceMesh& m) {
     const Eigen::Vector2d& u = m.mesh.u[i];
     gmsh::model::mesh::setNode(m.node_tags[i], {x.x(), x.y(), x.z()}, {u.x(), u.y()});
   }
+  write_current_mesh(path);
+}
+
+void write_current_mesh(const std::string& path) {
   gmsh::option::setNumber("Mesh.SaveParametric", 1);
   gmsh::option::setNumber("Mesh.MshFileVersion", 4.1);
   const fs::path target(path);

@@ -49,8 +49,10 @@ std::vector<CornerTriangle> corner_triangles(int nv, double h);
 
 /// Checks the mesh: sizes, indices, faces, free nodes inside their face's
 /// domain with phi(u) = x, non-degenerate surface normals at every corner.
+/// `exact_domain` false: the cheap domain test only (ParametricSurface::contains,
+/// not the trimmed face), for callers that only measure the mesh.
 /// \throw toolkit::InputError (a std::invalid_argument) naming the first problem (node, element, face).
-void validate_surface_mesh(const SurfaceMesh& mesh);
+void validate_surface_mesh(const SurfaceMesh& mesh, bool exact_domain = true);
 
 /// Unit surface normal at each element corner (4 per element); zero at a fixed
 /// node on a degenerate point (e.g. a pole that is a CAD vertex).

@@ -17,6 +17,8 @@ namespace meshopt::gmsh_io {
 // Errors: toolkit::InputError for bad input (unreadable model, mesh without
 // parametric coordinates, unsupported elements...), toolkit::IoError for a file
 // that cannot be written (toolkit/errors.h).
+using toolkit::InputError;  // the toolkit's own classes (no copies), by their short names here
+using toolkit::IoError;
 
 /// gmsh::initialize / finalize for the lifetime of the object (terminal output off
 /// unless `verbose`). One at a time per process.
@@ -55,5 +57,9 @@ GmshSurfaceMesh read_surface_mesh();
 /// model and writes it as MSH 4.1 with parametric coordinates, atomically
 /// (temporary file next to `path`, then rename). \throw IoError.
 void write_mesh(const std::string& path, const GmshSurfaceMesh& m);
+
+/// Writes the current model's mesh as MSH 4.1 with parametric coordinates,
+/// atomically (temporary file next to `path`, then rename). \throw IoError.
+void write_current_mesh(const std::string& path);
 
 }  // namespace meshopt::gmsh_io

@@ -1,0 +1,120 @@
+// Triangles needed for a given chordal deviation (issue 13): the remesher
+// (Dassi et al. 2014) against Gmsh's isotropic meshes of the same CAD part, the
+// fused torus and pipe of bench_smooth_cad (OpenCASCADE, 5 faces, sharp
+// intersection curves). The deviation is the one `meshopt remesh` reports: the
+// largest distance of a triangle centroid from the model. For Gmsh, the mesh
+// size (uniform), and separately the number of elements per 2 pi radius of
+// curvature (Mesh.MeshSizeFromCurvature), are bisected to the smallest mesh
+// whose deviation does not exceed the remesher's. Prints
+//   remesh: L s triangles deviation seconds
+//   uniform: size triangles deviation
+//   curvature: n triangles deviation
+//   ratio remesh / best isotropic
+// Usage: bench_remesh_vs_gmsh [L [S]]   (defaults 0.2, 1)
+#include <gmsh.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <functional>
+#include <numbers>
+#include <vector>
+
+#include "cad_fixtures.h"
+#include "meshopt/gmsh/gmsh_mesh.h"
+#include "meshopt/gmsh/gmsh_remesh_model.h"
+#include "meshopt/remesh.h"
+
+namespace {
+
+struct Sample {
+  double parameter = 0.0;
+  std::size_t triangles = 0;
+  double deviation = 0.0;
+};
+
+void make_model() {
+  gmsh::clear();
+  cad_fixtures::add_torus_pipe();
+}
+
+double max_deviation(const meshopt::RemeshMesh& m, const meshopt::gmsh_io::GmshRemeshGeometry& g) {
+  const auto c = meshopt::gmsh_io::project_centroids(m, g);
+  return *std::max_element(c.distance.begin(), c.distance.end());
+}
+
+/// Meshes the model with Gmsh options set by `configure` and measures it.
+Sample gmsh_mesh(const std::function<void()>& configure, double parameter) {
+  make_model();
+  configure();
+  meshopt::gmsh_io::generate_surface_mesh();
+  const meshopt::gmsh_io::GmshRemeshGeometry g(meshopt::gmsh_io::detect_features(std::numbers::pi / 6));
+  const meshopt::RemeshMesh m = meshopt::gmsh_io::read_remesh_mesh(g);
+  return {parameter, m.live_triangles(), max_deviation(m, g)};
+}
+
+/// Bisects `param` in [lo, hi] (deviation decreasing from lo to hi) for the
+/// cheapest mesh with deviation <= target.
+Sample bisect(double lo, double hi, double target, bool geometric, const std::function<Sample(double)>& mesh) {
+  Sample best = mesh(hi);
+  for (int it = 0; it < 8; ++it) {
+    const double mid = geometric ? std::sqrt(lo * hi) : 0.5 * (lo + hi);
+    const Sample s = mesh(mid);
+    if (s.deviation <= target) {
+      hi = mid;
+      if (s.triangles < best.triangles || best.deviation > target) best = s;
+    } else {
+      lo = mid;
+    }
+  }
+  return best;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  const double length = argc > 1 ? std::atof(argv[1]) : 0.2;
+  const double s = argc > 2 ? std::atof(argv[2]) : 1.0;
+  std::setvbuf(stdout, nullptr, _IOLBF, 0);
+  meshopt::gmsh_io::Session session;
+  make_model();
+  gmsh::option::setNumber("Mesh.MeshSizeMax", 2.0 * length);
+  meshopt::gmsh_io::generate_surface_mesh();
+  const meshopt::gmsh_io::GmshRemeshGeometry g(meshopt::gmsh_io::detect_features(std::numbers::pi / 6));
+  meshopt::RemeshMesh m = meshopt::gmsh_io::read_remesh_mesh(g);
+  meshopt::RemeshOptions opt;
+  opt.length = length;
+  opt.anisotropy = s;
+  const auto t0 = std::chrono::steady_clock::now();
+  meshopt::remesh(m, g, opt);
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  const double target = max_deviation(m, g);
+  std::printf("remesh: L %g s %g triangles %zu deviation %.4g seconds %.1f\n", length, s, m.live_triangles(), target,
+              seconds);
+  const Sample uniform = bisect(0.5, 0.02, target, true, [](double h) {
+    return gmsh_mesh(
+        [h] {
+          gmsh::option::setNumber("Mesh.MeshSizeMax", h);
+          gmsh::option::setNumber("Mesh.MeshSizeMin", h);
+          gmsh::option::setNumber("Mesh.MeshSizeFromCurvature", 0);
+        },
+        h);
+  });
+  std::printf("uniform: size %.4g triangles %zu deviation %.4g\n", uniform.parameter, uniform.triangles,
+              uniform.deviation);
+  const Sample curved = bisect(6.0, 150.0, target, true, [](double n) {
+    return gmsh_mesh(
+        [n] {
+          gmsh::option::setNumber("Mesh.MeshSizeMin", 0.0);
+          gmsh::option::setNumber("Mesh.MeshSizeMax", 1.0);
+          gmsh::option::setNumber("Mesh.MeshSizeFromCurvature", n);
+        },
+        n);
+  });
+  std::printf("curvature: n %.4g triangles %zu deviation %.4g\n", curved.parameter, curved.triangles,
+              curved.deviation);
+  const std::size_t best = std::min(uniform.triangles, curved.triangles);
+  std::printf("ratio remesh / best isotropic: %.3f\n", static_cast<double>(m.live_triangles()) / best);
+  return 0;
+}
