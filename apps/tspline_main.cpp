@@ -66,10 +66,8 @@ int run_param(const std::string& input, const std::string& out_dir, const std::s
   opt.progress = [&progress](const tspline::ProgressEvent& e) { progress.report(e); };
   // Fail on an unwritable output directory before any computation.
   tspline::io::ensure_writable_directory(out_dir);
-  std::string warnings;
-  const tspline::io::DomainInput domain = tspline::io::read_domain(input, domain_options, &warnings);
+  const tspline::io::DomainInput domain = tspline::io::read_domain(input, domain_options);
   const tspline::Polygon& polygon = domain.outer;
-  if (!warnings.empty()) progress.log("note: " + warnings);
   if (!domain.holes.empty() || !cuts_file.empty())
     return tspline_app::run_multipatch_param(domain, input, out_dir, cuts_file, opt, adaptive, samples, progress);
   tspline::io::AdaptSeriesWriter series(out_dir, samples);

@@ -149,7 +149,7 @@ bool is_gis_file(const std::string& path) {
   return i < n && (buf[i] == '{' || buf[i] == '<');
 }
 
-DomainInput read_domain(const std::string& path, const DomainReadOptions& options, std::string* warnings) {
+DomainInput read_domain(const std::string& path, const DomainReadOptions& options) {
   DomainInput out;
   if (!is_gis_file(path)) {
     if (options.layer || options.feature)

@@ -44,7 +44,6 @@ bool is_gis_file(const std::string& path);
 /// \throw IoError if the file cannot be opened; InputError for no polygon
 /// layer, a bad layer/feature/polygon choice, an unknown CRS for geographic
 /// data, or coordinates that are not longitude/latitude where they must be.
-DomainInput read_domain(const std::string& path, const DomainReadOptions& options = {},
-                        std::string* warnings = nullptr);
+DomainInput read_domain(const std::string& path, const DomainReadOptions& options = {});
 
 }  // namespace tspline::io
