@@ -70,7 +70,7 @@ std::vector<int> cells_to_refine(const TMesh& mesh, const std::vector<CellMapQua
 
 // The ranking of iterations: certified first, then fewest Gauss points with
 // det J <= 0, then good (J_r >= delta at the Gauss points), then the highest
-// min J_r over the whole map (dense sample).
+// min J_r over the whole map (dense sample and Gauss points).
 struct Score {
   bool certified = false;
   std::size_t nonpositive = 0;
@@ -242,11 +242,20 @@ class AdaptiveRun {
       }
     }
     rec.dense_quality = dense_map_quality(map, ad_.dense_samples);
+    // The whole-map minimum is over every point looked at: where a Gauss point
+    // is worse than the dense sample, it is the minimum (at that cell's centre).
+    for (int c = 0; c < static_cast<int>(cells.size()); ++c) {
+      if (cells[c].min_mean_ratio < rec.dense_quality.min_mean_ratio) {
+        rec.dense_quality.min_mean_ratio = cells[c].min_mean_ratio;
+        rec.dense_quality.worst_at = 0.5 * (f_.mesh.cell_min(c) + f_.mesh.cell_max(c));
+      }
+      rec.dense_quality.min_scaled = std::min(rec.dense_quality.min_scaled, cells[c].min_scaled);
+    }
     t_check_ += seconds_since(t2);
     {
       std::ostringstream s;
       s << "map (iteration " << round_ << "): " << f_.mesh.num_cells() << " cells, " << map.basis().size()
-        << " functions, J_r min " << rec.dense_quality.min_mean_ratio << " over the whole map (dense sample), "
+        << " functions, J_r min " << rec.dense_quality.min_mean_ratio << " over the whole map (dense sample and Gauss points), "
         << quality.min_mean_ratio << " at Gauss points; ";
       if (ad_.certify)
         s << cert.certified << " of " << cert.elements << " elements certified det J > 0"

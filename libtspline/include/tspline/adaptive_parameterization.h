@@ -88,7 +88,9 @@ struct ParameterizationResult {
   std::optional<TSplineMap> map;
   FitReport fit;
   MapQualityStats quality;          ///< at Gauss points
-  DenseMapQuality dense_quality;    ///< over a dense sample of every Bezier element
+  /// Over a dense sample of every Bezier element and the Gauss points (the
+  /// smaller of the two minima; worst_at is a cell centre if a Gauss point is worse).
+  DenseMapQuality dense_quality;
   std::vector<CellMapQuality> cell_quality;
   std::vector<AdaptIteration> iterations;
   int kept_iteration = 0;       ///< the best iteration, whose mesh and map these are

@@ -174,7 +174,7 @@ nlohmann::json param_report(const ParameterizationResult& r, const std::string& 
   rep["jacobian"] = map_quality_json(r.quality);
   rep["jacobian"]["gauss_points_per_direction"] = ad.gauss;
   rep["jacobian"]["threshold"] = ad.min_jacobian;
-  rep["jacobian"]["note"] = "min/mean at the Gauss points; whole_map: a dense sample of every Bezier element";
+  rep["jacobian"]["note"] = "min/mean at the Gauss points; whole_map: the smaller minimum of a dense sample of every Bezier element and the Gauss points";
   rep["jacobian"]["whole_map"] = {{"min_mean_ratio", r.dense_quality.min_mean_ratio},
                                   {"min_scaled", r.dense_quality.min_scaled},
                                   {"nonpositive_det_points", r.dense_quality.nonpositive_det},
