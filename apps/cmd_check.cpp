@@ -12,9 +12,9 @@
 #include "tspline/errors.h"
 #include "tspline/io/multipatch_file.h"
 #include "tspline/io/tspline_file.h"
-#include "tspline/multipatch_parameterization.h"
-#include "tspline/map_certification.h"
-#include "tspline/map_quality.h"
+#include "tspline/multipatch/multipatch_parameterization.h"
+#include "tspline/validity/map_certification.h"
+#include "tspline/validity/map_quality.h"
 
 namespace tspline_app {
 

@@ -6,7 +6,7 @@
 
 #include "commands.h"
 #include "tspline/errors.h"
-#include "tspline/io/atomic_file.h"
+#include "toolkit/io/atomic_file.h"
 #include "tspline/io/bezier_export.h"
 #include "tspline/io/msh_export.h"
 #include "tspline/io/multipatch_file.h"
@@ -38,7 +38,7 @@ int export_multipatch(const tspline::io::LoadedMaps& maps, const ExportArgs& a) 
                                  {"patch_b", f.patch_b},
                                  {"side_b", tspline::io::side_name(f.side_b)},
                                  {"orientation", "reversed"}});
-  tspline::io::write_text_atomic(a.bezier, doc.dump() + "\n");
+  toolkit::io::write_text_atomic(a.bezier, doc.dump() + "\n");
   if (!a.quiet)
     std::cout << "wrote " << a.bezier << ": " << elements << " Bezier elements on " << maps.patches.size()
               << " patches" << std::endl;
@@ -67,7 +67,7 @@ void add_export_command(CLI::App& app, CommandAction& action) {
       const tspline::io::LoadedTSpline& t = maps.patches.front();
       if (!a->bezier.empty()) {
         const nlohmann::json doc = tspline::io::bezier_document(t.map, a->file);
-        tspline::io::write_text_atomic(a->bezier, doc.dump() + "\n");
+        toolkit::io::write_text_atomic(a->bezier, doc.dump() + "\n");
         if (!a->quiet)
           std::cout << "wrote " << a->bezier << ": " << doc["elements"].size() << " Bezier elements on "
                     << t.map.mesh().num_cells() << " cells, " << t.map.basis().size() << " functions" << std::endl;

@@ -1,6 +1,6 @@
 // `tspline poisson`: solve -Laplace(u) = f, u = g on the boundary, with T-spline
 // isogeometric analysis on the domain of a T-spline file, and refine adaptively
-// or uniformly (libtspline/include/tspline/poisson.h). Writes convergence.csv, convergence.png,
+// or uniformly (libtspline/include/tspline/analysis/poisson.h). Writes convergence.csv, convergence.png,
 // report.json and solution.pvd + solution/step_NNN.vtu into OUTDIR.
 // Under `mpirun -n P` every process runs the same loop; the interior system is
 // assembled and solved by all of them (PETSc module, tspline/petsc_solver.h) when
@@ -30,16 +30,16 @@
 #include "progress.h"
 #include "expression.h"
 #include "tspline/errors.h"
-#include "tspline/io/atomic_file.h"
+#include "toolkit/io/atomic_file.h"
 #include "tspline/io/convergence_plot.h"
 #include "tspline/io/multipatch_file.h"
 #include "tspline/io/tspline_file.h"
 #include "poisson_multipatch.h"
 #include "tspline/io/cell_grid.h"
-#include "tspline/io/vtu_writer.h"
+#include "toolkit/io/vtu_writer.h"
 #include "petsc_session.h"
 #include "tspline/petsc_solver.h"
-#include "tspline/poisson.h"
+#include "tspline/analysis/poisson.h"
 
 namespace tspline_app {
 
@@ -253,12 +253,12 @@ void check_output_directory(const std::string& dir) {
 // ------------------------------------------------------------------ output
 
 /// The solution sampled per analysis cell with k x k sub-quads.
-tspline::io::VtuMesh solution_vtu(const tspline::TSplineMap& map, const tspline::PoissonSolution& sol,
+toolkit::io::VtuMesh solution_vtu(const tspline::TSplineMap& map, const tspline::PoissonSolution& sol,
                                   const tspline::PoissonProblem& problem, const std::vector<double>& eta,
                                   int k) {
   const tspline::TMesh& mesh = sol.space->mesh();
   std::vector<double> uh, ue, err, cell_eta;
-  tspline::io::VtuMesh out = tspline::io::cell_grid_vtu(mesh, k, [&](int c, const Eigen::Vector2d& uv) {
+  toolkit::io::VtuMesh out = tspline::io::cell_grid_vtu(mesh, k, [&](int c, const Eigen::Vector2d& uv) {
     const tspline::SolutionValue v = tspline::evaluate_solution(map, sol, c, uv, 0);
     uh.push_back(v.u);
     if (problem.exact) {
@@ -315,14 +315,14 @@ class PoissonOutput {
     const fs::path out(args_.out_dir);
     if (!started_) {
       // Created on the first completed step: a run failing before it leaves nothing.
-      tspline::io::ensure_writable_directory(out.string());
-      tspline::io::ensure_writable_directory((out / "solution").string());
+      toolkit::io::ensure_writable_directory(out.string());
+      toolkit::io::ensure_writable_directory((out / "solution").string());
       started_ = true;
       if (progress_.human()) print_header();
     }
     char name[64];
     std::snprintf(name, sizeof name, "solution/step_%03d.vtu", st.step);
-    tspline::io::write_vtu((out / name).string(), solution_vtu(map_, sol, problem_, eta, args_.samples));
+    toolkit::io::write_vtu((out / name).string(), solution_vtu(map_, sol, problem_, eta, args_.samples));
     pvd_.push_back({static_cast<double>(st.step), name, 0});
 
     json rec = {{"step", st.step},
@@ -400,10 +400,10 @@ class PoissonOutput {
           << s.solver.iterations << ',' << num(s.assembly_seconds) << ',' << num(s.solver.seconds) << ','
           << num(peak_total_[k]) << '\n';
     }
-    tspline::io::write_text_atomic((out / "convergence.csv").string(), csv.str());
+    toolkit::io::write_text_atomic((out / "convergence.csv").string(), csv.str());
     tspline::io::write_convergence_plot((out / "convergence.png").string(), steps_);
-    tspline::io::write_pvd((out / "solution.pvd").string(), pvd_);
-    tspline::io::write_text_atomic((out / "report.json").string(), report_.dump(2) + "\n");
+    toolkit::io::write_pvd((out / "solution.pvd").string(), pvd_);
+    toolkit::io::write_text_atomic((out / "report.json").string(), report_.dump(2) + "\n");
   }
 
   json& report() { return report_; }
@@ -433,7 +433,7 @@ class PoissonOutput {
   json report_;
   std::vector<tspline::PoissonStep> steps_;
   std::vector<double> peak_total_;  // per step: sum over the processes of their peak memory, MiB
-  std::vector<tspline::io::PvdEntry> pvd_;
+  std::vector<toolkit::io::PvdEntry> pvd_;
   bool started_ = false;
   Progress& progress_;
 };

@@ -13,9 +13,9 @@
 #include "meshopt/remesh_statistics.h"
 #include "meshopt_commands.h"
 #include "progress.h"
-#include "tspline/errors.h"
-#include "tspline/io/atomic_file.h"
-#include "tspline/io/vtu_writer.h"
+#include "toolkit/errors.h"
+#include "toolkit/io/atomic_file.h"
+#include "toolkit/io/vtu_writer.h"
 
 namespace meshopt_app {
 namespace {
@@ -56,7 +56,7 @@ Deviation deviation(const std::vector<double>& d) {
 void write_vtu(const std::string& path, const meshopt::RemeshMesh& m, double length, double s,
                const meshopt::gmsh_io::CurvatureAlignment& align, const meshopt::gmsh_io::CentroidProjection& centroids) {
   const std::vector<int>& faces = centroids.face;
-  tspline::io::VtuMesh v;
+  toolkit::io::VtuMesh v;
   for (const meshopt::RemeshVertex& x : m.vertices) v.points3d.push_back(x.x);
   std::vector<int> patch, face;
   for (std::size_t t = 0; t < m.triangles.size(); ++t) {
@@ -73,24 +73,24 @@ void write_vtu(const std::string& path, const meshopt::RemeshMesh& m, double len
   std::vector<int> kind;
   for (const meshopt::RemeshVertex& x : m.vertices) kind.push_back(static_cast<int>(x.kind));
   v.point_ints["kind"] = kind;  // 0 corner, 1 feature curve, 2 surface
-  tspline::io::write_vtu(path, v);
+  toolkit::io::write_vtu(path, v);
 }
 
 }  // namespace
 
 int run_remesh(const RemeshArgs& a) {
   namespace fs = std::filesystem;
-  if (!(a.length > 0.0) || !std::isfinite(a.length)) throw tspline::InputError("--length must be positive");
+  if (!(a.length > 0.0) || !std::isfinite(a.length)) throw toolkit::InputError("--length must be positive");
   if (a.anisotropy != -1.0 && (!(a.anisotropy >= 0.0) || !std::isfinite(a.anisotropy)))
-    throw tspline::InputError("--anisotropy must be >= 0");
+    throw toolkit::InputError("--anisotropy must be >= 0");
   if (!(a.feature_angle >= 0.0 && a.feature_angle <= 180.0))
-    throw tspline::InputError("--feature-angle must be in [0, 180] degrees");
-  if (!(a.min_angle >= 0.0 && a.min_angle < 60.0)) throw tspline::InputError("--min-angle must be in [0, 60) degrees");
-  if (a.rounds < 0) throw tspline::InputError("--rounds must be >= 0");
-  if (fs::path(a.out).extension() != ".msh") throw tspline::InputError("--out must end in .msh");
+    throw toolkit::InputError("--feature-angle must be in [0, 180] degrees");
+  if (!(a.min_angle >= 0.0 && a.min_angle < 60.0)) throw toolkit::InputError("--min-angle must be in [0, 60) degrees");
+  if (a.rounds < 0) throw toolkit::InputError("--rounds must be >= 0");
+  if (fs::path(a.out).extension() != ".msh") throw toolkit::InputError("--out must end in .msh");
   const std::string report = a.report.empty() ? fs::path(a.out).replace_extension(".json").string() : a.report;
   for (const std::string& f : {a.out, a.vtu, report})
-    if (!f.empty()) tspline::io::ensure_writable_directory(fs::absolute(f).parent_path().string());
+    if (!f.empty()) toolkit::io::ensure_writable_directory(fs::absolute(f).parent_path().string());
   tspline_app::Progress out(tspline_app::output_mode(a.quiet, a.json));
 
   const auto t_start = Clock::now();
@@ -169,7 +169,7 @@ int run_remesh(const RemeshArgs& a) {
         {"analysis", seconds_analysis},
         {"output", seconds_output}}},
       {"outputs", {{"mesh", a.out}, {"vtu", a.vtu}, {"report", report}}}};
-  tspline::io::write_text_atomic(report, j.dump(2) + "\n");
+  toolkit::io::write_text_atomic(report, j.dump(2) + "\n");
   char buf[512];
   std::snprintf(buf, sizeof buf,
                 "meshopt remesh: %zu patches, %zu feature curves, L %g, s %g\n"

@@ -5,7 +5,7 @@
 #include <numbers>
 #include <utility>
 
-#include "tspline/errors.h"
+#include "toolkit/errors.h"
 
 namespace tspline_app {
 
@@ -29,11 +29,11 @@ Expression::Expression(std::string option, std::string text, bool three_d)
     int results = 0;
     impl_->parser.Eval(results);
     if (results != 1)
-      throw tspline::InputError(option_ + ": cannot parse '" + text_ + "': it gives " +
+      throw toolkit::InputError(option_ + ": cannot parse '" + text_ + "': it gives " +
                                 std::to_string(results) +
                                 " comma-separated values, expected one expression in x and y" + (three_d ? " and z" : ""));
   } catch (const mu::Parser::exception_type& e) {
-    throw tspline::InputError(option_ + ": cannot parse '" + text_ + "': " + e.GetMsg());
+    throw toolkit::InputError(option_ + ": cannot parse '" + text_ + "': " + e.GetMsg());
   }
 }
 
@@ -46,12 +46,12 @@ double Expression::operator()(double x, double y, double z) const {
   try {
     return impl_->parser.Eval();
   } catch (const mu::Parser::exception_type& e) {
-    throw tspline::InputError(option_ + ": cannot evaluate '" + text_ + "' at x = " + std::to_string(x) +
+    throw toolkit::InputError(option_ + ": cannot evaluate '" + text_ + "' at x = " + std::to_string(x) +
                               ", y = " + std::to_string(y) + ", z = " + std::to_string(z) + ": " + e.GetMsg());
   }
 }
 
-tspline::ScalarField make_field(const std::string& option, const std::string& text) {
+std::function<double(double, double)> make_field(const std::string& option, const std::string& text) {
   auto e = std::make_shared<const Expression>(option, text);
   return [e](double x, double y) { return (*e)(x, y); };
 }

@@ -1,10 +1,9 @@
 #pragma once
 // Scalar fields given as expressions in x and y on the command line, parsed
 // with muParser (https://beltoforion.de/en/muparser/).
+#include <functional>
 #include <memory>
 #include <string>
-
-#include "tspline/poisson.h"
 
 namespace tspline_app {
 
@@ -39,8 +38,8 @@ class Expression {
   std::unique_ptr<Impl> impl_;
 };
 
-/// A ScalarField evaluating `text` (owns its own parser, shared by the copies of
+/// A scalar field (tspline::ScalarField) evaluating `text` (owns its own parser, shared by the copies of
 /// the returned std::function). \throw tspline::InputError as Expression.
-tspline::ScalarField make_field(const std::string& option, const std::string& text);
+std::function<double(double, double)> make_field(const std::string& option, const std::string& text);
 
 }  // namespace tspline_app

@@ -3,7 +3,7 @@
 // a flag, and the run stops at its next progress report (a log line or a
 // progress bar, see progress.cpp) by throwing toolkit::Interrupted, which
 // unwinds normally: outputs are only ever written through temporary files and
-// renamed when complete (tspline/io/atomic_file.h), so no half-written file is
+// renamed when complete (toolkit/io/atomic_file.h), so no half-written file is
 // left, and the program exits 130. A second signal ends the process at once
 // (the default action), for a stage that reports no progress for long.
 

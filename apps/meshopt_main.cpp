@@ -23,8 +23,8 @@
 #include "meshopt/gmsh/gmsh_mesh.h"
 #include "meshopt/surface_smoother.h"
 #include "toolkit/errors.h"
-#include "tspline/io/atomic_file.h"
-#include "tspline/io/vtu_writer.h"
+#include "toolkit/io/atomic_file.h"
+#include "toolkit/io/vtu_writer.h"
 
 #if defined(__SANITIZE_ADDRESS__)
 // LeakSanitizer: OpenCASCADE (libTK*, e.g. its STEP reader's static tables) and
@@ -59,7 +59,7 @@ nlohmann::json stats_json(const ElementQualities& q) {
 
 void write_vtu(const std::string& path, const meshopt::gmsh_io::GmshSurfaceMesh& g, const ElementQualities& q,
                const ElementQualities& shape) {
-  tspline::io::VtuMesh v;
+  toolkit::io::VtuMesh v;
   v.points3d = g.mesh.x;
   for (const meshopt::SurfaceElement& el : g.mesh.elements) v.cells.emplace_back(el.v.begin(), el.v.begin() + el.nv);
   v.quads_as_polygons = false;
@@ -70,7 +70,7 @@ void write_vtu(const std::string& path, const meshopt::gmsh_io::GmshSurfaceMesh&
   std::vector<int> free(g.mesh.x.size());
   for (std::size_t i = 0; i < free.size(); ++i) free[i] = g.mesh.free_face[i] >= 0 ? 1 : 0;
   v.point_ints["free"] = free;
-  tspline::io::write_vtu(path, v);
+  toolkit::io::write_vtu(path, v);
 }
 
 std::string line(const char* name, const ElementQualities& q) {
@@ -87,7 +87,7 @@ int run_smooth(const SmoothArgs& a) {
   if (!(a.tol > 0.0) || !std::isfinite(a.tol)) throw toolkit::InputError("--tol must be positive");
   const std::string report = a.report.empty() ? fs::path(a.out).replace_extension(".json").string() : a.report;
   for (const std::string& f : {a.out, a.vtu, report})
-    if (!f.empty()) tspline::io::ensure_writable_directory(fs::absolute(f).parent_path().string());
+    if (!f.empty()) toolkit::io::ensure_writable_directory(fs::absolute(f).parent_path().string());
   std::optional<tspline_app::Expression> size_expr;
   if (!a.size.empty()) size_expr.emplace("--size", a.size, true);
 
@@ -142,7 +142,7 @@ int run_smooth(const SmoothArgs& a) {
       {"gradient_fallbacks", rep.gradient_fallbacks},
       {"seconds", seconds},
       {"outputs", {{"mesh", a.out}, {"vtu", a.vtu}}}};
-  tspline::io::write_text_atomic(report, j.dump(2) + "\n");
+  toolkit::io::write_text_atomic(report, j.dump(2) + "\n");
 
   std::cout << "meshopt smooth: " << g.faces.size() << " surfaces, " << g.mesh.x.size() << " nodes (" << free_nodes
             << " free), " << g.mesh.elements.size() - quads << " triangles, " << quads << " quadrangles\n"

@@ -7,7 +7,7 @@
 #include "tspline/errors.h"
 #include "tspline/io/multipatch_output.h"
 #include "tspline/io/polygon_reader.h"
-#include "tspline/multipatch_parameterization.h"
+#include "tspline/multipatch/multipatch_parameterization.h"
 
 namespace tspline_app {
 

@@ -3,7 +3,7 @@
 #include <string>
 
 #include "progress.h"
-#include "tspline/adaptive_parameterization.h"
+#include "tspline/pipeline/adaptive_parameterization.h"
 #include "tspline/io/gis_reader.h"
 
 namespace tspline_app {

@@ -6,8 +6,8 @@
 #include <filesystem>
 
 #include "tspline/errors.h"
-#include "tspline/io/atomic_file.h"
-#include "tspline/multipatch_poisson.h"
+#include "toolkit/io/atomic_file.h"
+#include "tspline/analysis/multipatch_poisson.h"
 
 namespace tspline_app {
 
@@ -68,8 +68,8 @@ int run_multipatch_poisson(const tspline::io::LoadedMaps& maps, const MultiPatch
                                  {"gamma", args.gamma},
                                  {"coupling", "C0: one unknown per glued group of border functions"},
                                  {"steps", steps}};
-  tspline::io::ensure_writable_directory(args.out_dir);
-  tspline::io::write_text_atomic((std::filesystem::path(args.out_dir) / "report.json").string(),
+  toolkit::io::ensure_writable_directory(args.out_dir);
+  toolkit::io::write_text_atomic((std::filesystem::path(args.out_dir) / "report.json").string(),
                                  report.dump(2) + "\n");
   return 0;
 }

@@ -6,7 +6,7 @@
 #include <string>
 
 #include "tspline/io/multipatch_file.h"
-#include "tspline/poisson.h"
+#include "tspline/analysis/poisson.h"
 
 namespace tspline_app {
 

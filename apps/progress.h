@@ -16,7 +16,9 @@
 #include <ostream>
 #include <string>
 
-#include "tspline/progress_event.h"
+namespace tspline {
+struct ProgressEvent;
+}
 
 namespace tspline_app {
 
@@ -43,6 +45,7 @@ class Progress {
   /// {"event":"log","kind":"step"|"note","stage":...,"message":...} and
   /// {"event":"sweep"|"untangling_stage","stage":...,...}
   /// (sweeps: the first three and every 50th, like the human log off a terminal).
+  /// Defined in progress_report.cpp (the tspline program only).
   void report(const tspline::ProgressEvent& e);
   /// A progress bar "task [#####.....] done/total" (transient in human mode).
   void progress(const std::string& task, long done, long total);

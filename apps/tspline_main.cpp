@@ -23,12 +23,12 @@
 #include "param_multipatch.h"
 #include "progress.h"
 #include "tspline/errors.h"
-#include "tspline/io/atomic_file.h"
+#include "toolkit/io/atomic_file.h"
 #include "tspline/io/gis_reader.h"
-#include "tspline/adaptive_parameterization.h"
+#include "tspline/pipeline/adaptive_parameterization.h"
 #include "tspline/io/param_output.h"
 #include "tspline/io/polygon_reader.h"
-#include "tspline/parameterization.h"
+#include "tspline/pipeline/parameterization.h"
 
 // LeakSanitizer suppressions of the program (third-party libraries only): apps/petsc_session.cpp.
 
@@ -65,7 +65,7 @@ int run_param(const std::string& input, const std::string& out_dir, const std::s
   const bool quiet = mode != tspline_app::OutputMode::Human;
   opt.progress = [&progress](const tspline::ProgressEvent& e) { progress.report(e); };
   // Fail on an unwritable output directory before any computation.
-  tspline::io::ensure_writable_directory(out_dir);
+  toolkit::io::ensure_writable_directory(out_dir);
   const tspline::io::DomainInput domain = tspline::io::read_domain(input, domain_options);
   const tspline::Polygon& polygon = domain.outer;
   if (!domain.holes.empty() || !cuts_file.empty())

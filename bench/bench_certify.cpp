@@ -9,12 +9,12 @@
 #include <cstdio>
 #include <cstdlib>
 
-#include "tspline/bezier_extraction.h"
+#include "tspline/spline/bezier_extraction.h"
 #include "bench_front_args.h"
-#include "tspline/map_certification.h"
-#include "tspline/map_quality.h"
-#include "tspline/parameterization.h"
-#include "tspline/tspline_fit.h"
+#include "tspline/validity/map_certification.h"
+#include "tspline/validity/map_quality.h"
+#include "tspline/pipeline/parameterization.h"
+#include "tspline/spline/tspline_fit.h"
 
 using bench::since;
 

@@ -11,9 +11,9 @@
 #include <cstdlib>
 
 #include "bench_front_args.h"
-#include "tspline/map_quality.h"
-#include "tspline/parameterization.h"
-#include "tspline/tspline_fit.h"
+#include "tspline/validity/map_quality.h"
+#include "tspline/pipeline/parameterization.h"
+#include "tspline/spline/tspline_fit.h"
 
 using bench::since;
 

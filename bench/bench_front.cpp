@@ -11,7 +11,7 @@
 #include <string>
 
 #include "tspline/io/polygon_reader.h"
-#include "tspline/parameterization.h"
+#include "tspline/pipeline/parameterization.h"
 
 int main(int argc, char** argv) {
   if (argc < 4) {

@@ -8,7 +8,7 @@
 #include <optional>
 
 #include "tspline/io/polygon_reader.h"
-#include "tspline/parameterization.h"
+#include "tspline/pipeline/parameterization.h"
 
 namespace bench {
 

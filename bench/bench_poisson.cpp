@@ -27,7 +27,7 @@
 #include <string>
 
 #include "tspline/petsc_solver.h"
-#include "tspline/poisson.h"
+#include "tspline/analysis/poisson.h"
 
 namespace {
 

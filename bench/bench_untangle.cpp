@@ -11,9 +11,9 @@
 
 #include "bench_front_args.h"
 #include "tspline/io/polygon_reader.h"
-#include "tspline/map_untangling.h"
-#include "tspline/parameterization.h"
-#include "tspline/tspline_fit.h"
+#include "tspline/validity/map_untangling.h"
+#include "tspline/pipeline/parameterization.h"
+#include "tspline/spline/tspline_fit.h"
 
 using bench::since;
 

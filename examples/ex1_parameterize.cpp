@@ -13,7 +13,7 @@
 #include <exception>
 #include <string>
 
-#include "tspline/adaptive_parameterization.h"  // run_parameterization
+#include "tspline/pipeline/adaptive_parameterization.h"  // run_parameterization
 #include "tspline/io/param_output.h"            // param_report, write_param_outputs
 #include "tspline/io/polygon_reader.h"          // read_polygon (text or GeoJSON)
 

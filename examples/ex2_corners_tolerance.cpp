@@ -16,7 +16,7 @@
 #include <exception>
 #include <string>
 
-#include "tspline/adaptive_parameterization.h"
+#include "tspline/pipeline/adaptive_parameterization.h"
 #include "tspline/io/polygon_reader.h"
 
 int run(int argc, char** argv) {

@@ -14,7 +14,7 @@
 #include <exception>
 
 #include "tspline/io/tspline_file.h"
-#include "tspline/map_quality.h"  // mean_ratio_jacobian
+#include "tspline/validity/map_quality.h"  // mean_ratio_jacobian
 
 int run(int argc, char** argv) {
   if (argc < 2) {

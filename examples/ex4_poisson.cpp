@@ -12,7 +12,7 @@
 #include <exception>
 
 #include "tspline/io/tspline_file.h"
-#include "tspline/poisson.h"
+#include "tspline/analysis/poisson.h"
 
 int run(int argc, char** argv) {
   if (argc < 2) {

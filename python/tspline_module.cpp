@@ -15,13 +15,13 @@
 #include <string>
 
 #include "expression.h"
-#include "tspline/adaptive_parameterization.h"
+#include "tspline/pipeline/adaptive_parameterization.h"
 #include "tspline/errors.h"
 #include "tspline/io/gis_reader.h"
 #include "tspline/io/param_output.h"
 #include "tspline/io/tspline_file.h"
-#include "tspline/map_certification.h"
-#include "tspline/poisson.h"
+#include "tspline/validity/map_certification.h"
+#include "tspline/analysis/poisson.h"
 
 namespace py = pybind11;
 using Array = py::array_t<double, py::array::c_style | py::array::forcecast>;

@@ -6,9 +6,9 @@
 #include <filesystem>
 #include <numbers>
 
-#include "tspline/adaptive_parameterization.h"
+#include "tspline/pipeline/adaptive_parameterization.h"
 #include "tspline/io/tspline_file.h"
-#include "tspline/poisson.h"
+#include "tspline/analysis/poisson.h"
 
 int main() {
   // Ellipse with semi-axes 2 and 1, 128 vertices, counter-clockwise.

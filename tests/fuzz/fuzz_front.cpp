@@ -9,7 +9,7 @@
 
 #include "fuzz_support.h"
 #include "tspline/io/polygon_reader.h"
-#include "tspline/parameterization.h"
+#include "tspline/pipeline/parameterization.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   if (size > 2048) return 0;  // small polygons only

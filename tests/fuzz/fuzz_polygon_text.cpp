@@ -7,7 +7,7 @@
 
 #include "fuzz_support.h"
 #include "tspline/io/polygon_reader.h"
-#include "tspline/polygon_validation.h"
+#include "tspline/boundary/polygon_validation.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   const std::string text(reinterpret_cast<const char*>(data), size);

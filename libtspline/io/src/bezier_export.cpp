@@ -1,6 +1,6 @@
 #include "tspline/io/bezier_export.h"
 
-#include "tspline/bezier_extraction.h"
+#include "tspline/spline/bezier_extraction.h"
 
 namespace tspline::io {
 

@@ -4,10 +4,10 @@
 
 namespace tspline::io {
 
-VtuMesh cell_grid_vtu(const TMesh& mesh, int k,
+toolkit::io::VtuMesh cell_grid_vtu(const TMesh& mesh, int k,
                       const std::function<Eigen::Vector2d(int, const Eigen::Vector2d&)>& sample) {
   if (k < 1 || k > 64) throw std::invalid_argument("samples per cell edge must be in [1, 64]");
-  VtuMesh out;
+  toolkit::io::VtuMesh out;
   out.points.reserve(mesh.num_cells() * static_cast<std::size_t>((k + 1) * (k + 1)));
   std::vector<int> cell_id, level;
   for (int c = 0; c < static_cast<int>(mesh.num_cells()); ++c) {

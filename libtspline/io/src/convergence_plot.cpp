@@ -6,7 +6,7 @@
 #include <limits>
 
 #include "tspline/errors.h"
-#include "tspline/io/atomic_file.h"
+#include "toolkit/io/atomic_file.h"
 #include "tspline/io/canvas.h"
 
 namespace tspline::io {
@@ -55,7 +55,7 @@ void write_convergence_plot(const std::string& path, const std::vector<PoissonSt
                            bottom - (p.y() - ylo) / (yhi - ylo) * (bottom - top));
   };
   const Rgb black{0, 0, 0}, grid{220, 220, 220};
-  write_atomic(path, [&](const std::string& tmp) {
+  toolkit::io::write_atomic(path, [&](const std::string& tmp) {
     Canvas c(format, tmp, width, height);
     // Decade grid lines and labels.
     for (int k = static_cast<int>(xlo); k <= static_cast<int>(xhi); ++k) {

@@ -2,12 +2,12 @@
 
 #include <filesystem>
 
-#include "tspline/io/atomic_file.h"
+#include "toolkit/io/atomic_file.h"
 
 namespace tspline::io {
 
-VtuMesh tmesh_vtu(const TMesh& mesh, const std::vector<Eigen::Vector2d>& positions) {
-  VtuMesh out;
+toolkit::io::VtuMesh tmesh_vtu(const TMesh& mesh, const std::vector<Eigen::Vector2d>& positions) {
+  toolkit::io::VtuMesh out;
   out.points = positions;
   const auto nc = mesh.num_cells();
   out.cells.reserve(nc);
@@ -37,8 +37,8 @@ VtuMesh tmesh_vtu(const TMesh& mesh, const std::vector<Eigen::Vector2d>& positio
   return out;
 }
 
-VtuMesh boundary_vtu(const BoundaryMap& boundary) {
-  VtuMesh out;
+toolkit::io::VtuMesh boundary_vtu(const BoundaryMap& boundary) {
+  toolkit::io::VtuMesh out;
   const Polygon& p = boundary.polygon();
   const int n = static_cast<int>(p.vertices.size());
   out.points = p.vertices;
@@ -142,13 +142,13 @@ nlohmann::json front_report(const FrontResult& r, const std::string& input_path)
 }
 
 void write_front_meshes(const FrontResult& r, const std::string& out_dir) {
-  ensure_writable_directory(out_dir);
+  toolkit::io::ensure_writable_directory(out_dir);
   const std::filesystem::path dir(out_dir);
   std::vector<Eigen::Vector2d> param(r.mesh.num_vertices());
   for (int v = 0; v < static_cast<int>(param.size()); ++v) param[v] = r.mesh.vertex_param(v);
-  write_vtu((dir / "parametric_tmesh.vtu").string(), tmesh_vtu(r.mesh, param));
-  write_vtu((dir / "physical_tmesh.vtu").string(), tmesh_vtu(r.mesh, r.optimized));
-  write_vtu((dir / "boundary.vtu").string(), boundary_vtu(r.boundary));
+  toolkit::io::write_vtu((dir / "parametric_tmesh.vtu").string(), tmesh_vtu(r.mesh, param));
+  toolkit::io::write_vtu((dir / "physical_tmesh.vtu").string(), tmesh_vtu(r.mesh, r.optimized));
+  toolkit::io::write_vtu((dir / "boundary.vtu").string(), boundary_vtu(r.boundary));
 }
 
 }  // namespace tspline::io

@@ -9,8 +9,8 @@
 #include <utility>
 #include <vector>
 
-#include "tspline/bezier_extraction.h"
-#include "tspline/io/atomic_file.h"
+#include "tspline/spline/bezier_extraction.h"
+#include "toolkit/io/atomic_file.h"
 
 namespace tspline::io {
 
@@ -91,7 +91,7 @@ std::string msh_document(const TSplineMap& map, MshExportStats* stats) {
 MshExportStats write_msh_file(const std::string& path, const TSplineMap& map) {
   MshExportStats stats;
   const std::string text = msh_document(map, &stats);
-  write_text_atomic(path, text);
+  toolkit::io::write_text_atomic(path, text);
   return stats;
 }
 

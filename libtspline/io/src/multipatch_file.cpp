@@ -6,7 +6,7 @@
 #include <sstream>
 
 #include "tspline/errors.h"
-#include "tspline/io/atomic_file.h"
+#include "toolkit/io/atomic_file.h"
 
 namespace tspline::io {
 namespace {
@@ -66,7 +66,7 @@ void write_multipatch_file(const std::string& path, const std::vector<const TSpl
     out << (c ? ",\n    " : "\n    ") << pts.dump();
   }
   out << "\n  ]\n}\n";
-  write_text_atomic(path, out.str());
+  toolkit::io::write_text_atomic(path, out.str());
 }
 
 LoadedMaps read_maps_file(const std::string& path) {

@@ -2,7 +2,7 @@
 
 #include <filesystem>
 
-#include "tspline/io/atomic_file.h"
+#include "toolkit/io/atomic_file.h"
 #include "tspline/io/front_output.h"
 #include "tspline/io/multipatch_file.h"
 #include "tspline/io/param_output.h"
@@ -27,8 +27,8 @@ void append(Map& into, const Map& part) {
 
 }  // namespace
 
-VtuMesh merge_patches(const std::vector<VtuMesh>& parts) {
-  VtuMesh out;
+toolkit::io::VtuMesh merge_patches(const std::vector<toolkit::io::VtuMesh>& parts) {
+  toolkit::io::VtuMesh out;
   if (parts.empty()) return out;
   out.quads_as_polygons = parts.front().quads_as_polygons;
   out.point_scalars = parts.front().point_scalars, out.cell_scalars = parts.front().cell_scalars;
@@ -39,14 +39,14 @@ VtuMesh merge_patches(const std::vector<VtuMesh>& parts) {
   for (auto& [k, v] : out.cell_ints) v.clear();
   for (auto& [k, v] : out.point_ints) v.clear();
   for (auto& [k, v] : out.point_vectors) v.clear();
-  for (const VtuMesh& p : parts) {
+  for (const toolkit::io::VtuMesh& p : parts) {
     keep_common(out.point_scalars, p.point_scalars), keep_common(out.cell_scalars, p.cell_scalars);
     keep_common(out.cell_ints, p.cell_ints), keep_common(out.point_ints, p.point_ints);
     keep_common(out.point_vectors, p.point_vectors);
   }
   std::vector<int> patch;
   for (std::size_t k = 0; k < parts.size(); ++k) {
-    const VtuMesh& p = parts[k];
+    const toolkit::io::VtuMesh& p = parts[k];
     const int offset = static_cast<int>(out.points.size());
     out.points.insert(out.points.end(), p.points.begin(), p.points.end());
     for (std::vector<int> c : p.cells) {
@@ -115,7 +115,7 @@ void write_multipatch_outputs(const MultiPatchResult& R, const std::string& out_
   const std::filesystem::path dir(out_dir);
   std::vector<const TSplineMap*> maps;
   std::vector<TSplineFileMeta> metas;
-  std::vector<VtuMesh> surface, net, param, phys, boundary;
+  std::vector<toolkit::io::VtuMesh> surface, net, param, phys, boundary;
   for (std::size_t p = 0; p < R.patches.size(); ++p) {
     const ParameterizationResult& r = R.patches[p];
     maps.push_back(&*r.map);
@@ -136,12 +136,12 @@ void write_multipatch_outputs(const MultiPatchResult& R, const std::string& out_
   }
   write_multipatch_file((dir / "tspline.json").string(), maps, metas, R.layout.interfaces, R.layout.cuts,
                         report.value("input", ""));
-  write_vtu((dir / "surface.vtu").string(), merge_patches(surface));
-  write_vtu((dir / "control_net.vtu").string(), merge_patches(net));
-  write_vtu((dir / "parametric_tmesh.vtu").string(), merge_patches(param));
-  write_vtu((dir / "physical_tmesh.vtu").string(), merge_patches(phys));
-  write_vtu((dir / "boundary.vtu").string(), merge_patches(boundary));
-  write_text_atomic((dir / "report.json").string(), report.dump(2) + "\n");
+  toolkit::io::write_vtu((dir / "surface.vtu").string(), merge_patches(surface));
+  toolkit::io::write_vtu((dir / "control_net.vtu").string(), merge_patches(net));
+  toolkit::io::write_vtu((dir / "parametric_tmesh.vtu").string(), merge_patches(param));
+  toolkit::io::write_vtu((dir / "physical_tmesh.vtu").string(), merge_patches(phys));
+  toolkit::io::write_vtu((dir / "boundary.vtu").string(), merge_patches(boundary));
+  toolkit::io::write_text_atomic((dir / "report.json").string(), report.dump(2) + "\n");
 }
 
 }  // namespace tspline::io

@@ -8,18 +8,18 @@
 
 #include <Eigen/LU>
 
-#include "tspline/io/atomic_file.h"
+#include "toolkit/io/atomic_file.h"
 #include "tspline/io/cell_grid.h"
 #include "tspline/io/front_output.h"
 #include "tspline/io/tspline_file.h"
-#include "tspline/map_quality.h"
+#include "tspline/validity/map_quality.h"
 
 namespace tspline::io {
 
-VtuMesh surface_vtu(const TSplineMap& map, int k) {
+toolkit::io::VtuMesh surface_vtu(const TSplineMap& map, int k) {
   std::vector<double> jr, det, js;
   std::vector<Eigen::Vector2d> param;
-  VtuMesh out = cell_grid_vtu(map.mesh(), k, [&](int c, const Eigen::Vector2d& uv) {
+  toolkit::io::VtuMesh out = cell_grid_vtu(map.mesh(), k, [&](int c, const Eigen::Vector2d& uv) {
     const MapDerivatives d = map.derivatives(uv, 1, c);
     jr.push_back(mean_ratio_jacobian(d.J));
     det.push_back(d.J.determinant());
@@ -34,8 +34,8 @@ VtuMesh surface_vtu(const TSplineMap& map, int k) {
   return out;
 }
 
-VtuMesh control_net_vtu(const TSplineMap& map) {
-  VtuMesh out;
+toolkit::io::VtuMesh control_net_vtu(const TSplineMap& map) {
+  toolkit::io::VtuMesh out;
   out.points = map.control_points();
   std::vector<int> kind, fn;
   for (int a = 0; a < static_cast<int>(map.basis().size()); ++a) {
@@ -72,21 +72,21 @@ AdaptSeriesWriter::AdaptSeriesWriter(std::string out_dir, int samples) : out_dir
 
 void AdaptSeriesWriter::add(int it, const TMesh& mesh, const std::vector<Eigen::Vector2d>& x, const TSplineMap& map) {
   // Created on first use, so that a run failing before the first fit leaves nothing.
-  if (entries_.empty()) ensure_writable_directory((std::filesystem::path(out_dir_) / "adapt").string());
+  if (entries_.empty()) toolkit::io::ensure_writable_directory((std::filesystem::path(out_dir_) / "adapt").string());
   char name[64];
   std::snprintf(name, sizeof name, "adapt/mesh_%03d.vtu", it);
   const std::string mesh_file = name;
   std::snprintf(name, sizeof name, "adapt/surface_%03d.vtu", it);
   const std::string surface_file = name;
   const std::filesystem::path dir(out_dir_);
-  write_vtu((dir / mesh_file).string(), tmesh_vtu(mesh, x));
-  write_vtu((dir / surface_file).string(), surface_vtu(map, samples_));
+  toolkit::io::write_vtu((dir / mesh_file).string(), tmesh_vtu(mesh, x));
+  toolkit::io::write_vtu((dir / surface_file).string(), surface_vtu(map, samples_));
   entries_.push_back({static_cast<double>(it), mesh_file, 0});
   entries_.push_back({static_cast<double>(it), surface_file, 1});
 }
 
 void AdaptSeriesWriter::finish() const {
-  write_pvd((std::filesystem::path(out_dir_) / "adapt.pvd").string(), entries_);
+  toolkit::io::write_pvd((std::filesystem::path(out_dir_) / "adapt.pvd").string(), entries_);
 }
 
 namespace {
@@ -247,9 +247,9 @@ void write_param_outputs(const ParameterizationResult& r, const std::string& out
   meta.boundary = r.front.boundary.polygon();
   meta.corners = r.front.boundary.corners().index;
   write_tspline_file((dir / "tspline.json").string(), *r.map, meta);
-  write_vtu((dir / "surface.vtu").string(), surface_vtu(*r.map, samples));
-  write_vtu((dir / "control_net.vtu").string(), control_net_vtu(*r.map));
-  write_text_atomic((dir / "report.json").string(), report.dump(2) + "\n");  // last: the run's summary
+  toolkit::io::write_vtu((dir / "surface.vtu").string(), surface_vtu(*r.map, samples));
+  toolkit::io::write_vtu((dir / "control_net.vtu").string(), control_net_vtu(*r.map));
+  toolkit::io::write_text_atomic((dir / "report.json").string(), report.dump(2) + "\n");  // last: the run's summary
 }
 
 }  // namespace tspline::io

@@ -7,9 +7,9 @@
 #include <limits>
 
 #include "tspline/errors.h"
-#include "tspline/io/atomic_file.h"
+#include "toolkit/io/atomic_file.h"
 #include "tspline/io/canvas.h"
-#include "tspline/io/vtu_reader.h"
+#include "toolkit/io/vtu_reader.h"
 
 namespace tspline::io {
 
@@ -22,15 +22,15 @@ constexpr Rgb kBlack{0, 0, 0}, kDark{60, 60, 60}, kRed{215, 25, 28}, kBlue{33, 9
 constexpr int kMargin = 30;       // pixels around the drawing
 constexpr int kColourbar = 190;   // pixels on the right for the colour bar and its labels
 
-VtuMesh read_output(const fs::path& file, const char* written_by) {
+toolkit::io::VtuMesh read_output(const fs::path& file, const char* written_by) {
   std::error_code ec;
   if (!fs::is_regular_file(file, ec))
     throw IoError("'" + file.string() + "' not found: render draws the outputs of `" + written_by +
                   "`; give the directory it wrote (--out)");
-  return read_vtu(file.string());
+  return toolkit::io::read_vtu(file.string());
 }
 
-const std::vector<double>& point_array(const VtuMesh& m, const std::string& name, const fs::path& file) {
+const std::vector<double>& point_array(const toolkit::io::VtuMesh& m, const std::string& name, const fs::path& file) {
   const auto it = m.point_scalars.find(name);
   if (it == m.point_scalars.end()) throw IoError("'" + file.string() + "' has no point data '" + name + "'");
   return it->second;
@@ -39,7 +39,7 @@ const std::vector<double>& point_array(const VtuMesh& m, const std::string& name
 struct Box {
   Eigen::Vector2d lo = Eigen::Vector2d::Constant(std::numeric_limits<double>::infinity());
   Eigen::Vector2d hi = -Eigen::Vector2d::Constant(std::numeric_limits<double>::infinity());
-  void add(const VtuMesh& m) {
+  void add(const toolkit::io::VtuMesh& m) {
     for (const auto& p : m.points) {
       lo = lo.cwiseMin(p);
       hi = hi.cwiseMax(p);
@@ -56,14 +56,14 @@ void set_view(Canvas& img, const Box& box, bool colourbar) {
 /// Fills every cell (fan triangulation), each triangle in the colour of the
 /// mean of its corner scalars (the sub-quads of the .vtu files are small).
 template <class ColourOf>
-void fill_cells(Canvas& img, const VtuMesh& m, const std::vector<double>& s, ColourOf colour) {
+void fill_cells(Canvas& img, const toolkit::io::VtuMesh& m, const std::vector<double>& s, ColourOf colour) {
   for (const auto& cell : m.cells)
     for (std::size_t k = 1; k + 1 < cell.size(); ++k)
       img.fill_polygon({m.points[cell[0]], m.points[cell[k]], m.points[cell[k + 1]]},
                        colour((s[cell[0]] + s[cell[k]] + s[cell[k + 1]]) / 3.0));
 }
 
-void draw_all_edges(Canvas& img, const VtuMesh& m, Rgb colour, double thickness) {
+void draw_all_edges(Canvas& img, const toolkit::io::VtuMesh& m, Rgb colour, double thickness) {
   for (const auto& cell : m.cells) {
     if (cell.size() == 2) img.draw_line(m.points[cell[0]], m.points[cell[1]], colour, thickness);
     if (cell.size() < 3) continue;
@@ -76,7 +76,7 @@ void draw_all_edges(Canvas& img, const VtuMesh& m, Rgb colour, double thickness)
 /// The image of the T-mesh (or analysis mesh) cells in a cell_grid_vtu file:
 /// each cell is a run of k x k sub-quads (row by row, corners (i,j), (i+1,j),
 /// (i+1,j+1), (i,j+1)); strokes the run's border as one closed curve.
-void draw_cell_borders(Canvas& img, const VtuMesh& m, Rgb colour, double thickness) {
+void draw_cell_borders(Canvas& img, const toolkit::io::VtuMesh& m, Rgb colour, double thickness) {
   const auto it = m.cell_scalars.find("cell");
   if (it == m.cell_scalars.end()) return draw_all_edges(img, m, colour, thickness);
   const std::vector<double>& id = it->second;
@@ -176,12 +176,12 @@ RenderSummary render_png(const std::string& dir_name, const std::string& png_pat
   if (options.width < 16 || options.height < 16 || options.width > 16384 || options.height > 16384)
     throw InputError("image size must be between 16 and 16384 pixels per side");
   const char* param = "tspline param";
-  write_atomic(png_path, [&](const std::string& tmp) {
+  toolkit::io::write_atomic(png_path, [&](const std::string& tmp) {
     Canvas img(format, tmp, options.width, options.height);
     switch (summary.view) {
       case RenderView::Jacobian: {
         const fs::path file = dir / "surface.vtu";
-        const VtuMesh m = read_output(file, param);
+        const toolkit::io::VtuMesh m = read_output(file, param);
         const std::vector<double>& jr = point_array(m, "mean_ratio_jacobian", file);
         // J_r lies in [0, 1] for a valid map; a fold (J_r < 0) is drawn red.
         auto colour = [](double v) { return v < 0.0 ? kRed : viridis(v); };
@@ -198,21 +198,21 @@ RenderSummary render_png(const std::string& dir_name, const std::string& png_pat
       }
       case RenderView::TMesh: {
         const fs::path file = dir / "surface.vtu";
-        const VtuMesh m = read_output(file, param);
+        const toolkit::io::VtuMesh m = read_output(file, param);
         Box box;
         box.add(m);
         set_view(img, box, false);
         fill_cells(img, m, std::vector<double>(m.points.size(), 0.0), [](double) { return kFill; });
         draw_cell_borders(img, m, kBlack, 1.0);
         const fs::path bfile = dir / "boundary.vtu";
-        if (fs::is_regular_file(bfile, ec)) draw_all_edges(img, read_vtu(bfile.string()), kRed, 1.0);
+        if (fs::is_regular_file(bfile, ec)) draw_all_edges(img, toolkit::io::read_vtu(bfile.string()), kRed, 1.0);
         summary.source = file.string();
         break;
       }
       case RenderView::ControlNet: {
         const fs::path file = dir / "control_net.vtu", bfile = dir / "boundary.vtu";
-        const VtuMesh net = read_output(file, param);
-        const VtuMesh boundary = read_output(bfile, param);
+        const toolkit::io::VtuMesh net = read_output(file, param);
+        const toolkit::io::VtuMesh boundary = read_output(bfile, param);
         Box box;
         box.add(net);
         box.add(boundary);
@@ -226,7 +226,7 @@ RenderSummary render_png(const std::string& dir_name, const std::string& png_pat
       }
       case RenderView::Solution: {
         const fs::path file = solution_step(dir, options.step);
-        const VtuMesh m = read_vtu(file.string());
+        const toolkit::io::VtuMesh m = toolkit::io::read_vtu(file.string());
         const std::vector<double>& u = point_array(m, "u_h", file);
         const double lo = *std::min_element(u.begin(), u.end()), hi = *std::max_element(u.begin(), u.end());
         const double span = hi > lo ? hi - lo : 1.0;

@@ -21,7 +21,7 @@
 #include <tuple>
 
 #include "tspline/errors.h"
-#include "tspline/io/atomic_file.h"
+#include "toolkit/io/atomic_file.h"
 
 namespace tspline::io {
 
@@ -69,7 +69,7 @@ void check_meta(const TSplineMap& map, const TSplineFileMeta& meta) {
 }  // namespace
 
 void write_tspline_file(const std::string& path, const TSplineMap& map, const TSplineFileMeta& meta) {
-  write_text_atomic(path, tspline_file_text(map, meta));
+  toolkit::io::write_text_atomic(path, tspline_file_text(map, meta));
 }
 
 std::string tspline_file_text(const TSplineMap& map, const TSplineFileMeta& meta) {

@@ -34,7 +34,7 @@
 #include <string>
 #include <vector>
 
-#include "tspline/poisson.h"
+#include "tspline/analysis/poisson.h"
 
 namespace tspline::petsc {
 

@@ -6,7 +6,7 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
-#include "tspline/tspline_map.h"
+#include "tspline/spline/tspline_map.h"
 
 namespace tspline::io {
 

@@ -3,8 +3,8 @@
 #include <Eigen/Core>
 #include <functional>
 
-#include "tspline/io/vtu_writer.h"
-#include "tspline/tmesh.h"
+#include "toolkit/io/vtu_writer.h"
+#include "tspline/tmesh/tmesh.h"
 
 namespace tspline::io {
 
@@ -13,7 +13,7 @@ namespace tspline::io {
 /// (T-mesh cell id) and `level`. `sample(c, uv)` returns the physical point for
 /// the grid point uv of cell c; callers record their own point data in it, in
 /// call order. \throw std::invalid_argument unless 1 <= k <= 64.
-VtuMesh cell_grid_vtu(const TMesh& mesh, int k,
+toolkit::io::VtuMesh cell_grid_vtu(const TMesh& mesh, int k,
                       const std::function<Eigen::Vector2d(int, const Eigen::Vector2d&)>& sample);
 
 }  // namespace tspline::io

@@ -3,19 +3,19 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
-#include "tspline/parameterization.h"
-#include "tspline/io/vtu_writer.h"
+#include "tspline/pipeline/parameterization.h"
+#include "toolkit/io/vtu_writer.h"
 
 namespace tspline::io {
 
 /// The T-mesh as VTK polygons (each cell includes its hanging vertices) at the
 /// given vertex positions, with cell data level, valid, min_quality and point
 /// data hanging, boundary, and the parametric coordinates.
-VtuMesh tmesh_vtu(const TMesh& mesh, const std::vector<Eigen::Vector2d>& positions);
+toolkit::io::VtuMesh tmesh_vtu(const TMesh& mesh, const std::vector<Eigen::Vector2d>& positions);
 
 /// The polygon as line cells plus one vertex cell per corner; point data
 /// file_index and corner (0..3 for the corners, -1 elsewhere), cell data side.
-VtuMesh boundary_vtu(const BoundaryMap& boundary);
+toolkit::io::VtuMesh boundary_vtu(const BoundaryMap& boundary);
 
 /// The JSON report: counts, tolerance, corners, inverted cells after Coons and
 /// after optimization, quality statistics, sweeps and per-stage wall times.

@@ -13,7 +13,7 @@
 #include <string>
 #include <vector>
 
-#include "tspline/polygon.h"
+#include "tspline/boundary/polygon.h"
 
 namespace tspline::io {
 

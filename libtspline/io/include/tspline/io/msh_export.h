@@ -23,7 +23,7 @@
 #include <cstddef>
 #include <string>
 
-#include "tspline/tspline_map.h"
+#include "tspline/spline/tspline_map.h"
 
 namespace tspline::io {
 

@@ -6,7 +6,7 @@
 #include <vector>
 
 #include "tspline/io/tspline_file.h"
-#include "tspline/patch_layout.h"
+#include "tspline/multipatch/patch_layout.h"
 
 namespace tspline::io {
 

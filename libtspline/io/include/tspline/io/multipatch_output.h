@@ -7,14 +7,14 @@
 #include <string>
 #include <vector>
 
-#include "tspline/io/vtu_writer.h"
-#include "tspline/multipatch_parameterization.h"
+#include "toolkit/io/vtu_writer.h"
+#include "tspline/multipatch/multipatch_parameterization.h"
 
 namespace tspline::io {
 
 /// The meshes one after the other, with an Int32 cell array `patch` (the index
 /// in `parts`); arrays not present in every part are dropped.
-VtuMesh merge_patches(const std::vector<VtuMesh>& parts);
+toolkit::io::VtuMesh merge_patches(const std::vector<toolkit::io::VtuMesh>& parts);
 
 /// Report: per patch the single-patch report (param_report), per interface the
 /// gap and knots, and the totals (cells, elements, functions, certification,

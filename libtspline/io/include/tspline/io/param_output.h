@@ -6,22 +6,22 @@
 #include <string>
 #include <vector>
 
-#include "tspline/adaptive_parameterization.h"
-#include "tspline/io/vtu_writer.h"
+#include "tspline/pipeline/adaptive_parameterization.h"
+#include "toolkit/io/vtu_writer.h"
 
 namespace tspline::io {
 
 /// The map sampled on every cell with k x k sub-quads. Point data:
 /// mean_ratio_jacobian (J_r = 2 det J / |J|^2), det_jacobian, scaled_jacobian,
 /// parametric (xi, eta). Cell data: cell (T-mesh cell id), level.
-VtuMesh surface_vtu(const TSplineMap& map, int samples);
+toolkit::io::VtuMesh surface_vtu(const TSplineMap& map, int samples);
 
 /// The control points as vertex cells (one per function, first), then the
 /// control net as line cells: T-mesh edges between the anchors of their end
 /// vertices, and each border/corner extra function joined to its vertex's
 /// anchor. Point data kind (0 anchor, 1 edge extra, 2 corner extra) and
 /// function (index).
-VtuMesh control_net_vtu(const TSplineMap& map);
+toolkit::io::VtuMesh control_net_vtu(const TSplineMap& map);
 
 /// Writes adapt/mesh_NNN.vtu and adapt/surface_NNN.vtu for each iteration (the
 /// adapt/ folder is created on the first one) and,
@@ -36,7 +36,7 @@ class AdaptSeriesWriter {
  private:
   std::string out_dir_;
   int samples_;
-  std::vector<PvdEntry> entries_;
+  std::vector<toolkit::io::PvdEntry> entries_;
 };
 
 /// Full report: the front-half report plus the T-spline (functions, control

@@ -4,7 +4,7 @@
 #include <string>
 #include <vector>
 
-#include "tspline/polygon.h"
+#include "tspline/boundary/polygon.h"
 
 namespace tspline::io {
 

@@ -6,8 +6,8 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
-#include "tspline/polygon.h"
-#include "tspline/tspline_map.h"
+#include "tspline/boundary/polygon.h"
+#include "tspline/spline/tspline_map.h"
 
 namespace tspline::io {
 

@@ -1,0 +1,47 @@
+#pragma once
+// The adaptive loop of the IGA Poisson solver: solve (poisson_solver.h),
+// estimate (poisson_estimator.h), mark the cells with eta_e > gamma max eta and
+// split them with their refinement patch, or split every cell (uniform), repeat.
+#include <cstddef>
+#include <functional>
+#include <vector>
+
+#include "tspline/analysis/poisson_estimator.h"
+#include "tspline/analysis/poisson_solver.h"
+
+namespace tspline {
+
+struct AdaptiveSolveOptions {
+  enum class Refine { Adaptive, Uniform };
+  Refine refine = Refine::Adaptive;
+  int steps = 5;                ///< number of solves (>= 1)
+  double gamma = 0.5;           ///< marking parameter in [0,1]
+  std::size_t max_dofs = 200000;  ///< stop before a solve on a space with more DOFs
+  InteriorSystemSolver* solver = nullptr;  ///< external solver (see solve_poisson); not owned
+};
+
+struct PoissonStep {
+  int step = 0;
+  std::size_t dofs = 0;
+  std::size_t cells = 0;
+  double eta = 0.0;  ///< sqrt(sum eta_e^2)
+  bool has_errors = false;
+  PoissonErrors errors;
+  SolverStats solver;
+  double assembly_seconds = 0.0;
+  double seconds = 0.0;  ///< whole step (solve, errors, estimator)
+  std::size_t marked = 0;   ///< cells marked by the estimator (all cells for uniform refinement)
+  std::size_t refined = 0;  ///< cells split for the next step (marked cells and their refinement patch)
+  bool eta_at_roundoff = false;  ///< estimator below kRoundoffResidual of its scale: nothing refined
+};
+
+/// Called after each step with its record, the solution and the per-cell eta.
+using PoissonStepCallback =
+    std::function<void(const PoissonStep&, const PoissonSolution&, const std::vector<double>& eta)>;
+
+/// Solve, estimate, mark (adaptive) or split all cells (uniform), repeat.
+/// \throw InputError for bad options (steps < 1, gamma outside [0,1]).
+std::vector<PoissonStep> solve_adaptive(const TSplineMap& map, const PoissonProblem& problem,
+                                        const AdaptiveSolveOptions& options, const PoissonStepCallback& callback = {});
+
+}  // namespace tspline

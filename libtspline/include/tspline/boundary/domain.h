@@ -1,0 +1,39 @@
+#pragma once
+// A planar domain with holes: an outer ring and hole rings, validated as a
+// whole (every ring simple, holes strictly inside the outer ring, no two rings
+// crossing or touching, no hole inside another).
+#include <Eigen/Core>
+#include <string>
+#include <vector>
+
+#include "tspline/boundary/polygon.h"
+
+namespace tspline {
+
+/// The outer boundary and the holes, each a Polygon in its file's numbering.
+/// After validate_domain() every ring is oriented counter-clockwise (the
+/// domain lies to the left of the outer ring and to the right of each hole).
+struct Domain {
+  Polygon outer;
+  std::vector<Polygon> holes;
+};
+
+/// Name of ring r in messages: ring 0 is "the outer ring", ring k >= 1 is "hole k".
+std::string ring_name(std::size_t r);
+
+/// Validates and orients the domain.
+/// \throw InputError with one line naming the rings and edges (file vertex
+/// indices of the ring): a ring that is not a simple polygon (prefixed with the
+/// ring's name), "hole 2 crosses the outer ring: edge 4-5 of hole 2 and edge
+/// 0-1 of the outer ring intersect near (x, y)" (also for touching rings), "hole
+/// 1 lies outside the outer ring", "hole 3 lies inside hole 1".
+Domain validate_domain(Domain d);
+
+/// Area of the outer ring minus the areas of the holes (a validated domain).
+double domain_area(const Domain& d);
+
+/// Whether p lies strictly inside the domain (inside the outer ring and
+/// outside every hole; points on a ring count as outside).
+bool domain_contains(const Domain& d, const Eigen::Vector2d& p);
+
+}  // namespace tspline

@@ -1,0 +1,44 @@
+#pragma once
+// Internal to libtspline: polynomials on [0,1]^2 in the tensor-product
+// Bernstein basis and their exact arithmetic (product, derivatives, de
+// Casteljau subdivision), for the certification of det J > 0
+// (validity/map_certification.h). Not part of the public interface.
+#include <array>
+
+namespace tspline::detail {
+
+/// A polynomial of bidegree (m, n) <= (8, 8) on [0,1]^2 in the Bernstein basis:
+/// p(s, t) = sum_{i<=m, j<=n} c[i + (m+1) j] B_i^m(s) B_j^n(t).
+struct BernsteinPoly {
+  static constexpr int kMaxDegree = 8;
+  int m = 0, n = 0;
+  std::array<double, (kMaxDegree + 1) * (kMaxDegree + 1)> c{};
+
+  BernsteinPoly() = default;
+  BernsteinPoly(int m_, int n_);
+  int size() const { return (m + 1) * (n + 1); }
+  double& at(int i, int j) { return c[i + (m + 1) * j]; }
+  double at(int i, int j) const { return c[i + (m + 1) * j]; }
+  double min_coefficient() const;
+  double max_abs_coefficient() const;
+  /// Direct evaluation (sum of coefficients times basis values).
+  double operator()(double s, double t) const;
+};
+
+/// Product: (m1+m2, n1+n2), c_ij = sum a_{i1 j1} b_{i2 j2} binom(m1,i1) binom(m2,i2) / binom(m,i) (same in
+/// j).
+BernsteinPoly bernstein_product(const BernsteinPoly& a, const BernsteinPoly& b);
+/// d/ds (degree m-1 in s): m (c_{i+1,j} - c_{i,j}). Requires m >= 1.
+BernsteinPoly bernstein_ds(const BernsteinPoly& a);
+/// d/dt (degree n-1 in t). Requires n >= 1.
+BernsteinPoly bernstein_dt(const BernsteinPoly& a);
+/// a + f b, same bidegree.
+BernsteinPoly bernstein_axpy(const BernsteinPoly& a, double f, const BernsteinPoly& b);
+/// The four quarters of [0,1]^2 split at s = t = 1/2 (de Casteljau), each
+/// re-parameterized on [0,1]^2: SW, SE, NW, NE.
+std::array<BernsteinPoly, 4> bernstein_subdivide(const BernsteinPoly& p);
+
+/// The Bernstein basis values B_i^deg(s), i = 0..deg (deg <= BernsteinPoly::kMaxDegree), into out[0..deg].
+void bernstein_values(int deg, double s, double* out);
+
+}  // namespace tspline::detail

@@ -1,0 +1,80 @@
+#pragma once
+// Maps of domains with holes: the domain is cut into four-sided patches
+// (patch_layout.h; automatic_cuts.h unless the cuts are given), each patch goes
+// through the single-patch pipeline (run_parameterization) with its corners at
+// its cut ends, and the interfaces are made conforming: the two patches along
+// a cut are run with the union of their border knots on it (the same dyadic
+// parameters, mirrored: the patches traverse the cut in opposite directions)
+// until their boundary curves agree. Both curves are then the cubic spline
+// interpolant of the same points at the same knots (tspline_fit.h: on the
+// border of [0,1]^2 the map is a univariate spline determined by the border
+// interpolation points alone; later refinement reproduces it exactly), so the
+// two images of an interface agree to round-off.
+#include <Eigen/Core>
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "tspline/pipeline/adaptive_parameterization.h"
+#include "tspline/boundary/domain.h"
+#include "tspline/multipatch/patch_layout.h"
+
+namespace tspline {
+
+struct MultiPatchOptions {
+  /// Rounds of re-running the patches of non-conforming interfaces at most.
+  int max_sync_rounds = 4;
+  /// An interface conforms when its two images differ by at most this times
+  /// the domain's bounding-box diagonal (sampled at the knots and between).
+  double gap_tolerance = 1e-12;
+};
+
+struct InterfaceReport {
+  double max_gap = 0.0;          ///< largest distance between the two images (sampled)
+  std::size_t knots_a = 0, knots_b = 0;  ///< border vertices of the two sides (both corners included)
+  bool same_knots = false;       ///< the two sides carry the same knots (mirrored)
+};
+
+struct MultiPatchResult {
+  Domain domain;  ///< validated
+  PatchLayout layout;
+  std::string cuts_explanation;  ///< automatic choice, or "given"
+  std::vector<ParameterizationResult> patches;
+  std::vector<InterfaceReport> interfaces;
+  int sync_rounds = 0;           ///< rounds of re-running patches (0: conforming at once)
+  double diameter = 0.0;         ///< bounding-box diagonal of the domain
+  double domain_area = 0.0;      ///< polygon areas: outer minus holes
+  double map_area = 0.0;         ///< sum over patches of the integral of det J
+  double max_gap() const;
+  bool conforming(double gap_tolerance) const { return max_gap() <= gap_tolerance * diameter; }
+  bool valid() const;
+  bool certified_valid() const;
+  double min_relative_det_bound() const;  ///< min over patches of the certified relative lower bound
+  double min_mean_ratio_dense() const;    ///< min over patches of J_r over the dense sample
+  double min_mean_ratio_gauss() const;    ///< min over patches of J_r at Gauss points
+};
+
+/// Area of the image of the map: the integral of det J over [0,1]^2 (4 x 4
+/// Gauss points on every Bezier element, exact up to the rational weights).
+double map_area(const TSplineMap& map);
+
+/// The largest distance between S_a(side_a at t) and S_b(side_b at 1 - t) over
+/// 64 equal steps of t and the border knots of both sides.
+double interface_gap(const TSplineMap& a, int side_a, const TSplineMap& b, int side_b);
+
+/// Parametric point of chord parameter t on `side` (boundary_map.h orientation).
+Eigen::Vector2d side_point_uv(int side, double t);
+
+/// Called when a patch starts (patch index, round) for progress lines.
+using PatchCallback = std::function<void(std::size_t patch, int round)>;
+
+/// \param cuts the cuts, or nullopt for the automatic choice.
+/// \throw InputError for an invalid domain or cuts, or no automatic layout;
+/// NumericalError as run_parameterization.
+MultiPatchResult run_multipatch_parameterization(const Domain& domain, const std::optional<std::vector<Cut>>& cuts,
+                                                 const ParameterizationOptions& options,
+                                                 const AdaptiveOptions& adaptive, const MultiPatchOptions& multi = {},
+                                                 const PatchCallback& on_patch = {});
+
+}  // namespace tspline

@@ -1,0 +1,131 @@
+#pragma once
+// The whole parameterization, in named steps:
+//  1. front half (Brovka 2013 Sects. 3-4): T-mesh adapted to the boundary,
+//     Coons start, weighted K* untangling and smoothing of the T-mesh;
+//  2. first map: the cubic T-spline interpolating the T-mesh (Sect. 5). Its
+//     border control points define the boundary curve, frozen from here on;
+//     det J at the four corners of the square (the cross product of the two
+//     boundary tangents there, which no interior move changes) is checked;
+//  3. global untangling and smoothing of the map's own interior control points
+//     until det J > 0 is certified on every Bezier element (map_untangling.h);
+//  4. quality: mean ratio J_r at Gauss points (the paper's check, Sect. 6.1),
+//     over a dense sample of every element, and the certificate;
+//  5. if not certified or J_r < delta somewhere: refine those cells (the
+//     uncertified ones with a ring of neighbours), re-balance, carry the
+//     current map onto the finer T-mesh (transfer_map: the boundary curve is
+//     reproduced exactly) and go on from it at step 3 (Sect. 6.2, without
+//     re-interpolating from scratch).
+#include <functional>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "tspline/validity/map_certification.h"
+#include "tspline/validity/map_quality.h"
+#include "tspline/validity/map_untangling.h"
+#include "tspline/pipeline/parameterization.h"
+#include "tspline/spline/tspline_fit.h"
+#include "tspline/spline/tspline_map.h"
+
+namespace tspline {
+
+struct AdaptiveOptions {
+  double min_jacobian = 0.2;  ///< delta: refine cells where J_r < delta at some Gauss point
+  int max_adapt = 10;         ///< adaptive rounds at most
+  int gauss = 4;              ///< Gauss points per direction and cell for the check
+  /// Stop when the best iteration (fewest det J <= 0 points, then certified
+  /// valid before not, then highest min J_r) has not improved for this many rounds: refinement cannot fix
+  /// distortion that the corner choice imposes (a long strip mapped onto the
+  /// square keeps its aspect ratio however fine the mesh).
+  int stall_rounds = 2;
+  /// Once the map is certified, refine for J_r < delta only while each round
+  /// raises the whole-map min J_r by at least this fraction (where the minimum
+  /// is set by the boundary and the corners, refinement only adds cells:
+  /// Hispaniola went from 0.077 to 0.096 over 5 rounds and 1,057 to 55,774 cells).
+  /// 0 disables this stop.
+  double min_quality_gain = 0.1;
+  /// Once certified, no round refines more than this fraction of the cells for
+  /// J_r < delta alone (measured on Newfoundland: 3,647 of 6,964 cells below
+  /// 0.2 after certification; three more rounds reached 59,506 cells for a
+  /// minimum of 0.024 -> 0.032).
+  double max_quality_fraction = 0.25;
+  /// Never refine beyond this many cells.
+  std::size_t max_cells = 200000;
+  /// Untangle and smooth the interior control points of every map globally
+  /// (map_untangling.h). false: keep the interpolating map of the T-mesh.
+  bool optimize_control_points = true;
+  MapUntanglingOptions untangling;
+  /// dense_map_quality: (k + 1)^2 samples per Bezier element.
+  int dense_samples = 8;
+  /// Certify det J > 0 on every Bezier element after each fit; refine the cells
+  /// that are not certified, and stop only once the map is certified.
+  bool certify = true;
+  CertificationOptions certification;
+};
+
+struct AdaptIteration {
+  std::size_t cells = 0;
+  std::size_t vertices = 0;
+  std::size_t functions = 0;
+  std::size_t inverted_cells = 0;  ///< of the optimized T-mesh
+  std::size_t refined_cells = 0;   ///< cells marked after this iteration (0 for the last)
+  FitReport fit;                   ///< interpolation (iteration 0) or transfer of the previous map
+  bool control_points_optimized = false;
+  /// The global untangling of this iteration (no per-element data).
+  MapUntanglingReport untangling;
+  MapQualityStats quality;         ///< of the map kept in this iteration, at Gauss points
+  DenseMapQuality dense_quality;   ///< of that map, over a dense sample of every element
+  /// Certification of that map (counts and bounds; no per-cell data).
+  MapCertification certification;
+  std::size_t certification_marked_cells = 0;  ///< cells marked only because they are not certified
+  double seconds = 0.0;            ///< fit or transfer + untangling + checks
+};
+
+struct ParameterizationResult {
+  explicit ParameterizationResult(FrontResult f) : front(std::move(f)) {}
+  FrontResult front;  ///< mesh/optimized/quality_optimized are those of the kept T-mesh
+  std::optional<TSplineMap> map;
+  FitReport fit;
+  MapQualityStats quality;          ///< at Gauss points
+  /// Over a dense sample of every Bezier element and the Gauss points (the
+  /// smaller of the two minima; worst_at is a cell centre if a Gauss point is worse).
+  DenseMapQuality dense_quality;
+  std::vector<CellMapQuality> cell_quality;
+  std::vector<AdaptIteration> iterations;
+  int kept_iteration = 0;       ///< the best iteration, whose mesh and map these are
+  /// Whether the kept map's interior control points were optimized (so it does
+  /// not interpolate the interior T-mesh vertices).
+  bool control_points_optimized = false;
+  std::string stop_reason;      ///< why the adaptive loop stopped
+  /// Empty, or why no interior move can make the map valid (det J <= 0 at a
+  /// corner of the square, decided by the frozen boundary curve alone).
+  std::string boundary_problem;
+  bool boundary_simple = false;  ///< the frozen boundary curve is proven simple (boundary_curve.h)
+  MapCertification certification;  ///< of the kept map (empty if AdaptiveOptions::certify is off)
+  /// Refinement rounds made only because of the certification: the map was
+  /// valid and good at every Gauss point but not certified on every element.
+  int certification_rounds = 0;
+  /// The options this result was computed with (without the progress
+  /// callback), so that reports and writers need nothing else.
+  ParameterizationOptions options;
+  AdaptiveOptions adaptive;
+  bool valid() const { return quality.nonpositive_det == 0; }
+  bool certified_valid() const { return certification.certified_valid(); }
+  /// Valid and J_r >= adaptive.min_jacobian at every Gauss point (the paper's criterion).
+  bool good() const { return valid() && quality.min_mean_ratio >= adaptive.min_jacobian; }
+};
+
+/// Called after each fit with the iteration number (0 = first fit), the T-mesh,
+/// its physical vertex positions, the map and its per-cell quality.
+using IterationCallback = std::function<void(int, const TMesh&, const std::vector<Eigen::Vector2d>&,
+                                             const TSplineMap&, const std::vector<CellMapQuality>&)>;
+
+/// \throw InputError naming the first option out of range (options_validation.cpp).
+void validate_options(const AdaptiveOptions& options);
+
+/// \throw InputError for invalid input or options; NumericalError if a fit fails.
+ParameterizationResult run_parameterization(const Polygon& polygon, const ParameterizationOptions& options,
+                                            const AdaptiveOptions& adaptive, const IterationCallback& on_iteration = {});
+
+}  // namespace tspline

@@ -1,0 +1,109 @@
+#pragma once
+// The front half of the parameterization pipeline (Brovka 2013 Sects. 3-4):
+// validated polygon -> corners -> chord-length boundary map -> adapted balanced
+// T-mesh -> Coons start -> weighted K* untangling and smoothing.
+#include <Eigen/Core>
+#include <array>
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "meshopt/node_smoother.h"
+#include "tspline/boundary/border_knots.h"
+#include "tspline/boundary/boundary_map.h"
+#include "tspline/boundary/boundary_refinement.h"
+#include "tspline/tmesh/mesh_quality.h"
+#include "tspline/boundary/polygon.h"
+#include "tspline/pipeline/progress_event.h"
+#include "tspline/tmesh/tmesh.h"
+
+namespace tspline {
+
+struct ParameterizationOptions {
+  /// Corner vertex indices in the file's own numbering; automatic if empty.
+  std::optional<std::array<long long, 4>> corners;
+  /// Automatic corners: how many of the best choices to try (the whole front
+  /// half, initial level capped at 5) before keeping one by best_corner_trial
+  /// (a trial over --max-cells ranks last). 1: no trials.
+  int corner_trials = 4;
+  /// Boundary tolerance epsilon (an AREA, Sect. 3). If unset, epsilon =
+  /// tolerance_relative * (bounding-box diagonal)^2.
+  std::optional<double> tolerance_absolute;
+  double tolerance_relative = 1e-5;
+  /// Initial uniform level: 2^L x 2^L cells before boundary refinement.
+  int initial_level = 3;
+  /// No cell is refined beyond this level.
+  int max_level = 22;
+  /// The T-mesh never has more cells than this (`--max-cells`, the same budget
+  /// as AdaptiveOptions::max_cells): boundary refinement that needs more throws
+  /// InputError; repair rounds that would exceed it stop (repair_stop_reason).
+  std::size_t max_cells = 200000;
+  /// If inverted cells remain after optimization, refine them, re-balance,
+  /// re-optimize; at most this many rounds (0 disables the repair).
+  int max_repair_rounds = 8;
+  /// Optimize on a nested sequence of coarser T-meshes first (same final mesh,
+  /// far fewer sweeps on fine meshes). false: optimize the final mesh from Coons.
+  bool nested_optimization = true;
+  /// Border parameters per side that must be T-mesh vertices from the first
+  /// mesh on (multi-patch maps: both sides of an interface get the same knots).
+  BorderParams border_params;
+  /// Node optimization settings (libmeshopt).
+  meshopt::SmoothingOptions smoothing;
+  /// Progress events (progress_event.h); may be empty.
+  ProgressCallback progress;
+};
+
+struct StageTime {
+  std::string stage;
+  double seconds = 0.0;
+};
+
+/// One automatic corner choice tried on a coarser T-mesh.
+struct CornerTrial {
+  std::array<std::size_t, 4> corners{};  ///< indices into the CCW polygon
+  std::size_t inverted_cells = 0;
+  double min_quality = 0.0;
+  double mean_quality = 0.0;
+};
+
+/// The rule that keeps one of the corner trials: the fewest inverted cells,
+/// then the highest min + mean triangle quality; the first of equal trials.
+/// Returns its index (0 for an empty list).
+std::size_t best_corner_trial(const std::vector<CornerTrial>& trials);
+
+/// Everything the front half produces, for writers and reports.
+struct FrontResult {
+  explicit FrontResult(BoundaryMap b) : boundary(std::move(b)) {}
+  BoundaryMap boundary;
+  TMesh mesh = TMesh(0);
+  double tolerance_area = 0.0;
+  bool tolerance_is_relative = true;
+  BoundaryRefinementReport refinement;
+  std::vector<Eigen::Vector2d> coons;      ///< positions after the Coons start (on the T-mesh before any repair)
+  std::vector<Eigen::Vector2d> optimized;  ///< after untangling and smoothing
+  MeshQualityStats quality_coons;  ///< of the Coons start, on the T-mesh before any repair
+  MeshQualityStats quality_optimized;
+  meshopt::SmoothingReport smoothing;  ///< of the last optimization run
+  int total_sweeps = 0;                 ///< over all optimization runs
+  std::size_t node_visits = 0;          ///< node optimizations over all runs
+  /// Cells refined in each repair round (inverted cells after optimization).
+  std::vector<std::size_t> repair_refined_cells;
+  /// Why the repair stopped with inverted cells left ("" if none are left or
+  /// the repair rounds ran out).
+  std::string repair_stop_reason;
+  std::vector<CornerTrial> corner_trials;  ///< empty unless automatic corners were tried
+  std::vector<StageTime> times;
+  /// What clean_polygon removed from the input (file numbering), one note each.
+  std::vector<std::size_t> removed_vertices;
+  std::vector<std::string> cleaning_notes;
+};
+
+/// \throw InputError naming the first option out of range (options_validation.cpp).
+void validate_options(const ParameterizationOptions& options);
+
+/// Runs the front half on a polygon as read from a file (not yet validated).
+/// \throw InputError for invalid polygons, corners or options.
+FrontResult run_front(const Polygon& polygon, const ParameterizationOptions& options);
+
+}  // namespace tspline

@@ -1,0 +1,152 @@
+#pragma once
+// The distortion energy of a T-spline map as a function of its free control
+// points, for the global untangling and smoothing of the map itself
+// (map_untangling.h).
+//
+// The energy is the regularized one of Garanzha, Kaporin, Kudryavtseva,
+// Protais, Ray, Sokolov, "Foldover-free maps in 50 lines of code", ACM TOG
+// 40(4), 2021 (Eqs. 2-4 there), summed over sample points q of the Bezier
+// elements of the map (bezier_extraction.h):
+//
+//   E_eps = sum_q w_q [ (1 - theta) |J_q|_F^2 + theta (det J_q^2 + 1) ] / chi(det J_q, eps),
+//   chi(D, eps) = (D + sqrt(eps^2 + D^2)) / 2,
+//
+// with J_q = dS/d(xi, eta) / L, L^2 the area of the domain, so that the ideal
+// element is the parametric square scaled to the domain's area and det J = 1
+// on average. chi > 0 for every D, so E_eps is defined and smooth on tangled
+// maps; as eps -> 0, chi -> max(D, 0) and the first term tends to 2 / J_r
+// (J_r = 2 det J / |J|^2, the mean ratio of Brovka 2013 Eq. 9) on valid
+// points and to +infinity on folded ones: the same regularization as the K*
+// objective of Brovka Sect. 4 with h(sigma). The second term (theta = 1/128
+// as in the paper) keeps the element areas from collapsing.
+//
+// Samples: on every element, n x n Gauss-Lobatto (or Gauss) points on each of 2^l x 2^l equal
+// sub-squares (sample level l, per element; raised where a certificate fails,
+// so that the energy sees a fold between the samples of level 0). The weight
+// w_q is the Gauss weight times the sub-square's share of the element times
+// the element weight: its parametric area (the energy approximates an
+// integral over [0,1]^2) or 1 for every element (every element counts
+// equally, like the cells of the T-mesh objective; the default, see below).
+//
+// Free variables: the control points of the functions that vanish on the
+// border of [0,1]^2 (touches_border is false), in normalized coordinates
+// (P - centre) / L; the border control points define the boundary curve and
+// stay fixed.
+//
+// On an element the map is S = X / w with X = sum_a P_a N_a and w = sum_a N_a
+// in Bernstein form (X_k = sum_r P_r C(r, k)), so the energy and its exact
+// gradient cost O(samples x 16 + functions x 16) per element, without storing
+// basis values per sample.
+#include <Eigen/Core>
+#include <cstddef>
+#include <vector>
+
+#include "tspline/spline/bezier_extraction.h"
+#include "tspline/spline/tspline_map.h"
+
+namespace tspline {
+
+enum class ElementWeighting {
+  Uniform,  ///< every Bezier element has weight 1
+  Area      ///< weight = parametric area (an integral over the square)
+};
+
+struct MapEnergyOptions {
+  /// Points per direction per sub-square: Gauss-Lobatto (end points
+  /// included, n in [3, 5]) or Gauss-Legendre (n in [1, 6]).
+  int gauss = 5;
+  /// Gauss-Lobatto: samples on every element's corners and edges too. Measured
+  /// on Newfoundland: with 4 x 4 Gauss-Legendre points the optimizer folded the
+  /// map between samples along element edges (1,317 folded samples after the
+  /// first sample refinement, then a long second continuation).
+  bool lobatto = true;
+  double theta = 1.0 / 128;  ///< weight of the area term, in [0, 1)
+  int max_sample_level = 3;  ///< sample levels 0..this (2^l x 2^l sub-squares per element)
+  /// Uniform: small elements along a detailed coastline count as much as large
+  /// interior ones, which is where maps fold (measured on the bundled
+  /// coastlines: fewer continuation stages than Area).
+  ElementWeighting weighting = ElementWeighting::Uniform;
+  /// Threads for the energy and gradient (0: std::thread::hardware_concurrency).
+  int threads = 0;
+  /// Per basis function: may it move? Empty: every function not touching the
+  /// border. Otherwise only those marked (and not touching the border) are
+  /// variables, and only the elements they touch enter the energy (a local
+  /// problem: the rest of the map is fixed and adds a constant).
+  std::vector<char> movable;
+};
+
+/// Statistics over the current sample points (not a certificate).
+struct SampleStats {
+  std::size_t points = 0;
+  std::size_t nonpositive = 0;  ///< samples with det J <= 0
+  double min_det = 0.0;         ///< min det J / L^2 (normalized: 1 on average)
+  double min_mean_ratio = 0.0;  ///< min J_r
+  double mean_mean_ratio = 0.0; ///< weighted mean J_r
+};
+
+class MapEnergy {
+ public:
+  /// \throw std::invalid_argument for options out of range or a map whose
+  /// domain has no positive area.
+  MapEnergy(const TSplineMap& map, const MapEnergyOptions& options = {});
+
+  std::size_t num_variables() const { return 2 * free_functions_.size(); }
+  /// Indices (into the basis) of the functions whose control points are free.
+  const std::vector<int>& free_functions() const { return free_functions_; }
+  std::size_t num_elements() const { return elements_.size(); }
+  const BezierExtraction& extraction() const { return extraction_; }
+  double length_scale() const { return L_; }
+
+  /// The free coordinates of `map` (same basis as at construction), normalized.
+  Eigen::VectorXd variables(const TSplineMap& map) const;
+  /// All control points with the free ones taken from x.
+  std::vector<Eigen::Vector2d> control_points(const double* x) const;
+
+  /// E_eps at x; if gradient is not null, also dE/dx (num_variables() values);
+  /// if nonpositive is not null, the number of samples with det J <= 0.
+  /// With power p != 1 each sample's term is raised to p (sum_q w_q term_q^p):
+  /// p > 1 weighs the worst samples more, raising the minimum J_r rather than the mean.
+  double evaluate(const double* x, double eps, double* gradient, std::size_t* nonpositive = nullptr,
+                  double power = 1.0) const;
+  SampleStats stats(const double* x) const;
+
+  int sample_level(std::size_t element) const { return elements_[element].level; }
+  /// \pre 0 <= level <= max_sample_level.
+  void set_sample_level(std::size_t element, int level);
+  int max_sample_level() const { return options_.max_sample_level; }
+  std::size_t num_samples() const;
+
+ private:
+  struct Pattern {  // samples of one level on the unit square
+    std::vector<double> weight;              // sums to 1
+    std::vector<std::array<double, 16>> B;   // tensor Bernstein values
+    std::vector<std::array<double, 16>> Bs;  // d/ds
+    std::vector<std::array<double, 16>> Bt;  // d/dt
+  };
+  struct Element {
+    std::array<double, 16> W{};  // Bernstein coefficients of w = sum_a N_a
+    double hx = 1.0, hy = 1.0;   // parametric size
+    double weight = 1.0;
+    int level = 0;
+    bool active = true;  // touches a variable (else constant: left out)
+  };
+  // X and Y Bernstein coefficients of element k at the variables x.
+  void element_coefficients(std::size_t k, const double* x, std::array<double, 16>& X,
+                            std::array<double, 16>& Y) const;
+
+  MapEnergyOptions options_;
+  BezierExtraction extraction_;
+  std::vector<Element> elements_;
+  std::vector<Pattern> patterns_;
+  std::vector<int> variable_of_;             // per function: index of its x coordinate, or -1
+  std::vector<int> free_functions_;
+  std::vector<Eigen::Vector2d> normalized_;  // all control points, normalized
+  std::vector<Eigen::Vector2d> original_;    // as given (the fixed ones are returned exactly)
+  Eigen::Vector2d centre_ = Eigen::Vector2d::Zero();
+  double L_ = 1.0;
+};
+
+/// chi(D, eps) of the header, evaluated without cancellation for D < 0.
+double regularized_det(double D, double eps);
+
+}  // namespace tspline

@@ -1,0 +1,100 @@
+#pragma once
+// Global untangling and smoothing of a T-spline map: all interior control
+// points at once, until det J > 0 is certified on every Bezier element.
+//
+// Interpolating an untangled T-mesh says nothing about the interpolant between
+// its vertices; on real coastlines the cubic map folds there. This step moves
+// the map's own degrees of freedom, with the boundary curve fixed:
+//
+//  1. Minimize the regularized energy E_eps of map_energy.h with L-BFGS
+//     (Ceres' GradientProblemSolver) for a fixed eps, then lower eps by the
+//     rule of Garanzha et al. 2021 (Sect. 4 there): with sigma = max(1 -
+//     E/E_prev, 1/10) the relative progress of the stage and D_min the smallest
+//     sampled det J, mu = (1 - sigma) chi(D_min, eps), and eps = 2 sqrt(mu (mu -
+//     D_min)) if D_min < mu, else eps = eps_floor. Large eps makes the energy
+//     smooth and defined on folded maps; small eps turns it into a barrier on
+//     det J = 0, so the stages end as a quality optimization of a valid map.
+//  2. Samples are only samples: once every sample has det J > 0 the map is
+//     certified (map_certification.h) and the elements that are not certified
+//     get a finer sample level (map_energy.h), so that the next stages see the
+//     fold between the old samples.
+//  3. The last certified map is kept: later stages (the quality phase) cannot
+//     turn a certified map into an uncertified result. At the floor eps the
+//     energy refuses any step that makes a sample's det J <= 0.
+//
+// The map returned is the last certified one if there was one, else the last
+// iterate (then report.certified is false).
+#include <cstddef>
+#include <functional>
+#include <string>
+
+#include "tspline/validity/map_certification.h"
+#include "tspline/validity/map_energy.h"
+#include "tspline/spline/tspline_map.h"
+
+namespace tspline {
+
+struct UntanglingProgress {
+  int stage = 0;
+  double eps = 0.0;
+  double energy = 0.0;
+  int iterations = 0;  ///< L-BFGS iterations so far (all stages)
+  SampleStats samples;
+  bool certified = false;  ///< certified at the end of this stage
+};
+
+struct MapUntanglingOptions {
+  MapEnergyOptions energy;
+  /// eps continuation stages at most: a map that is still not certified then
+  /// needs more freedom (the adaptive loop refines where it fails) rather than
+  /// more stages (measured on Newfoundland: 80 stages of 20 iterations and two
+  /// sample refinements without a certificate on 3,247 cells).
+  int max_stages = 60;
+  int max_iterations_per_stage = 20;  ///< L-BFGS iterations per stage
+  int max_iterations = 20000;         ///< L-BFGS iterations in total
+  /// Stop once certified and a stage at the floor eps lowered the energy by
+  /// less than this fraction.
+  double energy_tolerance = 1e-3;
+  /// Exponent of each sample's term in the quality phase (at the floor eps):
+  /// 1 favours the mean of 1/J_r, larger values the minimum J_r.
+  double quality_power = 4.0;
+  /// Stages at the floor eps (the quality phase) once certified, at most.
+  int max_quality_stages = 3;
+  double eps_floor = 1e-9;  ///< smallest eps (normalized det J units)
+  /// Smallest relative decrease sigma of chi at the worst sample per stage
+  /// (Garanzha et al. use 1/10; 1/4 needed 33 instead of 54 stages on Bali,
+  /// 20 L-BFGS iterations per stage, and reached the same certified map).
+  double min_decrease = 0.25;
+  CertificationOptions certification;
+  /// When every sample is positive but some elements are not certified (folds
+  /// hidden between their samples): first untangle the control points of
+  /// those elements and of one ring of elements around them alone, with the
+  /// rest of the map fixed and finer samples there (a small problem), instead
+  /// of continuing on the whole map from a raised eps.
+  bool local_repair = true;
+  std::function<void(const UntanglingProgress&)> progress;
+};
+
+struct MapUntanglingReport {
+  std::size_t free_points = 0;
+  std::size_t fixed_points = 0;
+  std::size_t elements = 0;
+  std::size_t samples = 0;  ///< at the end (after sample refinement)
+  int stages = 0;
+  int iterations = 0;   ///< L-BFGS iterations
+  int evaluations = 0;  ///< energy + gradient evaluations
+  int sample_refinements = 0;  ///< elements whose sample level was raised
+  int local_repairs = 0;        ///< local problems solved for hidden folds (see local_repair)
+  int local_repairs_certified = 0;  ///< of which certified the map
+  SampleStats before, after;   ///< at the initial samples / at the final samples, of the returned map
+  bool certified = false;
+  MapCertification certification;  ///< of the returned map
+  std::string stop_reason;
+  double seconds = 0.0;
+};
+
+/// Moves the interior control points of `map` in place.
+/// \throw std::invalid_argument for options out of range.
+MapUntanglingReport untangle_map(TSplineMap& map, const MapUntanglingOptions& options = {});
+
+}  // namespace tspline

@@ -1,0 +1,140 @@
+// Validation of a domain with holes: each ring by validate_polygon, then the
+// rings against each other with CGAL's exact predicates (Epick).
+#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+#include <CGAL/Polygon_2_algorithms.h>
+#include <CGAL/box_intersection_d.h>
+
+#include <cctype>
+#include <cmath>
+#include <sstream>
+#include <utility>
+#include <vector>
+
+#include "tspline/boundary/domain.h"
+#include "tspline/errors.h"
+#include "tspline/boundary/polygon_validation.h"
+
+namespace tspline {
+namespace {
+
+using K = CGAL::Exact_predicates_inexact_constructions_kernel;
+using Point = K::Point_2;
+using Segment = K::Segment_2;
+// One box per edge; the info is (ring, edge index in that ring).
+using Box = CGAL::Box_intersection_d::Box_with_info_d<double, 2, std::pair<std::size_t, std::size_t>>;
+
+const Polygon& ring(const Domain& d, std::size_t r) { return r == 0 ? d.outer : d.holes[r - 1]; }
+
+Point point(const Eigen::Vector2d& v) { return {v.x(), v.y()}; }
+
+Segment edge(const Polygon& p, std::size_t e) {
+  return {point(p.vertices[e]), point(p.vertices[(e + 1) % p.vertices.size()])};
+}
+
+std::string edge_name(const Polygon& p, std::size_t e) {
+  const std::size_t n = p.vertices.size();
+  return std::to_string(p.file_index[e]) + "-" + std::to_string(p.file_index[(e + 1) % n]);
+}
+
+CGAL::Bounded_side side_of(const Polygon& p, const Eigen::Vector2d& x) {
+  std::vector<Point> pts;
+  pts.reserve(p.vertices.size());
+  for (const auto& v : p.vertices) pts.push_back(point(v));
+  return CGAL::bounded_side_2(pts.begin(), pts.end(), point(x), K());
+}
+
+// The first pair of edges of two different rings that intersect (cross,
+// touch or overlap), found by box intersection in O(n log n + k).
+void check_rings_disjoint(const Domain& d) {
+  std::vector<Box> boxes;
+  const std::size_t rings = d.holes.size() + 1;
+  for (std::size_t r = 0; r < rings; ++r) {
+    const Polygon& p = ring(d, r);
+    for (std::size_t e = 0; e < p.vertices.size(); ++e) boxes.emplace_back(edge(p, e).bbox(), std::make_pair(r, e));
+  }
+  struct Hit {
+    bool found = false;
+    std::pair<std::size_t, std::size_t> a, b;
+  } hit;
+  auto report = [&](const Box& x, const Box& y) {
+    if (x.info().first == y.info().first) return;  // within a ring: validate_polygon's job
+    const Segment s = edge(ring(d, x.info().first), x.info().second);
+    const Segment t = edge(ring(d, y.info().first), y.info().second);
+    if (!CGAL::do_intersect(s, t)) return;
+    auto a = x.info(), b = y.info();
+    if (a > b) std::swap(a, b);
+    if (!hit.found || std::make_pair(a, b) < std::make_pair(hit.a, hit.b)) hit = {true, a, b};
+  };
+  CGAL::box_self_intersection_d(boxes.begin(), boxes.end(), report);
+  if (!hit.found) return;
+  const Polygon& pa = ring(d, hit.a.first);
+  const Polygon& pb = ring(d, hit.b.first);
+  const Segment s = edge(pa, hit.a.second), t = edge(pb, hit.b.second);
+  const auto where = CGAL::intersection(s, t);
+  Point at = s.source();
+  if (where) {
+    if (const Point* q = boost::get<Point>(&*where)) at = *q;
+    else if (const Segment* q = boost::get<Segment>(&*where)) at = q->source();
+  }
+  // Crossing if each segment has endpoints strictly on both sides of the
+  // other; otherwise an endpoint lies on the other ring (touching).
+  const bool proper = CGAL::orientation(s.source(), s.target(), t.source()) *
+                              CGAL::orientation(s.source(), s.target(), t.target()) < 0 &&
+                      CGAL::orientation(t.source(), t.target(), s.source()) *
+                              CGAL::orientation(t.source(), t.target(), s.target()) < 0;
+  std::ostringstream m;
+  m.precision(10);
+  m << ring_name(hit.b.first) << (proper ? " crosses " : " touches ") << ring_name(hit.a.first) << ": edge "
+    << edge_name(pb, hit.b.second) << " of " << ring_name(hit.b.first) << " and edge " << edge_name(pa, hit.a.second)
+    << " of " << ring_name(hit.a.first) << (proper ? " intersect" : " meet") << " near (" << at.x() << ", "
+    << at.y() << "); holes must lie strictly inside the outer ring and apart from each other";
+  throw InputError(m.str());
+}
+
+}  // namespace
+
+std::string ring_name(std::size_t r) { return r == 0 ? "the outer ring" : "hole " + std::to_string(r); }
+
+Domain validate_domain(Domain d) {
+  auto validated = [](Polygon p, std::size_t r) {
+    try {
+      return validate_polygon(std::move(p));
+    } catch (const InputError& e) {
+      std::string name = ring_name(r);
+      name[0] = static_cast<char>(std::toupper(static_cast<unsigned char>(name[0])));
+      throw InputError(name + ": " + e.what());
+    }
+  };
+  d.outer = validated(std::move(d.outer), 0);
+  for (std::size_t h = 0; h < d.holes.size(); ++h) d.holes[h] = validated(std::move(d.holes[h]), h + 1);
+  check_rings_disjoint(d);
+  // No ring meets another: each hole lies entirely on one side of every other ring.
+  for (std::size_t h = 0; h < d.holes.size(); ++h) {
+    const Eigen::Vector2d x = d.holes[h].vertices.front();
+    if (side_of(d.outer, x) != CGAL::ON_BOUNDED_SIDE)
+      throw InputError(ring_name(h + 1) + " lies outside the outer ring (its vertex " +
+                       std::to_string(d.holes[h].file_index.front()) + " is not inside it)");
+    for (std::size_t g = 0; g < d.holes.size(); ++g) {
+      if (g == h) continue;
+      if (side_of(d.holes[g], x) == CGAL::ON_BOUNDED_SIDE)
+        throw InputError(ring_name(h + 1) + " lies inside " + ring_name(g + 1) +
+                         " (a hole in a hole is not part of the domain)");
+    }
+  }
+  return d;
+}
+
+double domain_area(const Domain& d) {
+  double a = signed_area(d.outer);
+  for (const Polygon& h : d.holes) a -= std::abs(signed_area(h));
+  return a;
+}
+
+bool domain_contains(const Domain& d, const Eigen::Vector2d& p) {
+  if (side_of(d.outer, p) != CGAL::ON_BOUNDED_SIDE) return false;
+  for (const Polygon& h : d.holes)
+    if (side_of(h, p) != CGAL::ON_UNBOUNDED_SIDE) return false;
+  return true;
+}
+
+}  // namespace tspline

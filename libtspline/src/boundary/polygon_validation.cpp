@@ -1,0 +1,285 @@
+// Validation of input polygons with CGAL's exact predicates (Epick: inexact
+// constructions, but orientation / do_intersect / collinearity are exact).
+#include "tspline/boundary/polygon_validation.h"
+
+#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+#include <CGAL/box_intersection_d.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstddef>
+#include <limits>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "tspline/errors.h"
+
+namespace tspline {
+namespace {
+
+using K = CGAL::Exact_predicates_inexact_constructions_kernel;
+using Point = K::Point_2;
+using Segment = K::Segment_2;
+// One box per edge; the info is the edge index i (edge i joins vertex i and i+1 mod n).
+using Box = CGAL::Box_intersection_d::Box_with_info_d<double, 2, std::size_t>;
+
+std::string fmt_point(double x, double y) {
+  std::ostringstream os;
+  os.precision(10);
+  os << '(' << x << ", " << y << ')';
+  return os.str();
+}
+
+struct Crossing {
+  std::size_t e1 = 0, e2 = 0;  // e1 < e2, polygon (not file) edge indices
+  Point where;
+  bool overlap = false;  // collinear overlap rather than a proper crossing/touch
+};
+
+// Exact test of two polygon edges found by the box filter. Adjacent edges must
+// only share their common vertex: they conflict iff the three points are collinear
+// and the shared vertex is not between the two others (the edges fold back).
+// Non-adjacent edges must not meet at all.
+bool edges_conflict(const std::vector<Point>& pts, std::size_t i, std::size_t j, Crossing& out) {
+  const std::size_t n = pts.size();
+  if (i > j) std::swap(i, j);
+  out.e1 = i;
+  out.e2 = j;
+  const bool j_follows_i = (j == i + 1);
+  const bool i_follows_j = (i == 0 && j == n - 1);
+  if (j_follows_i || i_follows_j) {
+    // Shared vertex b; the other ends a (before b) and c (after b).
+    const std::size_t b = j_follows_i ? j : 0;
+    const Point& a = pts[(b + n - 1) % n];
+    const Point& c = pts[(b + 1) % n];
+    if (CGAL::collinear(a, pts[b], c) && !CGAL::collinear_are_ordered_along_line(a, pts[b], c)) {
+      out.overlap = true;
+      // The overlap runs from b to whichever of a, c is closer to b.
+      out.where = CGAL::has_smaller_distance_to_point(pts[b], a, c) ? a : c;
+      return true;
+    }
+    return false;
+  }
+  const Segment s1(pts[i], pts[(i + 1) % n]);
+  const Segment s2(pts[j], pts[(j + 1) % n]);
+  if (!CGAL::do_intersect(s1, s2)) return false;
+  // The location is only for the message, so an inexact construction is fine.
+  const Point &a = s1.source(), &b = s1.target(), &c = s2.source(), &d = s2.target();
+  if (CGAL::collinear(a, b, c) && CGAL::collinear(a, b, d)) {
+    out.overlap = true;  // collinear segments that meet: report an end lying on the other
+    out.where = s1.has_on(c) ? c : s1.has_on(d) ? d : a;
+  } else {
+    // Solve a + t (b - a) = c + u (d - c) for t by Cramer's rule.
+    const double rx = b.x() - a.x(), ry = b.y() - a.y(), sx = d.x() - c.x(), sy = d.y() - c.y();
+    const double den = rx * sy - ry * sx;
+    const double t = den != 0.0 ? ((c.x() - a.x()) * sy - (c.y() - a.y()) * sx) / den : 0.0;
+    out.where = Point(a.x() + t * rx, a.y() + t * ry);
+  }
+  return true;
+}
+
+}  // namespace
+
+void check_polygon_scale(const Polygon& p) {
+  if (p.vertices.empty()) return;
+  const auto& fi = p.file_index;
+  Eigen::Vector2d lo = p.vertices.front(), hi = lo;
+  std::size_t far = 0;
+  for (std::size_t i = 0; i < p.vertices.size(); ++i) {
+    const Eigen::Vector2d& v = p.vertices[i];
+    lo = lo.cwiseMin(v), hi = hi.cwiseMax(v);
+    if (v.cwiseAbs().maxCoeff() > p.vertices[far].cwiseAbs().maxCoeff()) far = i;
+  }
+  const Eigen::Vector2d& v = p.vertices[far];
+  if (v.cwiseAbs().maxCoeff() > kMaxPolygonCoordinate) {
+    std::ostringstream s;
+    s << "vertex " << (fi.empty() ? far : fi[far]) << " " << fmt_point(v.x(), v.y())
+      << " is too far from the origin: coordinates must lie within +-" << kMaxPolygonCoordinate
+      << " (lengths are squared in areas and Jacobian determinants, which would overflow); rescale the "
+         "coordinates (e.g. to km) or shift them nearer the origin";
+    throw InputError(s.str());
+  }
+  // Extent: the larger side of the bounding box (exact, no squares).
+  const double extent = (hi - lo).maxCoeff();
+  if (extent < kMinPolygonExtent) {
+    std::ostringstream s;
+    s << "polygon is too small: its bounding box is " << (hi - lo).x() << " x " << (hi - lo).y()
+      << ", below the smallest supported extent " << kMinPolygonExtent
+      << " (areas and Jacobian determinants would underflow); rescale the coordinates (e.g. to mm or um)";
+    throw InputError(s.str());
+  }
+}
+
+double signed_area(const Polygon& p) {
+  const std::size_t n = p.vertices.size();
+  if (n < 3) return 0.0;
+  // Shoelace formula relative to the first vertex (reduces cancellation for
+  // polygons far from the origin, e.g. projected coastline coordinates).
+  const Eigen::Vector2d o = p.vertices[0];
+  double twice = 0.0;
+  for (std::size_t i = 1; i + 1 < n; ++i) {
+    const Eigen::Vector2d a = p.vertices[i] - o, b = p.vertices[i + 1] - o;
+    twice += a.x() * b.y() - a.y() * b.x();
+  }
+  return 0.5 * twice;
+}
+
+Polygon validate_polygon(Polygon p) {
+  const std::size_t n = p.vertices.size();
+  if (p.file_index.empty()) {
+    p.file_index.resize(n);
+    for (std::size_t i = 0; i < n; ++i) p.file_index[i] = i;
+  } else if (p.file_index.size() != n) {
+    throw std::invalid_argument("validate_polygon: file_index has " + std::to_string(p.file_index.size()) +
+                                " entries for " + std::to_string(n) + " vertices");
+  }
+  const auto& fi = p.file_index;
+  if (n < 4) {
+    throw InputError("polygon has " + std::to_string(n) + " vertices; at least 4 are needed");
+  }
+  for (std::size_t i = 0; i < n; ++i) {
+    const auto& v = p.vertices[i];
+    if (!std::isfinite(v.x()) || !std::isfinite(v.y())) {
+      throw InputError("vertex " + std::to_string(fi[i]) + " has a non-finite coordinate " +
+                       fmt_point(v.x(), v.y()));
+    }
+  }
+  check_polygon_scale(p);
+  for (std::size_t i = 0; i < n; ++i) {
+    const std::size_t j = (i + 1) % n;
+    if (p.vertices[i] == p.vertices[j]) {
+      throw InputError("vertices " + std::to_string(fi[i]) + " and " + std::to_string(fi[j]) + " are equal " +
+                       fmt_point(p.vertices[i].x(), p.vertices[i].y()) + "; remove the duplicate");
+    }
+  }
+  std::vector<Point> pts;
+  pts.reserve(n);
+  for (const auto& v : p.vertices) pts.emplace_back(v.x(), v.y());
+
+  // Zero area (exact): every vertex collinear with the first two distinct ones.
+  bool all_collinear = true;
+  for (std::size_t i = 2; i < n && all_collinear; ++i)
+    all_collinear = CGAL::collinear(pts[0], pts[1], pts[i]);
+  if (all_collinear) throw InputError("polygon has zero area (all vertices are collinear)");
+
+  // Candidate edge pairs from overlapping bounding boxes (O(n log n + k)), then
+  // exact tests. Keep the pair with the smallest indices so the report is
+  // deterministic whatever order the box algorithm reports pairs in.
+  std::vector<Box> boxes;
+  boxes.reserve(n);
+  for (std::size_t i = 0; i < n; ++i) boxes.emplace_back(pts[i].bbox() + pts[(i + 1) % n].bbox(), i);
+  bool found = false;
+  std::size_t n_conflicts = 0;
+  Crossing first;
+  CGAL::box_self_intersection_d(boxes.begin(), boxes.end(), [&](const Box& a, const Box& b) {
+    Crossing c;
+    if (!edges_conflict(pts, a.info(), b.info(), c)) return;
+    ++n_conflicts;
+    if (!found || std::pair(c.e1, c.e2) < std::pair(first.e1, first.e2)) first = c;
+    found = true;
+  });
+  if (found) {
+    auto edge = [&](std::size_t e) { return std::to_string(fi[e]) + "-" + std::to_string(fi[(e + 1) % n]); };
+    std::string msg = "polygon is not simple: edges " + edge(first.e1) + " and " + edge(first.e2) +
+                      (first.overlap ? " overlap near " : " intersect near ") +
+                      fmt_point(first.where.x(), first.where.y());
+    if (n_conflicts > 1) msg += " (" + std::to_string(n_conflicts - 1) + " more conflicting edge pair(s))";
+    msg += "; the domain must be bounded by one simple closed polygon: fix the vertices there (check the "
+           "vertex order, duplicated or stray points)";
+    throw InputError(msg);
+  }
+
+  // Orientation, exactly: the lexicographically smallest vertex of a simple
+  // polygon is convex, and its neighbours are not collinear with it (they would
+  // lie on the same ray from it, i.e. the edges would overlap, excluded above).
+  const std::size_t m =
+      static_cast<std::size_t>(std::min_element(pts.begin(), pts.end(),
+                                                [](const Point& a, const Point& b) {
+                                                  return CGAL::compare_xy(a, b) == CGAL::SMALLER;
+                                                }) -
+                               pts.begin());
+  const auto o = CGAL::orientation(pts[(m + n - 1) % n], pts[m], pts[(m + 1) % n]);
+  if (o == CGAL::CLOCKWISE) {
+    std::reverse(p.vertices.begin(), p.vertices.end());
+    std::reverse(p.file_index.begin(), p.file_index.end());
+  }
+  return p;
+}
+
+PolygonCleaning clean_polygon(Polygon p) {
+  const std::size_t n0 = p.vertices.size();
+  if (p.file_index.empty()) {
+    p.file_index.resize(n0);
+    for (std::size_t i = 0; i < n0; ++i) p.file_index[i] = i;
+  }
+  PolygonCleaning out;
+  for (const auto& v : p.vertices)
+    if (!std::isfinite(v.x()) || !std::isfinite(v.y())) {
+      out.polygon = std::move(p);  // validate_polygon names the vertex
+      return out;
+    }
+  // One pass over a stack: a vertex is dropped if it repeats the previous one,
+  // or if the previous edge and the next one lie on one line and double back
+  // (the vertex is the tip of a zero-area spike). Dropping a vertex can expose
+  // the next spike (a -> b -> a -> ...), which the stack handles.
+  std::vector<std::size_t> keep;
+  keep.reserve(n0);
+  auto spike = [&](std::size_t a, std::size_t b, std::size_t c) {
+    const Point pa(p.vertices[a].x(), p.vertices[a].y()), pb(p.vertices[b].x(), p.vertices[b].y()),
+        pc(p.vertices[c].x(), p.vertices[c].y());
+    return CGAL::collinear(pa, pb, pc) && !CGAL::collinear_are_ordered_along_line(pa, pb, pc);
+  };
+  auto note = [&](std::size_t dropped, const std::string& why) {
+    out.removed_file_indices.push_back(p.file_index[dropped]);
+    out.notes.push_back("removed vertex " + std::to_string(p.file_index[dropped]) + " " + why);
+  };
+  bool changed = true;
+  // i repeats the last kept vertex: the one later in the file goes (the
+  // closing vertex of a file that repeats its first one, say).
+  auto repeats = [&](std::size_t i) {
+    if (keep.empty() || !(p.vertices[keep.back()] == p.vertices[i])) return false;
+    changed = true;
+    if (p.file_index[i] < p.file_index[keep.back()]) {
+      note(keep.back(), "(repeats vertex " + std::to_string(p.file_index[i]) + ")");
+      keep.back() = i;
+    } else {
+      note(i, "(repeats vertex " + std::to_string(p.file_index[keep.back()]) + ")");
+    }
+    return true;
+  };
+  std::vector<std::size_t> order(n0);
+  for (std::size_t i = 0; i < n0; ++i) order[i] = i;
+  // Repeat around the closing seam until nothing changes (at most a few passes).
+  while (changed && order.size() >= 3) {
+    changed = false;
+    keep.clear();
+    for (std::size_t i : order) {
+      if (repeats(i)) continue;
+      while (keep.size() >= 2 && spike(keep[keep.size() - 2], keep.back(), i)) {
+        note(keep.back(), "(tip of a zero-area spike: edges " + std::to_string(p.file_index[keep[keep.size() - 2]]) +
+                              "-" + std::to_string(p.file_index[keep.back()]) + " and " +
+                              std::to_string(p.file_index[keep.back()]) + "-" + std::to_string(p.file_index[i]) +
+                              " overlap)");
+        keep.pop_back();
+        changed = true;
+        if (!keep.empty() && p.vertices[keep.back()] == p.vertices[i]) break;
+      }
+      if (repeats(i)) continue;
+      keep.push_back(i);
+    }
+    // Rotate so that the seam between the last and first vertex is looked at too.
+    if (keep.size() >= 3) std::rotate(keep.begin(), keep.begin() + static_cast<std::ptrdiff_t>(keep.size() / 2), keep.end());
+    order = keep;
+  }
+  std::sort(order.begin(), order.end());  // file order
+  Polygon q;
+  for (std::size_t i : order) q.vertices.push_back(p.vertices[i]), q.file_index.push_back(p.file_index[i]);
+  std::sort(out.removed_file_indices.begin(), out.removed_file_indices.end());
+  out.polygon = std::move(q);
+  return out;
+}
+
+}  // namespace tspline

@@ -1,0 +1,142 @@
+// Bernstein arithmetic on [0,1]^2; see tspline/detail/bernstein.h.
+#include "tspline/detail/bernstein.h"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+namespace tspline::detail {
+
+namespace {
+
+constexpr int kMax = BernsteinPoly::kMaxDegree;
+
+// binom(n, k) for n <= 2 kMax (exact in double).
+double binom(int n, int k) {
+  static const auto table = [] {
+    std::array<std::array<double, 2 * kMax + 1>, 2 * kMax + 1> t{};
+    for (int i = 0; i <= 2 * kMax; ++i) {
+      t[i][0] = t[i][i] = 1.0;
+      for (int j = 1; j < i; ++j) t[i][j] = t[i - 1][j - 1] + t[i - 1][j];
+    }
+    return t;
+  }();
+  return table[n][k];
+}
+
+}  // namespace
+
+// Bernstein basis values B_i^deg(s), i = 0..deg.
+void bernstein_values(int deg, double s, double* out) {
+  // Powers by repeated multiplication (no pow calls): s^i and r^(deg-i).
+  const double r = 1.0 - s;
+  double sp[kMax + 1], rp[kMax + 1];
+  sp[0] = rp[0] = 1.0;
+  for (int i = 1; i <= deg; ++i) sp[i] = sp[i - 1] * s, rp[i] = rp[i - 1] * r;
+  for (int i = 0; i <= deg; ++i) out[i] = binom(deg, i) * sp[i] * rp[deg - i];
+}
+
+namespace {
+
+// de Casteljau split of one coefficient row (stride `stride`, deg+1 values) at 1/2.
+void split_row(const double* in, int deg, int stride, double* left, double* right) {
+  double w[kMax + 1];
+  for (int i = 0; i <= deg; ++i) w[i] = in[i * stride];
+  for (int k = 0; k <= deg; ++k) {
+    left[k * stride] = w[0];
+    right[(deg - k) * stride] = w[deg - k];
+    for (int i = 0; i < deg - k; ++i) w[i] = 0.5 * (w[i] + w[i + 1]);
+  }
+}
+
+}  // namespace
+
+// ---------------------------------------------------------------------------
+// Bernstein arithmetic
+// ---------------------------------------------------------------------------
+BernsteinPoly::BernsteinPoly(int m_, int n_) : m(m_), n(n_) {
+  if (m < 0 || n < 0 || m > kMaxDegree || n > kMaxDegree)
+    throw std::invalid_argument("BernsteinPoly: bidegree out of range");
+}
+
+double BernsteinPoly::min_coefficient() const { return *std::min_element(c.begin(), c.begin() + size()); }
+
+double BernsteinPoly::max_abs_coefficient() const {
+  double r = 0.0;
+  for (int k = 0; k < size(); ++k) r = std::max(r, std::abs(c[k]));
+  return r;
+}
+
+double BernsteinPoly::operator()(double s, double t) const {
+  double bs[kMax + 1], bt[kMax + 1];
+  bernstein_values(m, s, bs);
+  bernstein_values(n, t, bt);
+  double v = 0.0;
+  for (int j = 0; j <= n; ++j) {
+    double row = 0.0;
+    for (int i = 0; i <= m; ++i) row += at(i, j) * bs[i];
+    v += row * bt[j];
+  }
+  return v;
+}
+
+// With scaled coefficients a_ij binom(m1,i) binom(n1,j) the product is a plain
+// 2-D convolution (the power-basis identity B_i^m1 B_k^m2 =
+// binom(m1,i) binom(m2,k) / binom(m1+m2,i+k) B_{i+k}^{m1+m2}).
+BernsteinPoly bernstein_product(const BernsteinPoly& a, const BernsteinPoly& b) {
+  BernsteinPoly r(a.m + b.m, a.n + b.n);
+  double sa[(kMax + 1) * (kMax + 1)], sb[(kMax + 1) * (kMax + 1)];
+  for (int j = 0; j <= a.n; ++j)
+    for (int i = 0; i <= a.m; ++i) sa[i + (a.m + 1) * j] = a.at(i, j) * binom(a.m, i) * binom(a.n, j);
+  for (int j = 0; j <= b.n; ++j)
+    for (int i = 0; i <= b.m; ++i) sb[i + (b.m + 1) * j] = b.at(i, j) * binom(b.m, i) * binom(b.n, j);
+  for (int j1 = 0; j1 <= a.n; ++j1)
+    for (int i1 = 0; i1 <= a.m; ++i1) {
+      const double x = sa[i1 + (a.m + 1) * j1];
+      if (x == 0.0) continue;
+      for (int j2 = 0; j2 <= b.n; ++j2)
+        for (int i2 = 0; i2 <= b.m; ++i2) r.at(i1 + i2, j1 + j2) += x * sb[i2 + (b.m + 1) * j2];
+    }
+  for (int j = 0; j <= r.n; ++j)
+    for (int i = 0; i <= r.m; ++i) r.at(i, j) /= binom(r.m, i) * binom(r.n, j);
+  return r;
+}
+
+BernsteinPoly bernstein_ds(const BernsteinPoly& a) {
+  if (a.m < 1) throw std::invalid_argument("bernstein_ds: degree 0");
+  BernsteinPoly r(a.m - 1, a.n);
+  for (int j = 0; j <= a.n; ++j)
+    for (int i = 0; i < a.m; ++i) r.at(i, j) = a.m * (a.at(i + 1, j) - a.at(i, j));
+  return r;
+}
+
+BernsteinPoly bernstein_dt(const BernsteinPoly& a) {
+  if (a.n < 1) throw std::invalid_argument("bernstein_dt: degree 0");
+  BernsteinPoly r(a.m, a.n - 1);
+  for (int j = 0; j < a.n; ++j)
+    for (int i = 0; i <= a.m; ++i) r.at(i, j) = a.n * (a.at(i, j + 1) - a.at(i, j));
+  return r;
+}
+
+BernsteinPoly bernstein_axpy(const BernsteinPoly& a, double f, const BernsteinPoly& b) {
+  if (a.m != b.m || a.n != b.n) throw std::invalid_argument("bernstein_axpy: bidegrees differ");
+  BernsteinPoly r = a;
+  for (int k = 0; k < r.size(); ++k) r.c[k] += f * b.c[k];
+  return r;
+}
+
+std::array<BernsteinPoly, 4> bernstein_subdivide(const BernsteinPoly& p) {
+  // Split in s row by row into left/right, then each in t column by column.
+  BernsteinPoly ls(p.m, p.n), rs(p.m, p.n);
+  for (int j = 0; j <= p.n; ++j)
+    split_row(&p.c[(p.m + 1) * j], p.m, 1, &ls.c[(p.m + 1) * j], &rs.c[(p.m + 1) * j]);
+  std::array<BernsteinPoly, 4> q = {BernsteinPoly(p.m, p.n), BernsteinPoly(p.m, p.n), BernsteinPoly(p.m, p.n),
+                                    BernsteinPoly(p.m, p.n)};
+  for (int i = 0; i <= p.m; ++i) {
+    split_row(&ls.c[i], p.n, p.m + 1, &q[0].c[i], &q[2].c[i]);
+    split_row(&rs.c[i], p.n, p.m + 1, &q[1].c[i], &q[3].c[i]);
+  }
+  return q;
+}
+
+}  // namespace tspline::detail

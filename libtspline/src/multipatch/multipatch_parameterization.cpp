@@ -1,0 +1,230 @@
+#include "tspline/multipatch/multipatch_parameterization.h"
+
+#include <Eigen/LU>
+
+#include <algorithm>
+#include <limits>
+#include <set>
+
+#include "tspline/multipatch/automatic_cuts.h"
+#include "tspline/spline/bezier_extraction.h"
+#include "tspline/boundary/border_knots.h"
+#include "tspline/errors.h"
+#include "tspline/validity/map_certification.h"
+#include "tspline/validity/map_quality.h"
+#include "tspline/spline/tspline_fit.h"
+
+namespace tspline {
+
+Eigen::Vector2d side_point_uv(int side, double t) {
+  switch (static_cast<Side>(side)) {
+    case Side::Bottom: return {t, 0.0};
+    case Side::Right: return {1.0, t};
+    case Side::Top: return {1.0 - t, 1.0};
+    case Side::Left: return {0.0, 1.0 - t};
+  }
+  return {0.0, 0.0};
+}
+
+double map_area(const TSplineMap& map) {
+  double area = 0.0;
+  std::vector<QuadraturePoint> q;
+  for (int c = 0; c < static_cast<int>(map.mesh().num_cells()); ++c) {
+    q.clear();
+    cell_quadrature(map.basis(), c, 4, q);
+    for (const QuadraturePoint& p : q) area += p.weight * map.derivatives(p.uv, 1, c).J.determinant();
+  }
+  return area;
+}
+
+double interface_gap(const TSplineMap& a, int side_a, const TSplineMap& b, int side_b) {
+  std::vector<double> t = border_params(a.mesh(), static_cast<Side>(side_a));
+  for (double s : border_params(b.mesh(), static_cast<Side>(side_b))) t.push_back(reversed_param(s));
+  for (int k = 0; k <= 64; ++k) t.push_back(k / 64.0);
+  double gap = 0.0;
+  for (double s : t)
+    gap = std::max(gap, (a.point(side_point_uv(side_a, s)) - b.point(side_point_uv(side_b, reversed_param(s)))).norm());
+  return gap;
+}
+
+double MultiPatchResult::max_gap() const {
+  double g = 0.0;
+  for (const InterfaceReport& i : interfaces) g = std::max(g, i.max_gap);
+  return g;
+}
+
+bool MultiPatchResult::valid() const {
+  return std::all_of(patches.begin(), patches.end(), [](const ParameterizationResult& r) { return r.valid(); });
+}
+
+bool MultiPatchResult::certified_valid() const {
+  return std::all_of(patches.begin(), patches.end(),
+                     [](const ParameterizationResult& r) { return r.certified_valid(); });
+}
+
+double MultiPatchResult::min_relative_det_bound() const {
+  double m = std::numeric_limits<double>::infinity();
+  for (const auto& r : patches) m = std::min(m, r.certification.min_relative_lower_bound);
+  return m;
+}
+
+double MultiPatchResult::min_mean_ratio_dense() const {
+  double m = std::numeric_limits<double>::infinity();
+  for (const auto& r : patches) m = std::min(m, r.dense_quality.min_mean_ratio);
+  return m;
+}
+
+double MultiPatchResult::min_mean_ratio_gauss() const {
+  double m = std::numeric_limits<double>::infinity();
+  for (const auto& r : patches) m = std::min(m, r.quality.min_mean_ratio);
+  return m;
+}
+
+namespace {
+
+// Knots of both sides of interface f (patch a's parameters; b's mirrored).
+std::set<double> interface_knots(const MultiPatchResult& R, const Interface& f) {
+  std::set<double> u;
+  for (double t : border_params(R.patches[f.patch_a].map->mesh(), static_cast<Side>(f.side_a))) u.insert(t);
+  for (double t : border_params(R.patches[f.patch_b].map->mesh(), static_cast<Side>(f.side_b)))
+    u.insert(reversed_param(t));
+  return u;
+}
+
+InterfaceReport measure_interface(const MultiPatchResult& R, const Interface& f) {
+  const TSplineMap& a = *R.patches[f.patch_a].map;
+  const TSplineMap& b = *R.patches[f.patch_b].map;
+  InterfaceReport rep;
+  rep.max_gap = interface_gap(a, f.side_a, b, f.side_b);
+  const std::vector<double> ka = border_params(a.mesh(), static_cast<Side>(f.side_a));
+  std::vector<double> kb = border_params(b.mesh(), static_cast<Side>(f.side_b));
+  rep.knots_a = ka.size();
+  rep.knots_b = kb.size();
+  for (double& t : kb) t = reversed_param(t);
+  std::sort(kb.begin(), kb.end());
+  rep.same_knots = ka == kb;
+  return rep;
+}
+
+// Once the boundary curves agree, the later adaptive rounds may still have
+// refined one side of an interface and not the other. Each patch is refined to
+// the union of the knots of its interfaces and its map carried over
+// (transfer_map reproduces the boundary curve exactly; inside it is the
+// interpolant of the old map), then checked again: the new map replaces the
+// old one only if it is still certified (or the old one was not either).
+void equalize_interface_knots(MultiPatchResult& R, const AdaptiveOptions& ad, int max_level) {
+  std::vector<BorderParams> want(R.patches.size());
+  for (const Interface& f : R.layout.interfaces) {
+    const std::set<double> u = interface_knots(R, f);
+    for (double t : u) {
+      want[f.patch_a][f.side_a].push_back(t);
+      want[f.patch_b][f.side_b].push_back(reversed_param(t));
+    }
+  }
+  for (std::size_t p = 0; p < R.patches.size(); ++p) {
+    ParameterizationResult& r = R.patches[p];
+    TMesh mesh = r.map->mesh();
+    if (refine_to_border_params(mesh, want[p], max_level) == 0) continue;
+    TSplineMap map = transfer_map(*r.map, std::move(mesh));
+    MapCertification cert = ad.certify ? certify_map(map, ad.certification) : MapCertification{};
+    if (ad.certify && r.certified_valid() && !cert.certified_valid()) continue;
+    std::vector<CellMapQuality> cells;
+    r.quality = map_quality(map, ad.gauss, &cells);
+    r.cell_quality = std::move(cells);
+    r.dense_quality = dense_map_quality(map, ad.dense_samples);
+    r.certification = std::move(cert);
+    r.front.mesh = map.mesh();
+    r.front.optimized.assign(r.front.mesh.num_vertices(), Eigen::Vector2d::Zero());
+    for (int v = 0; v < static_cast<int>(r.front.mesh.num_vertices()); ++v)
+      r.front.optimized[v] = map.point(r.front.mesh.vertex_param(v));
+    r.map.emplace(std::move(map));
+  }
+}
+
+}  // namespace
+
+MultiPatchResult run_multipatch_parameterization(const Domain& input, const std::optional<std::vector<Cut>>& cuts,
+                                                 const ParameterizationOptions& options,
+                                                 const AdaptiveOptions& adaptive, const MultiPatchOptions& multi,
+                                                 const PatchCallback& on_patch) {
+  if (multi.max_sync_rounds < 0) throw InputError("the number of interface rounds must be >= 0");
+  auto log = [&](const std::string& s) { report_step(options.progress, "patches", s); };
+  MultiPatchResult R;
+  R.domain = validate_domain(input);
+  if (cuts) {
+    R.layout = build_patch_layout(R.domain, *cuts);
+    R.cuts_explanation = "given";
+  } else {
+    AutomaticCuts a = automatic_cuts(R.domain);
+    R.layout = build_patch_layout(R.domain, std::move(a.cuts));
+    R.cuts_explanation = "automatic: " + a.explanation;
+  }
+  {
+    Eigen::Vector2d lo = R.domain.outer.vertices.front(), hi = lo;
+    for (const auto& v : R.domain.outer.vertices) lo = lo.cwiseMin(v), hi = hi.cwiseMax(v);
+    R.diameter = (hi - lo).norm();
+  }
+  R.domain_area = domain_area(R.domain);
+  const std::size_t P = R.layout.patches.size();
+  log("patches: " + std::to_string(P) + " four-sided patches, " + std::to_string(R.layout.cuts.size()) + " cuts (" +
+      R.cuts_explanation + ")");
+
+  std::vector<BorderParams> required(P);
+  std::vector<char> stale(P, 1);
+  for (int round = 0;; ++round) {
+    for (std::size_t p = 0; p < P; ++p) {
+      if (!stale[p]) continue;
+      if (on_patch) on_patch(p, round);
+      ParameterizationOptions po = options;
+      const Patch& patch = R.layout.patches[p];
+      po.corners = std::array<long long, 4>{};
+      for (int k = 0; k < 4; ++k) (*po.corners)[k] = static_cast<long long>(patch.corners[k]);
+      po.corner_trials = 1;
+      po.border_params = required[p];
+      // The patch's events, its text prefixed with the patch.
+      if (options.progress)
+        po.progress = [cb = options.progress, p](const ProgressEvent& e) {
+          ProgressEvent f = e;
+          f.text = "patch " + std::to_string(p) + ": " + e.text;
+          cb(f);
+        };
+      ParameterizationResult run = run_parameterization(patch.polygon, po, adaptive);
+      if (round == 0) R.patches.push_back(std::move(run));  // round 0 runs every patch, in order
+      else R.patches[p] = std::move(run);
+      if (!R.patches[p].map) throw NumericalError("patch " + std::to_string(p) + ": no map was produced");
+      stale[p] = 0;
+    }
+    // Interfaces: gaps and knots.
+    R.interfaces.assign(R.layout.interfaces.size(), {});
+    bool all_conform = true;
+    for (std::size_t i = 0; i < R.layout.interfaces.size(); ++i) {
+      const Interface& f = R.layout.interfaces[i];
+      const InterfaceReport& rep = R.interfaces[i] = measure_interface(R, f);
+      if (rep.max_gap <= multi.gap_tolerance * R.diameter) continue;
+      all_conform = false;
+      if (round >= multi.max_sync_rounds) continue;
+      // Both sides get the union of the knots, mirrored for patch b.
+      std::set<double> u = interface_knots(R, f);
+      u.insert(required[f.patch_a][f.side_a].begin(), required[f.patch_a][f.side_a].end());
+      for (double t : required[f.patch_b][f.side_b]) u.insert(reversed_param(t));
+      required[f.patch_a][f.side_a].assign(u.begin(), u.end());
+      required[f.patch_b][f.side_b].clear();
+      for (double t : u) required[f.patch_b][f.side_b].push_back(reversed_param(t));
+      stale[f.patch_a] = stale[f.patch_b] = 1;
+    }
+    if (all_conform || round >= multi.max_sync_rounds) {
+      R.sync_rounds = round;
+      break;
+    }
+    log("interfaces: re-running " + std::to_string(std::count(stale.begin(), stale.end(), 1)) +
+        " patches with the union of the knots of their interfaces");
+  }
+  equalize_interface_knots(R, adaptive, options.max_level);
+  for (std::size_t i = 0; i < R.layout.interfaces.size(); ++i)
+    R.interfaces[i] = measure_interface(R, R.layout.interfaces[i]);
+  R.map_area = 0.0;
+  for (const auto& r : R.patches) R.map_area += map_area(*r.map);
+  return R;
+}
+
+}  // namespace tspline

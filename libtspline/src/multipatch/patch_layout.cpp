@@ -1,0 +1,370 @@
+// Patches of a domain cut by polylines: the faces of the plane graph of rings
+// and cuts, found by the usual half-edge walk (at each vertex turn to the
+// first outgoing edge clockwise from the one we came along).
+#include "tspline/multipatch/patch_layout.h"
+
+#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <map>
+#include <numbers>
+#include <set>
+#include <sstream>
+
+#include "tspline/errors.h"
+#include "tspline/boundary/polygon_validation.h"
+
+namespace tspline {
+namespace {
+
+using K = CGAL::Exact_predicates_inexact_constructions_kernel;
+using CPoint = K::Point_2;
+using CSegment = K::Segment_2;
+
+const Polygon& ring(const Domain& d, std::size_t r) { return r == 0 ? d.outer : d.holes[r - 1]; }
+std::size_t ring_count(const Domain& d) { return d.holes.size() + 1; }
+
+double diameter(const Domain& d) {
+  Eigen::Vector2d lo = d.outer.vertices.front(), hi = lo;
+  for (const auto& v : d.outer.vertices) lo = lo.cwiseMin(v), hi = hi.cwiseMax(v);
+  return (hi - lo).norm();
+}
+
+double snap_tolerance(const Domain& d) { return 1e-9 * diameter(d); }
+
+std::string fmt(const Eigen::Vector2d& p) {
+  std::ostringstream s;
+  s.precision(10);
+  s << '(' << p.x() << ", " << p.y() << ')';
+  return s.str();
+}
+
+// Closest point of segment [a, b] to p, as the parameter s in [0, 1].
+double project(const Eigen::Vector2d& p, const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
+  const Eigen::Vector2d ab = b - a;
+  const double l2 = ab.squaredNorm();
+  return l2 > 0.0 ? std::clamp((p - a).dot(ab) / l2, 0.0, 1.0) : 0.0;
+}
+
+struct RingHit {
+  std::size_t ring = 0, edge = 0;
+  double s = 0.0, distance = std::numeric_limits<double>::infinity();
+};
+
+RingHit closest_ring_point(const Domain& d, const Eigen::Vector2d& p) {
+  RingHit best;
+  for (std::size_t r = 0; r < ring_count(d); ++r) {
+    const auto& v = ring(d, r).vertices;
+    for (std::size_t i = 0; i < v.size(); ++i) {
+      const Eigen::Vector2d &a = v[i], &b = v[(i + 1) % v.size()];
+      const double s = project(p, a, b);
+      const double dist = (a + s * (b - a) - p).norm();
+      if (dist < best.distance) best = {r, i, s, dist};
+    }
+  }
+  return best;
+}
+
+CPoint cpoint(const Eigen::Vector2d& v) { return {v.x(), v.y()}; }
+
+// The plane graph of rings and cuts.
+struct Graph {
+  std::vector<Eigen::Vector2d> points;
+  std::vector<char> is_node;
+  struct HalfEdge {
+    int from, to, cut;
+  };
+  std::vector<HalfEdge> half_edges;
+  std::vector<std::vector<int>> outgoing;
+};
+
+Graph build_graph(const Domain& d, const std::vector<Cut>& cuts) {
+  Graph g;
+  const double tol = snap_tolerance(d);
+  // Ring vertices first (ring r, vertex i -> ring_first[r] + i).
+  std::vector<std::size_t> ring_first;
+  for (std::size_t r = 0; r < ring_count(d); ++r) {
+    ring_first.push_back(g.points.size());
+    for (const auto& v : ring(d, r).vertices) g.points.push_back(v);
+  }
+  g.is_node.assign(g.points.size(), 0);
+  // Cut ends: an end of an earlier cut, a ring vertex, or a new vertex on a ring edge.
+  std::map<std::pair<std::size_t, std::size_t>, std::vector<std::pair<double, int>>> inserted;
+  std::vector<std::vector<int>> cut_ids(cuts.size());
+  std::vector<int> ends;
+  auto end_id = [&](const Eigen::Vector2d& p) {
+    for (int e : ends)
+      if ((g.points[e] - p).norm() <= tol) return e;
+    const RingHit h = closest_ring_point(d, p);
+    const auto& v = ring(d, h.ring).vertices;
+    const Eigen::Vector2d a = v[h.edge], b = v[(h.edge + 1) % v.size()];
+    int id;
+    if ((a - p).norm() <= tol) id = static_cast<int>(ring_first[h.ring] + h.edge);
+    else if ((b - p).norm() <= tol) id = static_cast<int>(ring_first[h.ring] + (h.edge + 1) % v.size());
+    else {
+      id = static_cast<int>(g.points.size());
+      g.points.push_back(a + h.s * (b - a));
+      g.is_node.push_back(0);
+      inserted[{h.ring, h.edge}].push_back({h.s, id});
+    }
+    g.is_node[id] = 1;
+    ends.push_back(id);
+    return id;
+  };
+  for (std::size_t c = 0; c < cuts.size(); ++c) {
+    cut_ids[c].push_back(end_id(cuts[c].front()));
+    for (std::size_t k = 1; k + 1 < cuts[c].size(); ++k) {
+      cut_ids[c].push_back(static_cast<int>(g.points.size()));
+      g.points.push_back(cuts[c][k]);
+      g.is_node.push_back(0);
+    }
+    cut_ids[c].push_back(end_id(cuts[c].back()));
+  }
+  auto add = [&](int a, int b, int cut) { g.half_edges.push_back({a, b, cut}); };
+  for (std::size_t r = 0; r < ring_count(d); ++r) {
+    const std::size_t n = ring(d, r).vertices.size();
+    std::vector<int> seq;
+    for (std::size_t i = 0; i < n; ++i) {
+      seq.push_back(static_cast<int>(ring_first[r] + i));
+      auto it = inserted.find({r, i});
+      if (it == inserted.end()) continue;
+      auto on_edge = it->second;
+      std::sort(on_edge.begin(), on_edge.end());
+      for (const auto& [s, id] : on_edge) seq.push_back(id);
+    }
+    // The domain lies left of the outer ring (CCW) and right of each hole (CCW): walk holes backwards.
+    for (std::size_t i = 0; i < seq.size(); ++i) {
+      const int a = seq[i], b = seq[(i + 1) % seq.size()];
+      if (r == 0) add(a, b, -1);
+      else add(b, a, -1);
+    }
+  }
+  for (std::size_t c = 0; c < cuts.size(); ++c)
+    for (std::size_t k = 0; k + 1 < cut_ids[c].size(); ++k) {
+      add(cut_ids[c][k], cut_ids[c][k + 1], static_cast<int>(c));
+      add(cut_ids[c][k + 1], cut_ids[c][k], static_cast<int>(c));
+    }
+  g.outgoing.assign(g.points.size(), {});
+  for (std::size_t h = 0; h < g.half_edges.size(); ++h) g.outgoing[g.half_edges[h].from].push_back(static_cast<int>(h));
+  return g;
+}
+
+double angle_of(const Eigen::Vector2d& v) { return std::atan2(v.y(), v.x()); }
+
+// The outgoing half-edge at the end of h that is first clockwise from the reverse of h.
+int next_half_edge(const Graph& g, int h) {
+  const auto& e = g.half_edges[h];
+  const Eigen::Vector2d v = g.points[e.to];
+  const double ref = angle_of(g.points[e.from] - v);
+  int best = -1;
+  double best_cw = 0.0;
+  for (int o : g.outgoing[e.to]) {
+    double cw = ref - angle_of(g.points[g.half_edges[o].to] - v);
+    while (cw <= 1e-15) cw += 2.0 * std::numbers::pi;
+    while (cw > 2.0 * std::numbers::pi) cw -= 2.0 * std::numbers::pi;
+    if (best < 0 || cw < best_cw) best = o, best_cw = cw;
+  }
+  return best;
+}
+
+// Faces with their vertex ids (for the simplicity check).
+std::vector<std::pair<LayoutFace, std::vector<int>>> faces_with_ids(const Domain& d, const std::vector<Cut>& cuts) {
+  const Graph g = build_graph(d, cuts);
+  std::vector<char> seen(g.half_edges.size(), 0);
+  std::vector<std::pair<LayoutFace, std::vector<int>>> out;
+  for (std::size_t h0 = 0; h0 < g.half_edges.size(); ++h0) {
+    if (seen[h0]) continue;
+    LayoutFace f;
+    std::vector<int> ids;
+    for (int h = static_cast<int>(h0); !seen[h]; h = next_half_edge(g, h)) {
+      seen[h] = 1;
+      const auto& e = g.half_edges[h];
+      f.points.push_back(g.points[e.from]);
+      f.is_node.push_back(g.is_node[e.from]);
+      f.edge_cut.push_back(e.cut);
+      ids.push_back(e.from);
+      if (f.points.size() > g.half_edges.size()) break;  // cannot happen on a plane graph
+    }
+    out.push_back({std::move(f), std::move(ids)});
+  }
+  return out;
+}
+
+double cross(const Eigen::Vector2d& a, const Eigen::Vector2d& b) { return a.x() * b.y() - a.y() * b.x(); }
+
+// Interior angle (radians) of a CCW polygon at vertex i.
+double inner_angle(const std::vector<Eigen::Vector2d>& p, std::size_t i) {
+  const std::size_t n = p.size();
+  const Eigen::Vector2d a = p[(i + n - 1) % n] - p[i], b = p[(i + 1) % n] - p[i];
+  double t = std::atan2(cross(b, a), b.dot(a));
+  if (t < 0) t += 2.0 * std::numbers::pi;
+  return t;
+}
+
+std::string face_name(const LayoutFace& f) {
+  std::set<int> cuts;
+  for (int c : f.edge_cut)
+    if (c >= 0) cuts.insert(c + 1);
+  std::ostringstream s;
+  s << "the patch near " << fmt(f.points.front());
+  if (!cuts.empty()) {
+    s << " (bounded by cut" << (cuts.size() > 1 ? "s" : "");
+    for (auto it = cuts.begin(); it != cuts.end(); ++it) s << (it == cuts.begin() ? " " : ", ") << *it;
+    s << ")";
+  }
+  return s.str();
+}
+
+}  // namespace
+
+std::size_t LayoutFace::nodes() const { return static_cast<std::size_t>(std::count(is_node.begin(), is_node.end(), 1)); }
+
+std::vector<LayoutFace> layout_faces(const Domain& domain, const std::vector<Cut>& cuts) {
+  std::vector<LayoutFace> out;
+  for (auto& [f, ids] : faces_with_ids(domain, cuts)) out.push_back(std::move(f));
+  return out;
+}
+
+void validate_cuts(const Domain& d, const std::vector<Cut>& cuts) {
+  const double tol = snap_tolerance(d);
+  for (std::size_t c = 0; c < cuts.size(); ++c) {
+    const std::string name = "cut " + std::to_string(c + 1);
+    if (cuts[c].size() < 2) throw InputError(name + " has fewer than two points");
+    for (const auto& p : cuts[c])
+      if (!p.allFinite()) throw InputError(name + " has a non-finite coordinate");
+    for (std::size_t k = 0; k + 1 < cuts[c].size(); ++k)
+      if ((cuts[c][k + 1] - cuts[c][k]).norm() <= tol)
+        throw InputError(name + " repeats its point " + fmt(cuts[c][k]));
+    for (const Eigen::Vector2d& end : {cuts[c].front(), cuts[c].back()}) {
+      bool at_cut_end = false;
+      for (std::size_t o = 0; o < cuts.size(); ++o)
+        if (o != c && ((cuts[o].front() - end).norm() <= tol || (cuts[o].back() - end).norm() <= tol)) at_cut_end = true;
+      if (!at_cut_end && closest_ring_point(d, end).distance > tol)
+        throw InputError(name + ": its end " + fmt(end) + " lies neither on a ring nor at an end of another cut");
+    }
+    if (!domain_contains(d, 0.5 * (cuts[c][0] + cuts[c][1])))
+      throw InputError(name + " runs outside the domain near " + fmt(0.5 * (cuts[c][0] + cuts[c][1])));
+  }
+  // Cut segments against ring edges: they may meet only at the cut's own ends.
+  auto near_end = [&](const Cut& cut, const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
+    for (const Eigen::Vector2d& e : {cut.front(), cut.back()})
+      if ((a + project(e, a, b) * (b - a) - e).norm() <= tol) return true;
+    return false;
+  };
+  for (std::size_t c = 0; c < cuts.size(); ++c) {
+    for (std::size_t k = 0; k + 1 < cuts[c].size(); ++k) {
+      const CSegment s(cpoint(cuts[c][k]), cpoint(cuts[c][k + 1]));
+      const auto box = s.bbox();
+      for (std::size_t r = 0; r < ring_count(d); ++r) {
+        const auto& v = ring(d, r).vertices;
+        for (std::size_t i = 0; i < v.size(); ++i) {
+          const Eigen::Vector2d a = v[i], b = v[(i + 1) % v.size()];
+          const CSegment t(cpoint(a), cpoint(b));
+          if (!CGAL::do_overlap(box, t.bbox()) || !CGAL::do_intersect(s, t)) continue;
+          const bool end_segment = k == 0 || k + 2 == cuts[c].size();
+          // Allowed: the cut's end lies on this edge and the cut leaves it into the domain.
+          if (end_segment && near_end(cuts[c], a, b)) {
+            const Eigen::Vector2d other = (cuts[c].front() - a).norm() + (cuts[c].front() - b).norm() <=
+                                                  (cuts[c].back() - a).norm() + (cuts[c].back() - b).norm()
+                                              ? cuts[c][k + 1]
+                                              : cuts[c][k];
+            if (CGAL::orientation(t.source(), t.target(), cpoint(other)) != CGAL::COLLINEAR) continue;
+          }
+          const Polygon& p = ring(d, r);
+          throw InputError("cut " + std::to_string(c + 1) + " crosses " + ring_name(r) + " (edge " +
+                           std::to_string(p.file_index[i]) + "-" + std::to_string(p.file_index[(i + 1) % v.size()]) +
+                           ") near " + fmt(0.5 * (a + b)) + " away from the cut's ends");
+        }
+      }
+    }
+  }
+  // Cuts against cuts (and a cut against itself): they may share ends only.
+  for (std::size_t c = 0; c < cuts.size(); ++c)
+    for (std::size_t o = c; o < cuts.size(); ++o)
+      for (std::size_t k = 0; k + 1 < cuts[c].size(); ++k)
+        for (std::size_t l = (o == c ? k + 1 : 0); l + 1 < cuts[o].size(); ++l) {
+          const CSegment s(cpoint(cuts[c][k]), cpoint(cuts[c][k + 1]));
+          const CSegment t(cpoint(cuts[o][l]), cpoint(cuts[o][l + 1]));
+          if (!CGAL::do_intersect(s, t)) continue;
+          // Shared points allowed: consecutive segments of one cut, and common ends of two cuts.
+          std::vector<Eigen::Vector2d> shared;
+          if (o == c && l == k + 1) shared.push_back(cuts[c][k + 1]);
+          if (o != c && k == 0) shared.push_back(cuts[c].front());
+          if (o != c && k + 2 == cuts[c].size()) shared.push_back(cuts[c].back());
+          bool allowed = false;
+          for (const auto& e : shared) {
+            const auto hit = CGAL::intersection(s, t);
+            const CPoint* q = hit ? boost::get<CPoint>(&*hit) : nullptr;
+            if (q && (Eigen::Vector2d(q->x(), q->y()) - e).norm() <= tol) allowed = true;
+          }
+          if (allowed) continue;
+          const Eigen::Vector2d at = 0.5 * (cuts[c][k] + cuts[c][k + 1]);
+          if (o == c) throw InputError("cut " + std::to_string(c + 1) + " crosses itself near " + fmt(at));
+          throw InputError("cuts " + std::to_string(c + 1) + " and " + std::to_string(o + 1) + " cross near " +
+                           fmt(at) + " (cuts may meet only at their ends)");
+        }
+}
+
+PatchLayout build_patch_layout(const Domain& d, std::vector<Cut> cuts) {
+  validate_cuts(d, cuts);
+  PatchLayout L;
+  L.cuts = std::move(cuts);
+  for (auto& [f, ids] : faces_with_ids(d, L.cuts)) {
+    const std::size_t n = f.points.size();
+    double area2 = 0.0;
+    for (std::size_t i = 0; i < n; ++i) area2 += cross(f.points[i], f.points[(i + 1) % n]);
+    if (!(area2 > 0.0))
+      throw InputError("a ring near " + fmt(f.points.front()) +
+                       " is not connected to the others by cuts: every hole needs at least two cuts");
+    std::vector<int> sorted = ids;
+    std::sort(sorted.begin(), sorted.end());
+    if (std::adjacent_find(sorted.begin(), sorted.end()) != sorted.end())
+      throw InputError(face_name(f) + " is not simply connected or touches itself: every hole needs at least "
+                                      "two cuts, and cuts must split the domain into simple four-sided patches");
+    std::vector<std::size_t> corners;
+    for (std::size_t i = 0; i < n; ++i)
+      if (f.is_node[i]) corners.push_back(i);
+    if (corners.size() > 4)
+      throw InputError(face_name(f) + " has " + std::to_string(corners.size()) +
+                       " cut ends on its boundary; a four-sided patch can have at most four (its corners)");
+    // Missing corners: the sharpest convex ring vertices.
+    if (corners.size() < 4) {
+      std::vector<std::pair<double, std::size_t>> cand;
+      for (std::size_t i = 0; i < n; ++i)
+        if (!f.is_node[i]) cand.push_back({inner_angle(f.points, i), i});
+      std::sort(cand.begin(), cand.end());
+      for (const auto& [angle, i] : cand) {
+        if (corners.size() == 4 || angle >= std::numbers::pi * (1.0 - 1e-9)) break;
+        corners.push_back(i);
+      }
+      if (corners.size() < 4)
+        throw InputError(face_name(f) + " has only " + std::to_string(corners.size()) +
+                         " corners (cut ends and convex vertices): add cuts");
+      std::sort(corners.begin(), corners.end());
+    }
+    Patch p;
+    p.polygon.vertices = f.points;
+    p.polygon.file_index.resize(n);
+    for (std::size_t i = 0; i < n; ++i) p.polygon.file_index[i] = i;
+    for (int k = 0; k < 4; ++k) {
+      p.corners[k] = corners[k];
+      // Side k is a cut if its first edge is one (every cut end is a corner).
+      p.side_cut[k] = f.edge_cut[corners[k]];
+    }
+    L.patches.push_back(std::move(p));
+  }
+  for (std::size_t c = 0; c < L.cuts.size(); ++c) {
+    std::vector<std::pair<std::size_t, int>> sides;
+    for (std::size_t q = 0; q < L.patches.size(); ++q)
+      for (int k = 0; k < 4; ++k)
+        if (L.patches[q].side_cut[k] == static_cast<int>(c)) sides.push_back({q, k});
+    if (sides.size() != 2)
+      throw InputError("cut " + std::to_string(c + 1) + " is not the side of two patches");
+    L.interfaces.push_back({c, sides[0].first, sides[1].first, sides[0].second, sides[1].second});
+  }
+  return L;
+}
+
+}  // namespace tspline

@@ -1,0 +1,262 @@
+// Domains with holes: rings input, domain validation, cut layouts, the
+// multi-patch map (conforming interfaces, areas, certification) and its file.
+#include <doctest/doctest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <numbers>
+
+#include "test_support.h"
+#include "tspline/multipatch/automatic_cuts.h"
+#include "tspline/boundary/border_knots.h"
+#include "tspline/boundary/domain.h"
+#include "tspline/errors.h"
+#include "tspline/io/gis_reader.h"
+#include "tspline/io/multipatch_file.h"
+#include "tspline/io/multipatch_output.h"
+#include "tspline/io/polygon_reader.h"
+#include "tspline/multipatch/multipatch_parameterization.h"
+#include "tspline/multipatch/patch_layout.h"
+#include "tspline/boundary/polygon_validation.h"
+
+namespace {
+
+using tspline::Cut;
+using tspline::Domain;
+using test_support::contains;
+using test_support::make_polygon;
+using test_support::message_of;
+
+std::string holes_file(const std::string& name) { return std::string(TSPLINE_TEST_DATA_DIR) + "/holes/" + name; }
+
+tspline::Polygon square(double x0, double y0, double x1, double y1) {
+  return make_polygon({{x0, y0}, {x1, y0}, {x1, y1}, {x0, y1}});
+}
+
+Domain read_text_domain(const std::string& path) {
+  const tspline::io::DomainInput in = tspline::io::read_domain(path);
+  return Domain{in.outer, in.holes};
+}
+
+std::string validation_error(const Domain& d) {
+  return message_of<tspline::InputError>([&] { (void)tspline::validate_domain(d); });
+}
+
+// The square [0,4]^2 with the square hole [1,3]^2, cut along the diagonals.
+Domain framed_square() { return Domain{square(0, 0, 4, 4), {square(1, 1, 3, 3)}}; }
+std::vector<Cut> diagonal_cuts() {
+  return {{{1, 1}, {0, 0}}, {{3, 1}, {4, 0}}, {{3, 3}, {4, 4}}, {{1, 3}, {0, 4}}};
+}
+
+}  // namespace
+
+TEST_SUITE("holes") {
+  TEST_CASE("text rings: blank lines separate rings, comment lines do not") {
+    const auto rings = tspline::io::parse_text_rings(
+        "# plate\n0 0\n4 0\n# still the outer ring\n4 4\n0 4\n\n1 1\n1 2\n2 2\n\n\n3 3\n3.5 3\n3.5 3.5\n", "t");
+    REQUIRE(rings.size() == 3);
+    CHECK(rings[0].vertices.size() == 4);
+    CHECK(rings[1].vertices.size() == 3);
+    CHECK(rings[2].vertices.size() == 3);
+    CHECK(rings[2].vertices[1].x() == 3.5);
+    CHECK(rings[1].file_index[2] == 2);  // numbering within the ring
+    // The bundled plate: a square and a 64-gon.
+    const Domain plate = read_text_domain(holes_file("plate_with_hole.txt"));
+    CHECK(plate.outer.vertices.size() == 4);
+    REQUIRE(plate.holes.size() == 1);
+    CHECK(plate.holes[0].vertices.size() == 64);
+  }
+
+  TEST_CASE("domain validation: either orientation, area of the outer ring minus the holes") {
+    Domain d = framed_square();
+    std::reverse(d.holes[0].vertices.begin(), d.holes[0].vertices.end());  // clockwise hole
+    std::reverse(d.outer.vertices.begin(), d.outer.vertices.end());        // clockwise outer ring
+    const Domain v = tspline::validate_domain(d);
+    CHECK(tspline::signed_area(v.outer) == doctest::Approx(16));
+    CHECK(tspline::signed_area(v.holes[0]) == doctest::Approx(4));
+    CHECK(tspline::domain_area(v) == doctest::Approx(12));
+    CHECK(tspline::domain_contains(v, {0.5, 0.5}));
+    CHECK_FALSE(tspline::domain_contains(v, {2, 2}));
+  }
+
+  TEST_CASE("domain validation: bad holes are named with their edges") {
+    // Two holes that cross.
+    std::string m = validation_error(Domain{square(0, 0, 10, 10), {square(1, 1, 4, 4), square(3, 3, 6, 6)}});
+    CHECK(contains(m, "hole 2 crosses hole 1"));
+    CHECK(contains(m, "edge"));
+    // A hole touching the outer ring at a vertex.
+    m = validation_error(Domain{square(0, 0, 10, 10), {make_polygon({{5, 0}, {6, 2}, {5, 3}, {4, 2}})}});
+    CAPTURE(m);
+    CHECK(contains(m, "hole 1 touches the outer ring"));
+    // A hole crossing the outer ring.
+    m = validation_error(Domain{square(0, 0, 10, 10), {square(8, 8, 12, 9)}});
+    CHECK(contains(m, "hole 1 crosses the outer ring"));
+    // A hole outside, a hole in a hole, a hole that is not a simple polygon.
+    m = validation_error(Domain{square(0, 0, 10, 10), {square(20, 20, 21, 21)}});
+    CHECK(contains(m, "hole 1 lies outside the outer ring"));
+    m = validation_error(Domain{square(0, 0, 10, 10), {square(1, 1, 6, 6), square(2, 2, 3, 3)}});
+    CHECK(contains(m, "hole 2 lies inside hole 1"));
+    m = validation_error(Domain{square(0, 0, 10, 10), {make_polygon({{1, 1}, {3, 3}, {3, 1}, {1, 3}})}});
+    CHECK(contains(m, "Hole 1: "));
+  }
+
+  TEST_CASE("cuts: crossing, off the rings or out of the domain are named") {
+    const Domain d = tspline::validate_domain(framed_square());
+    auto err = [&](const std::vector<Cut>& c) {
+      return message_of<tspline::InputError>([&] { tspline::validate_cuts(d, c); });
+    };
+    CHECK(contains(err({{{1, 1}, {2, 0}}, {{2, 1}, {1, 0}}}), "cuts 1 and 2 cross"));
+    CHECK(contains(err({{{1, 1}, {0.5, 0.7}}}), "cut 1: its end (0.5, 0.7) lies neither on a ring"));
+    CHECK(contains(err({{{1, 2}, {3, 2}}}), "runs outside the domain"));
+    CHECK(contains(err({{{0, 2}, {0.5, 2}, {4, 2}}}), "cut 1 crosses hole 1 (edge"));
+    // A hole with a single cut leaves a face that is not simple.
+    const std::string m =
+        message_of<tspline::InputError>([&] { (void)tspline::build_patch_layout(d, {{{1, 1}, {0, 0}}}); });
+    CHECK(contains(m, "not simply connected"));
+  }
+
+  TEST_CASE("patch layout: four trapezoids whose interfaces are whole sides traversed both ways") {
+    const Domain d = tspline::validate_domain(framed_square());
+    const tspline::PatchLayout L = tspline::build_patch_layout(d, diagonal_cuts());
+    REQUIRE(L.patches.size() == 4);
+    REQUIRE(L.interfaces.size() == 4);
+    double area = 0;
+    for (const tspline::Patch& p : L.patches) {
+      CHECK(tspline::signed_area(p.polygon) == doctest::Approx(3));  // (4 + 2) / 2 * 1
+      area += tspline::signed_area(p.polygon);
+    }
+    CHECK(area == doctest::Approx(tspline::domain_area(d)));
+    for (const tspline::Interface& f : L.interfaces) {
+      const tspline::Patch& a = L.patches[f.patch_a];
+      const tspline::Patch& b = L.patches[f.patch_b];
+      CHECK(f.patch_a != f.patch_b);
+      // Side k runs from corner k to corner k+1: a's start is b's end and conversely.
+      CHECK(a.polygon.vertices[a.corners[f.side_a]] == b.polygon.vertices[b.corners[(f.side_b + 1) % 4]]);
+      CHECK(a.polygon.vertices[a.corners[(f.side_a + 1) % 4]] == b.polygon.vertices[b.corners[f.side_b]]);
+      CHECK(a.side_cut[f.side_a] == static_cast<int>(f.cut));
+    }
+  }
+
+  TEST_CASE("border knots: refinement makes dyadic border parameters vertices") {
+    tspline::TMesh m(2);
+    m.build_topology();
+    CHECK(tspline::border_params(m, tspline::Side::Top) == std::vector<double>{0, 0.25, 0.5, 0.75, 1});
+    tspline::BorderParams want;
+    want[static_cast<int>(tspline::Side::Top)] = {0.375};
+    want[static_cast<int>(tspline::Side::Left)] = {0.0625};
+    CHECK(tspline::refine_to_border_params(m, want, 10) > 0);
+    const auto top = tspline::border_params(m, tspline::Side::Top);
+    const auto left = tspline::border_params(m, tspline::Side::Left);
+    CHECK(std::count(top.begin(), top.end(), 0.375) == 1);
+    CHECK(std::count(left.begin(), left.end(), 0.0625) == 1);
+    // t on the top side is xi = 1 - t.
+    CHECK(m.find_vertex({tspline::TMesh::kRoot * 5 / 8, tspline::TMesh::kRoot}) >= 0);
+    CHECK(m.check_invariants().empty());
+    want[0] = {0.3};
+    CHECK_THROWS_AS(tspline::refine_to_border_params(m, want, 10), tspline::InputError);
+  }
+
+  TEST_CASE("automatic cuts of the plate: the plate's corners are corners of the patches, never inside a side") {
+    const Domain d = tspline::validate_domain(read_text_domain(holes_file("plate_with_hole.txt")));
+    const tspline::AutomaticCuts a = tspline::automatic_cuts(d);
+    const tspline::PatchLayout L = tspline::build_patch_layout(d, a.cuts);
+    CHECK(L.patches.size() >= 4);
+    CHECK(L.patches.size() == L.cuts.size());  // Euler: patches = cuts - holes + 1
+    for (const Eigen::Vector2d& corner : d.outer.vertices) {
+      std::size_t as_corner = 0, inside_side = 0;
+      for (const tspline::Patch& p : L.patches)
+        for (std::size_t i = 0; i < p.polygon.vertices.size(); ++i) {
+          if (p.polygon.vertices[i] != corner) continue;
+          const bool is_corner = std::find(p.corners.begin(), p.corners.end(), i) != p.corners.end();
+          (is_corner ? as_corner : inside_side) += 1;
+        }
+      CHECK(as_corner >= 1);
+      CHECK(inside_side == 0);
+    }
+    // Every cut end lies on a ring: the hole (radius 1 about (2, 2)) or the square's border.
+    for (const Cut& c : a.cuts)
+      for (const Eigen::Vector2d& e : {c.front(), c.back()}) {
+        const bool on_hole = std::abs((e - Eigen::Vector2d(2, 2)).norm() - 1.0) < 1e-6;
+        const bool on_square = e.x() == 0 || e.x() == 4 || e.y() == 0 || e.y() == 4;
+        CHECK((on_hole || on_square));
+      }
+  }
+
+  TEST_CASE("multi-patch map of the plate: certified, watertight, area of the plate minus the hole") {
+    const Domain d = read_text_domain(holes_file("plate_with_hole.txt"));
+    const tspline::MultiPatchResult R =
+        tspline::run_multipatch_parameterization(d, std::nullopt, {}, {});
+    CHECK(R.patches.size() >= 4);
+    CHECK(R.certified_valid());
+    CHECK(R.min_relative_det_bound() > 0);
+    CHECK(R.min_mean_ratio_dense() > 0.2);
+    // Polygon areas: 16 minus the 64-gon inscribed in the unit circle.
+    const double hole = 0.5 * 64 * std::sin(2 * std::numbers::pi / 64);
+    CHECK(R.domain_area == doctest::Approx(16 - hole).epsilon(1e-6));
+    CHECK(std::abs(R.map_area - R.domain_area) < 1e-3 * R.domain_area);
+    CHECK(R.max_gap() <= 1e-12 * R.diameter);
+    for (const auto& i : R.interfaces) CHECK(i.same_knots);
+    // The gap is measured, not assumed: patch 0 against itself along another side is far off.
+    const tspline::Interface& f = R.layout.interfaces[0];
+    CHECK(tspline::interface_gap(*R.patches[f.patch_a].map, f.side_a, *R.patches[f.patch_a].map,
+                                 (f.side_a + 1) % 4) > 0.1);
+
+    SUBCASE("format version 2 reads back bit-identically; the version-1 reader refuses it") {
+      const auto dir = test_support::scratch_dir("holes", "v2");
+      const nlohmann::json report = tspline::io::multipatch_report(R, "plate_with_hole.txt", 0.0);
+      tspline::io::write_multipatch_outputs(R, dir.string(), report, 2);
+      const tspline::io::LoadedMaps m = tspline::io::read_maps_file((dir / "tspline.json").string());
+      CHECK(m.version == 2);
+      REQUIRE(m.patches.size() == R.patches.size());
+      REQUIRE(m.interfaces.size() == R.layout.interfaces.size());
+      CHECK(m.interfaces[2].side_b == R.layout.interfaces[2].side_b);
+      for (std::size_t p = 0; p < R.patches.size(); ++p)
+        for (const Eigen::Vector2d& uv : {Eigen::Vector2d(0.3, 0.7), Eigen::Vector2d(1, 0.25)})
+          CHECK(m.patches[p].map.point(uv) == R.patches[p].map->point(uv));
+      const std::string msg = message_of<tspline::InputError>(
+          [&] { (void)tspline::io::read_tspline_file((dir / "tspline.json").string()); });
+      CHECK(contains(msg, "unsupported version 2"));
+      for (const char* f : {"surface.vtu", "boundary.vtu", "parametric_tmesh.vtu", "physical_tmesh.vtu",
+                            "control_net.vtu", "report.json"})
+        CHECK(std::filesystem::exists(dir / f));
+    }
+  }
+
+  TEST_CASE("multi-patch map of the flange (bore and four bolt holes)") {
+    const Domain d = read_text_domain(holes_file("flange.txt"));
+    REQUIRE(d.holes.size() == 5);
+    const tspline::MultiPatchResult R = tspline::run_multipatch_parameterization(d, std::nullopt, {}, {});
+    CHECK(R.certified_valid());
+    CHECK(std::abs(R.map_area - R.domain_area) < 1e-3 * R.domain_area);
+    CHECK(R.max_gap() <= 1e-12 * R.diameter);
+    // Every cut is the side of exactly two patches.
+    CHECK(R.layout.interfaces.size() == R.layout.cuts.size());
+  }
+
+  TEST_CASE("two holes in line in a disk: chords from cut ends into the rings where no chord between cut ends fits") {
+    auto circle = [](double cx, double cy, double r, int n) {
+      std::vector<Eigen::Vector2d> v;
+      for (int k = 0; k < n; ++k)
+        v.emplace_back(cx + r * std::cos(2 * std::numbers::pi * k / n), cy + r * std::sin(2 * std::numbers::pi * k / n));
+      return make_polygon(v);
+    };
+    const Domain d{circle(0, 0, 5, 80), {circle(-2, 0, 1, 32), circle(2, 0, 1, 32)}};
+    const tspline::MultiPatchResult R = tspline::run_multipatch_parameterization(d, std::nullopt, {}, {});
+    CHECK(R.certified_valid());
+    CHECK(std::abs(R.map_area - R.domain_area) < 1e-3 * R.domain_area);
+    CHECK(R.max_gap() <= 1e-12 * R.diameter);
+    for (const tspline::Patch& p : R.layout.patches) CHECK(p.corners.size() == 4);
+  }
+
+  TEST_CASE("GeoJSON polygon with an interior ring: the hole is read and projected with the outer ring") {
+    const tspline::io::DomainInput in = tspline::io::read_domain(holes_file("corsica_lake_lonlat.geojson"));
+    REQUIRE(in.holes.size() == 1);
+    CHECK(in.description["units"] == "m");
+    const Domain v = tspline::validate_domain(Domain{in.outer, in.holes});
+    // Corsica is some 8,700 km^2; the lake a small part of it.
+    CHECK(tspline::domain_area(v) > 7e9);
+    CHECK(tspline::domain_area(v) < 1e10);
+    CHECK(tspline::signed_area(v.holes[0]) < 0.05 * tspline::signed_area(v.outer));
+  }
+}

@@ -1,0 +1,245 @@
+// Global untangling of the T-spline map (map_energy.h, map_untangling.h): the
+// energy's gradient against central differences, chi without cancellation, a
+// folded map untangled to a certified one with its boundary curve unchanged,
+// folds between the samples found through the certificate and removed (by a
+// local problem, or by finer samples), a local energy against the full one,
+// and the quality phase never leaving a certified map uncertified.
+#include <doctest/doctest.h>
+
+#include <Eigen/LU>
+
+#include <cmath>
+#include <optional>
+#include <random>
+
+#include "separable_maps.h"
+#include "test_support.h"
+#include "tspline/validity/map_certification.h"
+#include "tspline/validity/map_energy.h"
+#include "tspline/validity/map_untangling.h"
+
+using tspline::MapEnergy;
+using tspline::TSplineMap;
+
+namespace {
+
+// The identity of [0,1]^2 scaled by 10 on a T-mesh with T-junctions, with every
+// interior control point moved at random by up to `amplitude` (units of 10).
+TSplineMap perturbed_map(unsigned seed, double amplitude, bool t_junctions = true) {
+  TSplineMap map = tspline::greville_identity_map(t_junctions ? test_support::random_leaf_splits(2, 6, seed)
+                                                              : test_support::uniform_mesh(2));
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> u(-amplitude, amplitude);
+  std::vector<Eigen::Vector2d> P = map.control_points();
+  for (std::size_t a = 0; a < P.size(); ++a) {
+    P[a] *= 10.0;
+    if (!tspline::touches_border(map.basis().function(static_cast<int>(a)))) P[a] += 10.0 * Eigen::Vector2d(u(rng), u(rng));
+  }
+  map.set_control_points(P);
+  return map;
+}
+
+std::vector<Eigen::Vector2d> border_points(const TSplineMap& map) {
+  std::vector<Eigen::Vector2d> out;
+  for (std::size_t a = 0; a < map.basis().size(); ++a)
+    if (tspline::touches_border(map.basis().function(static_cast<int>(a)))) out.push_back(map.control_points()[a]);
+  return out;
+}
+
+}  // namespace
+
+TEST_SUITE("map_untangling") {
+  TEST_CASE("chi(D, eps) = (D + sqrt(eps^2 + D^2)) / 2, accurate for D << 0") {
+    CHECK(tspline::regularized_det(3.0, 4.0) == doctest::Approx(4.0).epsilon(1e-15));
+    CHECK(tspline::regularized_det(-3.0, 4.0) == doctest::Approx(1.0).epsilon(1e-15));
+    // eps^2 / (4 |D|) to first order, where the textbook form cancels to 0.
+    CHECK(tspline::regularized_det(-1e8, 1e-3) == doctest::Approx(2.5e-15).epsilon(1e-10));
+    CHECK(tspline::regularized_det(2.0, 0.0) == 2.0);
+  }
+
+  TEST_CASE("energy gradient equals central differences (folded and valid maps, both weightings)") {
+    for (unsigned seed : {3u, 11u})
+      for (double amplitude : {0.02, 0.15})
+        for (auto weighting : {tspline::ElementWeighting::Uniform, tspline::ElementWeighting::Area}) {
+          const TSplineMap map = perturbed_map(seed, amplitude);
+          tspline::MapEnergyOptions eo;
+          eo.weighting = weighting;
+          eo.lobatto = seed == 3;  // both sample rules
+          eo.gauss = eo.lobatto ? 5 : 4;
+          MapEnergy energy(map, eo);
+          // A finer sample level on some elements exercises the other patterns.
+          for (std::size_t e = 0; e < energy.num_elements(); e += 3) energy.set_sample_level(e, 1);
+          const Eigen::VectorXd x = energy.variables(map);
+          REQUIRE(x.size() > 10);
+          for (double eps : {1.0, 0.05}) {
+            const double power = eps == 1.0 ? 1.0 : 3.0;  // the quality phase's powered terms too
+            Eigen::VectorXd g(x.size());
+            energy.evaluate(x.data(), eps, g.data(), nullptr, power);
+            double max_err = 0.0, max_g = 0.0;
+            for (Eigen::Index i = 0; i < x.size(); ++i) {
+              // h ~ cbrt(machine eps) x the variable scale: truncation and
+              // round-off errors of the central difference are both ~1e-10.
+              const double h = 1e-5;
+              Eigen::VectorXd xp = x, xm = x;
+              xp[i] += h, xm[i] -= h;
+              const double fd = (energy.evaluate(xp.data(), eps, nullptr, nullptr, power) -
+                                 energy.evaluate(xm.data(), eps, nullptr, nullptr, power)) /
+                                (2 * h);
+              max_err = std::max(max_err, std::abs(fd - g[i]));
+              max_g = std::max(max_g, std::abs(g[i]));
+            }
+            CAPTURE(seed);
+            CAPTURE(amplitude);
+            CAPTURE(eps);
+            CHECK(max_g > 0.0);
+            CHECK(max_err <= 1e-6 * max_g);
+          }
+        }
+  }
+
+  TEST_CASE("the energy of the scaled identity is the ideal 2 per unit weight, and the variables round-trip") {
+    // Without T-junctions the Greville map is exactly the identity.
+    const TSplineMap map = perturbed_map(5, 0.0, false);
+    tspline::MapEnergyOptions eo;
+    eo.theta = 0.0;
+    eo.weighting = tspline::ElementWeighting::Area;
+    const MapEnergy energy(map, eo);
+    CHECK(energy.length_scale() == doctest::Approx(10.0).epsilon(1e-12));
+    const Eigen::VectorXd x = energy.variables(map);
+    // J = identity after normalization: |J|^2 / det J = 2, weights sum to 1.
+    CHECK(energy.evaluate(x.data(), 1e-12, nullptr) == doctest::Approx(2.0).epsilon(1e-10));
+    const tspline::SampleStats st = energy.stats(x.data());
+    CHECK(st.nonpositive == 0);
+    CHECK(st.min_mean_ratio == doctest::Approx(1.0).epsilon(1e-10));
+    const std::vector<Eigen::Vector2d> P = energy.control_points(x.data());
+    for (std::size_t a = 0; a < P.size(); ++a) CHECK((P[a] - map.control_points()[a]).norm() < 1e-12);
+  }
+
+  TEST_CASE("a folded map is untangled to a certified map; the boundary curve does not move") {
+    for (unsigned seed : {1u, 2u, 7u}) {
+      TSplineMap map = perturbed_map(seed, 0.15);
+      const tspline::MapCertification before = tspline::certify_map(map);
+      CAPTURE(seed);
+      REQUIRE(before.invalid > 0);
+      const std::vector<Eigen::Vector2d> border = border_points(map);
+      const tspline::MapUntanglingReport r = tspline::untangle_map(map);
+      CHECK(r.certified);
+      const tspline::MapCertification after = tspline::certify_map(map);
+      CHECK(after.certified_valid());
+      CHECK(after.min_relative_lower_bound > 0.0);
+      CHECK(r.after.nonpositive == 0);
+      CHECK(r.after.min_mean_ratio > 0.5);  // a square: the untangled map is close to conformal
+      CHECK(border_points(map) == border);
+    }
+  }
+
+  TEST_CASE("a fold between the samples is found through the certificate and removed") {
+    // With 2 x 2 Gauss points per element, find a perturbed map that is valid
+    // at every sample but proven folded by the certificate.
+    tspline::MapUntanglingOptions uo;
+    uo.energy.lobatto = false;
+    uo.energy.gauss = 2;
+    std::optional<TSplineMap> found;
+    for (unsigned seed = 1; seed < 400 && !found; ++seed) {
+      TSplineMap map = perturbed_map(seed, 0.05 + 0.0005 * seed);
+      const MapEnergy e(map, uo.energy);
+      if (e.stats(e.variables(map).data()).nonpositive == 0 && tspline::certify_map(map).invalid > 0) found = map;
+    }
+    REQUIRE(found);
+    // Both ways out: the local problem around the failing elements (default),
+    // and finer samples on the whole map's continuation. Few iterations per
+    // stage, so that the first stage does not already remove the fold.
+    uo.max_iterations_per_stage = 2;
+    for (bool local : {true, false}) {
+      CAPTURE(local);
+      TSplineMap map = *found;
+      uo.local_repair = local;
+      const tspline::MapUntanglingReport r = tspline::untangle_map(map, uo);
+      CHECK(r.before.nonpositive == 0);
+      CHECK(r.certified);
+      CHECK(tspline::certify_map(map).certified_valid());
+      if (local)
+        CHECK(r.local_repairs_certified >= 1);
+      else
+        CHECK(r.local_repairs == 0);
+    }
+  }
+
+  TEST_CASE("a local energy (movable functions) is the full energy minus a constant, with the same gradient") {
+    const TSplineMap map = perturbed_map(4, 0.1);
+    const MapEnergy full(map);
+    tspline::MapEnergyOptions lo;
+    lo.movable.assign(map.basis().size(), 0);
+    for (std::size_t a = 0; a < lo.movable.size(); a += 3) lo.movable[a] = 1;
+    const MapEnergy local(map, lo);
+    REQUIRE(local.free_functions().size() > 3);
+    REQUIRE(local.free_functions().size() < full.free_functions().size());
+    CHECK(local.length_scale() == full.length_scale());  // normalized by the whole domain's area
+    // Position of each local variable among the full ones.
+    std::vector<int> full_index(map.basis().size(), -1);
+    for (std::size_t i = 0; i < full.free_functions().size(); ++i) full_index[full.free_functions()[i]] = 2 * static_cast<int>(i);
+    Eigen::VectorXd xf = full.variables(map), xl = local.variables(map);
+    std::mt19937 rng(8);
+    std::uniform_real_distribution<double> u(-0.01, 0.01);
+    std::optional<double> offset;
+    for (int trial = 0; trial < 3; ++trial) {
+      for (std::size_t i = 0; i < local.free_functions().size(); ++i) {
+        const int j = full_index[local.free_functions()[i]];
+        REQUIRE(j >= 0);
+        const double dx = u(rng), dy = u(rng);
+        xl[2 * i] += dx, xl[2 * i + 1] += dy, xf[j] += dx, xf[j + 1] += dy;
+      }
+      Eigen::VectorXd gf(xf.size()), gl(xl.size());
+      const double Ef = full.evaluate(xf.data(), 0.1, gf.data()), El = local.evaluate(xl.data(), 0.1, gl.data());
+      // The elements without a movable function add a constant, to round-off of the sums.
+      if (!offset) offset = Ef - El;
+      CHECK(Ef - El == doctest::Approx(*offset).epsilon(1e-12).scale(std::abs(Ef)));
+      for (std::size_t i = 0; i < local.free_functions().size(); ++i) {
+        const int j = full_index[local.free_functions()[i]];
+        CHECK(gl[2 * i] == doctest::Approx(gf[j]).epsilon(1e-12).scale(gf.cwiseAbs().maxCoeff()));
+        CHECK(gl[2 * i + 1] == doctest::Approx(gf[j + 1]).epsilon(1e-12).scale(gf.cwiseAbs().maxCoeff()));
+      }
+    }
+  }
+
+  TEST_CASE("a fold at a corner of the square, which only the boundary decides, is reported, not hidden") {
+    // det J at (0,0) is S_xi x S_eta, set by the border control points alone:
+    // pull the second one of the bottom side back behind the corner.
+    TSplineMap map = perturbed_map(6, 0.0, false);
+    std::vector<Eigen::Vector2d> P = map.control_points();
+    int second = -1;
+    for (std::size_t a = 0; a < P.size(); ++a) {
+      const tspline::BlendingFunction& f = map.basis().function(static_cast<int>(a));
+      if (f.knots_eta[3] == 0.0 && f.knots_xi[2] == 0.0 && f.knots_xi[3] > 0.0) second = static_cast<int>(a);
+    }
+    REQUIRE(second >= 0);
+    P[second].x() = -0.5;
+    map.set_control_points(P);
+    REQUIRE(map.jacobian({0.0, 0.0}).determinant() < 0.0);
+    const tspline::MapUntanglingReport r = tspline::untangle_map(map);
+    CHECK_FALSE(r.certified);
+    CHECK(r.certification.invalid > 0);
+    bool at_corner = false;
+    for (const auto& f : r.certification.failures)
+      at_corner = at_corner || (f.lo.x() == 0.0 && f.lo.y() == 0.0);
+    CHECK(at_corner);
+    CHECK(map.control_points()[second] == P[second]);
+  }
+
+  TEST_CASE("the quality phase keeps a certified map certified and does not lower its energy's quality") {
+    for (unsigned seed : {2u, 9u}) {
+      TSplineMap map = perturbed_map(seed, 0.03);
+      REQUIRE(tspline::certify_map(map).certified_valid());
+      const MapEnergy e0(map);
+      const double jr_before = e0.stats(e0.variables(map).data()).mean_mean_ratio;
+      std::vector<bool> certified_stages;
+      tspline::MapUntanglingOptions uo;
+      uo.progress = [&](const tspline::UntanglingProgress& p) { certified_stages.push_back(p.certified); };
+      const tspline::MapUntanglingReport r = tspline::untangle_map(map, uo);
+      CHECK(r.certified);
+      CHECK(tspline::certify_map(map).certified_valid());
+      CHECK(r.after.mean_mean_ratio >= jr_before);
+      REQUIRE_FALSE(certified_stages.empty());
+    }
+  }
+}

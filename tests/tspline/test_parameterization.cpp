@@ -1,0 +1,97 @@
+// The front half on every bundled test domain, with default options and
+// automatic corners: the optimized T-mesh must have no inverted cell.
+#include <doctest/doctest.h>
+
+#include <iostream>
+
+#include "test_support.h"
+
+using test_support::contains;
+
+#include "tspline/io/polygon_reader.h"
+#include "tspline/pipeline/parameterization.h"
+
+TEST_SUITE("parameterization") {
+  TEST_CASE("every test domain ends with zero inverted cells (default options, automatic corners)") {
+    for (const std::string name : {"square.txt", "lshape_cw.txt", "disk.txt", "flower.txt", "cshape.txt", "gear.txt",
+                             "blob_bay.txt", "fjords.txt"}) {
+      CAPTURE(name);
+      const auto poly = tspline::io::read_polygon(test_support::polygon_file(name));
+      const tspline::FrontResult r = tspline::run_front(poly, {});
+      MESSAGE(name << ": " << r.mesh.num_cells() << " cells, inverted after Coons "
+                   << r.quality_coons.inverted_cells << ", after optimization " << r.quality_optimized.inverted_cells
+                   << ", min/mean quality " << r.quality_optimized.min_quality << "/"
+                   << r.quality_optimized.mean_quality << ", sweeps " << r.total_sweeps << ", repair rounds " << r.repair_refined_cells.size());
+      CHECK(r.quality_optimized.inverted_cells == 0);
+      CHECK(r.refinement.edges_over_tolerance == 0);
+      CHECK(r.mesh.check_invariants() == "");
+      CHECK(r.quality_optimized.min_quality > 0.0);
+      // Boundary vertices stay exactly where the chord-length map puts them.
+      for (int v = 0; v < static_cast<int>(r.mesh.num_vertices()); ++v)
+        if (r.mesh.vertex_on_boundary(v))
+          CHECK((r.optimized[v] - r.boundary.point_at(r.mesh.vertex_param(v))).norm() == 0.0);
+    }
+  }
+}
+
+TEST_SUITE("parameterization") {
+  TEST_CASE("nested optimization ends on the same T-mesh as the direct one, and as good") {
+    const auto poly = tspline::io::read_polygon(test_support::polygon_file("flower.txt"));
+    tspline::ParameterizationOptions opt;
+    opt.initial_level = 5;
+    opt.corner_trials = 1;  // the same corners for both runs
+    opt.smoothing.relative_displacement_tolerance = 1e-5;
+    opt.smoothing.max_sweeps = 5000;
+    const tspline::FrontResult nested = tspline::run_front(poly, opt);
+    opt.nested_optimization = false;
+    const tspline::FrontResult direct = tspline::run_front(poly, opt);
+    REQUIRE(nested.mesh.num_cells() == direct.mesh.num_cells());
+    REQUIRE(nested.mesh.num_vertices() == direct.mesh.num_vertices());
+    // Same vertex set (exact integer coordinates), hence the same optimization problem.
+    for (int v = 0; v < static_cast<int>(direct.mesh.num_vertices()); ++v)
+      CHECK(nested.mesh.find_vertex(direct.mesh.vertex_ipos(v)) >= 0);
+    CHECK(nested.quality_optimized.inverted_cells == 0);
+    CHECK(direct.quality_optimized.inverted_cells == 0);
+    // Both converge to the same optimum: node positions agree to a small
+    // fraction of the smallest cell's physical size (~1e-2 here).
+    double worst = 0.0;
+    for (int v = 0; v < static_cast<int>(direct.mesh.num_vertices()); ++v) {
+      const int w = nested.mesh.find_vertex(direct.mesh.vertex_ipos(v));
+      worst = std::max(worst, (nested.optimized[w] - direct.optimized[v]).norm());
+    }
+    MESSAGE("largest node distance nested vs direct: " << worst);
+    CHECK(worst < 1e-3);
+    CHECK(nested.quality_optimized.mean_quality == doctest::Approx(direct.quality_optimized.mean_quality).epsilon(1e-4));
+  }
+}
+
+TEST_SUITE("parameterization") {
+  TEST_CASE("corner trials keep the best automatic choice by the documented criterion") {
+    const auto poly = tspline::io::read_polygon(test_support::polygon_file("lshape_cw.txt"));
+    tspline::ParameterizationOptions opt;
+    opt.corner_trials = 4;
+    const tspline::FrontResult r = tspline::run_front(poly, opt);
+    REQUIRE(r.corner_trials.size() == 4);
+    // The rule itself is tested on literal values (best_corner_trial, test_hardening.cpp);
+    // here: the run keeps the trial it names, and that trial is no worse than any other.
+    const std::size_t best = tspline::best_corner_trial(r.corner_trials);
+    CHECK(r.boundary.corners().index == r.corner_trials[best].corners);
+    for (const auto& t : r.corner_trials) {
+      CHECK(r.corner_trials[best].inverted_cells <= t.inverted_cells);
+      if (t.inverted_cells == r.corner_trials[best].inverted_cells)
+        CHECK(r.corner_trials[best].min_quality + r.corner_trials[best].mean_quality >=
+              t.min_quality + t.mean_quality);
+    }
+    CHECK(contains(r.boundary.corners().explanation, "(choice " + std::to_string(best + 1) + ")"));
+    // With the default initial level the trial is the final run: identical numbers.
+    CHECK(r.quality_optimized.min_quality == r.corner_trials[best].min_quality);
+    CHECK(r.quality_optimized.mean_quality == r.corner_trials[best].mean_quality);
+    // The four choices are distinct.
+    for (std::size_t i = 0; i < 4; ++i)
+      for (std::size_t j = i + 1; j < 4; ++j) CHECK(r.corner_trials[i].corners != r.corner_trials[j].corners);
+    opt.corner_trials = 1;
+    const tspline::FrontResult single = tspline::run_front(poly, opt);
+    CHECK(single.corner_trials.empty());
+    CHECK(single.boundary.corners().index == r.corner_trials[0].corners);
+  }
+}

@@ -1,0 +1,138 @@
+// run_front / run_parameterization as a library user sees them: the progress
+// events (typed, per stage), the options kept in the result, the options
+// validated before any work with the option named, and the corner trials,
+// whose kept trial is the run itself.
+#include <doctest/doctest.h>
+
+#include <array>
+#include <functional>
+#include <map>
+#include <set>
+#include <string>
+
+#include "test_support.h"
+#include "tspline/pipeline/adaptive_parameterization.h"
+#include "tspline/errors.h"
+#include "tspline/io/polygon_reader.h"
+#include "tspline/pipeline/parameterization.h"
+
+using tspline::ProgressEvent;
+
+TEST_SUITE("parameterization_run") {
+  TEST_CASE("progress arrives as typed events: steps per stage, every sweep in order, untangling stages") {
+    const tspline::Polygon poly = tspline::io::read_polygon(test_support::polygon_file("lshape_cw.txt"));
+    std::vector<ProgressEvent> events;
+    tspline::ParameterizationOptions opt;
+    opt.corner_trials = 1;  // concurrent trials report when each is done, not their sweeps
+    opt.progress = [&](const ProgressEvent& e) { events.push_back(e); };
+    tspline::AdaptiveOptions ad;
+    ad.max_adapt = 1;
+    const tspline::ParameterizationResult r = tspline::run_parameterization(poly, opt, ad);
+    std::set<std::string> step_stages;
+    int last_sweep = -1, sweeps = 0, untangling_stages = 0;
+    for (const ProgressEvent& e : events) {
+      CHECK_FALSE(e.text.empty());
+      CHECK_FALSE(e.stage.empty());
+      switch (e.kind) {
+        case ProgressEvent::Kind::Step: step_stages.insert(e.stage); break;
+        case ProgressEvent::Kind::Note: break;
+        case ProgressEvent::Kind::Sweep:
+          // Each optimization run counts its sweeps from 0, one event per sweep.
+          CHECK(e.stage == "optimization");
+          CHECK((e.count == 0 || e.count == last_sweep + 1));
+          CHECK(e.value >= 0.0);
+          last_sweep = e.count;
+          ++sweeps;
+          break;
+        case ProgressEvent::Kind::Untangling:
+          CHECK(e.stage == "untangling");
+          CHECK(e.iteration >= 0);
+          CHECK(e.count >= 0);
+          CHECK(e.value > 0.0);  // eps
+          ++untangling_stages;
+          break;
+      }
+    }
+    for (const char* s : {"boundary", "tmesh", "coons", "optimization", "boundary_curve", "untangling", "map", "stop"}) {
+      CAPTURE(s);
+      CHECK(step_stages.count(s) == 1);
+    }
+    // Every sweep of every optimization run was reported.
+    CHECK(sweeps == r.front.total_sweeps);
+    int stages = 0;
+    for (const tspline::AdaptIteration& it : r.iterations) stages += it.untangling.stages;
+    CHECK(untangling_stages == stages);
+    // The last event says why the loop stopped.
+    CHECK(events.back().stage == "stop");
+    CHECK(test_support::contains(events.back().text, r.stop_reason));
+  }
+
+  TEST_CASE("the result keeps the options it was computed with, without the callbacks") {
+    const tspline::Polygon poly = tspline::io::read_polygon(test_support::polygon_file("square.txt"));
+    tspline::ParameterizationOptions opt;
+    opt.initial_level = 2;
+    opt.progress = [](const ProgressEvent&) {};
+    tspline::AdaptiveOptions ad;
+    ad.min_jacobian = 0.35;
+    ad.max_adapt = 1;
+    const tspline::ParameterizationResult r = tspline::run_parameterization(poly, opt, ad);
+    CHECK(r.options.initial_level == 2);
+    CHECK_FALSE(r.options.progress);
+    CHECK(r.adaptive.min_jacobian == 0.35);
+    CHECK(r.adaptive.max_adapt == 1);
+    CHECK(r.good() == (r.valid() && r.quality.min_mean_ratio >= 0.35));
+  }
+
+  TEST_CASE("options out of range are input errors that name the option, before any work") {
+    const tspline::Polygon poly = tspline::io::read_polygon(test_support::polygon_file("square.txt"));
+    auto message = [&](const tspline::ParameterizationOptions& o, const tspline::AdaptiveOptions& a) -> std::string {
+      try {
+        tspline::run_parameterization(poly, o, a);
+      } catch (const tspline::InputError& e) {
+        return e.what();
+      }
+      return "";
+    };
+    const std::map<std::string, std::function<void(tspline::ParameterizationOptions&, tspline::AdaptiveOptions&)>>
+        cases{{"--omega", [](auto& o, auto&) { o.smoothing.over_relaxation = 2.5; }},
+              {"--max-sweeps", [](auto& o, auto&) { o.smoothing.max_sweeps = -1; }},
+              {"--sweep-tol", [](auto& o, auto&) { o.smoothing.relative_displacement_tolerance = -1.0; }},
+              {"--init-level", [](auto& o, auto&) { o.initial_level = 11; }},
+              {"--min-jacobian", [](auto&, auto& a) { a.min_jacobian = 0.0; }},
+              {"--cert-depth", [](auto&, auto& a) { a.certification.max_depth = 21; }},
+              {"quality_power", [](auto&, auto& a) { a.untangling.quality_power = 0.5; }}};
+    for (const auto& [name, spoil] : cases) {
+      CAPTURE(name);
+      tspline::ParameterizationOptions o;
+      tspline::AdaptiveOptions a;
+      spoil(o, a);
+      CHECK(test_support::contains(message(o, a), name));
+    }
+  }
+
+  TEST_CASE("the kept corner trial is the run: the same T-mesh and nodes as a run with those corners given") {
+    const tspline::Polygon poly = tspline::io::read_polygon(test_support::polygon_file("flower.txt"));
+    tspline::ParameterizationOptions opt;
+    int trial_reports = 0;  // one "trial k of n done" per trial, as each finishes
+    opt.progress = [&](const ProgressEvent& e) { trial_reports += e.stage == "corners" && test_support::contains(e.text, "trial"); };
+    const tspline::FrontResult automatic = tspline::run_front(poly, opt);
+    CHECK(trial_reports == opt.corner_trials);
+    REQUIRE(automatic.corner_trials.size() == static_cast<std::size_t>(opt.corner_trials));
+    std::array<long long, 4> given{};
+    for (int k = 0; k < 4; ++k)
+      given[k] = static_cast<long long>(automatic.boundary.polygon().file_index[automatic.boundary.corners().index[k]]);
+    opt.corners = given;
+    trial_reports = 0;
+    opt.progress = [&](const ProgressEvent& e) { trial_reports += e.stage == "corners" && test_support::contains(e.text, "trial"); };
+    const tspline::FrontResult explicit_corners = tspline::run_front(poly, opt);
+    CHECK(trial_reports == 0);  // corners given: no trials
+    REQUIRE(explicit_corners.mesh.num_cells() == automatic.mesh.num_cells());
+    REQUIRE(explicit_corners.optimized.size() == automatic.optimized.size());
+    for (std::size_t v = 0; v < automatic.optimized.size(); ++v) CHECK(explicit_corners.optimized[v] == automatic.optimized[v]);
+    CHECK(explicit_corners.total_sweeps == automatic.total_sweeps);
+    // The stage times of the kept trial are reported as the run's.
+    bool has_optimization = false;
+    for (const tspline::StageTime& t : automatic.times) has_optimization = has_optimization || t.stage == "optimization";
+    CHECK(has_optimization);
+  }
+}
