@@ -1,5 +1,5 @@
 #pragma once
-// Subcommands of the `tspline` program that live outside tspline_main.cpp.
+// The subcommands of the `tspline` program, one file each (cmd_*.cpp).
 //
 // Each add_*_commands() registers its subcommands on `app`. When one of them is
 // parsed, its callback stores the work to do in `action`; main() then runs
@@ -12,6 +12,9 @@ namespace tspline_app {
 
 /// The work of the parsed subcommand; returns the process exit code.
 using CommandAction = std::function<int()>;
+
+/// `tspline param`: the parameterization of a domain and its output folder (cmd_param.cpp).
+void add_param_command(CLI::App& app, CommandAction& action);
 
 /// `tspline eval` and `tspline info`: evaluate / describe a T-spline file
 /// (docs/tspline_format.md).

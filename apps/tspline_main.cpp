@@ -10,219 +10,21 @@
 //   exit 4  unexpected internal error
 //   exit 130 interrupted (Ctrl-C): stopped before writing any output
 #include <CLI/CLI.hpp>
-#include <array>
-#include <cstdio>
 #include <iostream>
-#include <optional>
-#include <sstream>
-#include <string>
 
 #include "commands.h"
 #include "exit_codes.h"
 #include "interrupt.h"
-#include "param_multipatch.h"
-#include "progress.h"
-#include "tspline/errors.h"
-#include "toolkit/io/atomic_file.h"
-#include "tspline/io/gis_reader.h"
-#include "tspline/pipeline/adaptive_parameterization.h"
-#include "tspline/io/param_output.h"
-#include "tspline/io/polygon_reader.h"
-#include "tspline/pipeline/parameterization.h"
 
 // LeakSanitizer suppressions of the program (third-party libraries only): apps/petsc_session.cpp.
-
-namespace {
-
-std::array<long long, 4> parse_corners(const std::string& text) {
-  std::array<long long, 4> out{};
-  std::stringstream ss(text);
-  std::string item;
-  int n = 0;
-  while (std::getline(ss, item, ',')) {
-    if (n == 4) throw tspline::InputError("--corners expects 4 comma-separated indices, got '" + text + "'");
-    std::size_t used = 0;
-    try {
-      out[n] = std::stoll(item, &used);
-    } catch (const std::exception&) {
-      used = 0;
-    }
-    if (used == 0 || used != item.size())
-      throw tspline::InputError("--corners: '" + item + "' is not an integer vertex index");
-    ++n;
-  }
-  if (n != 4) throw tspline::InputError("--corners expects 4 comma-separated indices, got '" + text + "'");
-  return out;
-}
-
-int run_param(const std::string& input, const std::string& out_dir, const std::string& corners_text,
-              tspline::ParameterizationOptions opt, const tspline::AdaptiveOptions& adaptive, int samples,
-              const tspline::io::DomainReadOptions& domain_options, tspline_app::OutputMode mode,
-              const std::string& cuts_file) {
-  if (!corners_text.empty()) opt.corners = parse_corners(corners_text);
-  if (samples < 1 || samples > 64) throw tspline::InputError("--samples must be in [1, 64]");
-  tspline_app::Progress progress(mode);
-  const bool quiet = mode != tspline_app::OutputMode::Human;
-  opt.progress = [&progress](const tspline::ProgressEvent& e) { progress.report(e); };
-  // Fail on an unwritable output directory before any computation.
-  toolkit::io::ensure_writable_directory(out_dir);
-  const tspline::io::DomainInput domain = tspline::io::read_domain(input, domain_options);
-  const tspline::Polygon& polygon = domain.outer;
-  if (!domain.holes.empty() || !cuts_file.empty())
-    return tspline_app::run_multipatch_param(domain, input, out_dir, cuts_file, opt, adaptive, samples, progress);
-  tspline::io::AdaptSeriesWriter series(out_dir, samples);
-  const tspline::ParameterizationResult result = tspline::run_parameterization(
-      polygon, opt, adaptive,
-      [&](int it, const tspline::TMesh& mesh, const std::vector<Eigen::Vector2d>& x, const tspline::TSplineMap& map,
-          const std::vector<tspline::CellMapQuality>&) {
-        series.add(it, mesh, x, map);
-        progress.event({{"event", "iteration"},
-                        {"iteration", it},
-                        {"cells", mesh.num_cells()},
-                        {"functions", map.basis().size()}});
-        progress.progress("adaptive rounds", it + 1, adaptive.max_adapt + 1);
-      });
-  series.finish();
-  nlohmann::json report = tspline::io::param_report(result, input);
-  report["input_geometry"] = domain.description;  // format, layer, CRS, projection (gis_reader.h)
-  tspline::io::write_param_outputs(result, out_dir, report, samples);
-  progress.settle();
-  progress.event({{"event", "result"},
-                  {"valid", result.valid()},
-                  {"good", result.good()},
-                  {"certified_valid", result.certified_valid()},
-                  {"min_mean_ratio_jacobian", result.quality.min_mean_ratio},
-                  {"cells", result.map ? result.map->mesh().num_cells() : 0},
-                  {"stop_reason", result.stop_reason},
-                  {"out", out_dir},
-                  {"files", {"tspline.json", "surface.vtu", "control_net.vtu", "adapt.pvd", "parametric_tmesh.vtu",
-                             "physical_tmesh.vtu", "boundary.vtu", "report.json"}}});
-  if (!quiet)
-    std::cout << "wrote tspline.json, surface.vtu, control_net.vtu, adapt.pvd, parametric_tmesh.vtu, "
-                 "physical_tmesh.vtu, boundary.vtu, report.json to "
-              << out_dir << std::endl;
-  if (!result.valid()) {
-    std::cerr << "tspline: error: the map is not valid: det J <= 0 at " << result.quality.nonpositive_det << " of "
-              << result.quality.points << " quadrature points; adaptive refinement stopped: " << result.stop_reason
-              << " (files written; see surface.vtu, point data det_jacobian, or `tspline render OUTDIR`); try "
-                 "other --corners, a smaller --tol-rel, or more --max-adapt rounds"
-              << std::endl;
-    return 3;
-  }
-  if (adaptive.certify && !result.certified_valid()) {
-    const tspline::MapCertification& c = result.certification;
-    std::string where;
-    if (!c.failures.empty()) {
-      // Where: the first failing element, in parametric and physical coordinates.
-      const tspline::CertificationFailure& f = c.failures.front();
-      const Eigen::Vector2d uv = f.certificate.status == tspline::ElementStatus::Invalid
-                                     ? f.certificate.negative_at
-                                     : Eigen::Vector2d(0.5 * (f.lo + f.hi));
-      const Eigen::Vector2d x = result.map->point(uv);
-      std::ostringstream s;
-      s << ", e.g. near (" << x.x() << ", " << x.y() << ") = S(" << uv.x() << ", " << uv.y() << ")";
-      where = s.str();
-    }
-    std::cerr << "tspline: error: the map is not certified valid: " << c.elements - c.certified << " of " << c.elements
-              << " elements not certified (" << c.invalid << " with det J < 0 proven, " << c.undecided
-              << " undecided" << where << "); adaptive refinement stopped: " << result.stop_reason
-              << " (files written; run 'tspline check' on tspline.json for the elements)" << std::endl;
-    return 3;
-  }
-  if (!result.good() && !quiet)
-    std::cout << "warning: min J_r " << result.quality.min_mean_ratio << " is below --min-jacobian "
-              << adaptive.min_jacobian << "; adaptive refinement stopped: " << result.stop_reason
-              << " (the corner choice fixes the map's aspect ratio: try other --corners)" << std::endl;
-  return 0;
-}
-
-}  // namespace
 
 int main(int argc, char** argv) {
   CLI::App app{"tspline: T-spline parameterization of 2D domains for isogeometric analysis"};
   app.require_subcommand(1);
   app.set_version_flag("--version", "tspline " TSPLINE_VERSION);
 
-  CLI::App* param = app.add_subcommand(
-      "param", "Parameterize the domain bounded by a polygon: adapted T-mesh, Coons start, untangling and smoothing, "
-      "cubic T-spline fit, Jacobian check and adaptive refinement");
-  std::string input, out_dir, corners;
-  tspline::ParameterizationOptions opt;
-  double tol = 0.0;
-  std::size_t geojson_polygon = 0;
-  bool quiet = false;
-  param->add_option("DOMAIN", input,
-                    "Domain file: text polygon ('x y' per line, '#' comments, planar) or any polygon layer GDAL reads "
-                    "(Shapefile, GeoPackage, KML, GML, GeoJSON, ...; longitude/latitude are projected to metres)")
-      ->required();
-  param->add_option("--out", out_dir, "Output directory (created if missing)")->required();
-  std::string cuts_file;
-  param->add_option("--cuts", cuts_file,
-                    "Domain with holes: the cuts into four-sided patches as polylines ('x y' per line, cuts "
-                    "separated by blank lines; ends on rings or at ends of other cuts); default: automatic");
-  param->add_option("--corners", corners,
-                    "Four vertex indices i,j,k,l (0-based, the file's own numbering, in cyclic file order) "
-                    "mapped to (0,0),(1,0),(1,1),(0,1); default: automatic choice explained in report.json");
-  param->add_option("--corner-trials", opt.corner_trials,
-                    "Automatic corners: run this many of the best choices and keep the one with the fewest "
-                    "inverted cells, then the best min + mean quality (1: no trials)")
-      ->capture_default_str();
-  auto* tol_opt = param->add_option("--tol", tol,
-                                    "Boundary tolerance epsilon as an absolute AREA (units^2): a boundary cell "
-                                    "is refined while a polygon vertex forms with its edge a triangle larger "
-                                    "than epsilon (Brovka 2013 Sect. 3)");
-  param->add_option("--tol-rel", opt.tolerance_relative,
-                    "Boundary tolerance relative to the squared bounding-box diagonal, used when --tol is "
-                    "not given")
-      ->capture_default_str();
-  param->add_option("--init-level", opt.initial_level, "Initial uniform level L in [0, 10]: 2^L x 2^L cells")
-      ->capture_default_str();
-  param->add_option("--max-level", opt.max_level, "Maximum refinement level of any cell")->capture_default_str();
-  param->add_option("--max-sweeps", opt.smoothing.max_sweeps, "Maximum Gauss-Seidel sweeps of the optimization")
-      ->capture_default_str();
-  param->add_option("--omega", opt.smoothing.over_relaxation,
-                    "Over-relaxation factor in [1, 2) of the node updates (1: plain Gauss-Seidel)")
-      ->capture_default_str();
-  param->add_option("--sweep-tol", opt.smoothing.relative_displacement_tolerance,
-                    "Stop when the largest node move relative to its local edge length is below this")
-      ->capture_default_str();
-  auto* gj_opt = param->add_option("--polygon", geojson_polygon,
-                                   "GIS file (or GeoJSON) with several polygons (in the layer or the --feature): "
-                                   "which one (0-based, file order); default the largest");
-  tspline::io::DomainReadOptions domain_options;
-  std::string layer;
-  std::size_t feature = 0;
-  auto* layer_opt = param->add_option("--layer", layer, "GIS file: layer name or 0-based index; default the first "
-                                                        "layer with polygons");
-  auto* feature_opt = param->add_option("--feature", feature, "GIS file: only this feature (0-based, layer order)");
-  param->add_flag("--planar", domain_options.planar,
-                  "Keep the coordinates as they are (no projection of longitude/latitude to metres)");
-  tspline::AdaptiveOptions adaptive;
-  int samples = 4;
-  param->add_option("--min-jacobian", adaptive.min_jacobian,
-                    "delta of Sect. 6.2: refine the cells where the mean ratio Jacobian J_r = 2 det J / |J|^2 is "
-                    "below it at some of the 4x4 Gauss points")
-      ->capture_default_str();
-  param->add_option("--max-adapt", adaptive.max_adapt, "Adaptive refinement rounds at most")->capture_default_str();
-  param->add_option("--max-cells", adaptive.max_cells, "The T-mesh never goes beyond this many cells (boundary refinement, repair, adaptive "
-                    "refinement); a polygon that needs more stops with a message")
-      ->capture_default_str();
-  bool no_cpo = false;
-  param->add_flag("--no-control-point-optimization", no_cpo,
-                  "Keep the interpolating map of the T-mesh (by default all interior control points are "
-                  "untangled and smoothed globally until det J > 0 is certified)");
-  param->add_option("--cert-depth", adaptive.certification.max_depth,
-                    "Certification of det J > 0 on every Bezier element: de Casteljau subdivision levels at most "
-                    "(an element still undecided there is refined like one with J_r below --min-jacobian)")
-      ->check(CLI::Range(0, 20))
-      ->capture_default_str();
-  param->add_option("--samples", samples, "surface.vtu: k x k sub-quads per T-mesh cell")->capture_default_str();
-  param->add_flag("--quiet,-q", quiet, "Print errors only");
-  bool json_events = false;
-  param->add_flag("--json", json_events,
-                  "Print progress and the result as JSON lines (one object per line: events log, progress, "
-                  "iteration, result) instead of text");
-  tspline_app::CommandAction command;  // set by the other subcommands when parsed (commands.h)
+  tspline_app::CommandAction command;  // set by the subcommand parsed (commands.h)
+  tspline_app::add_param_command(app, command);
   tspline_app::add_tspline_file_commands(app, command);
   tspline_app::add_check_command(app, command);
   tspline_app::add_poisson_command(app, command);
@@ -242,16 +44,6 @@ int main(int argc, char** argv) {
   tspline_app::install_interrupt_handlers();
   try {
     if (command) return command();
-    if (param->parsed()) {
-      if (tol_opt->count() > 0) opt.tolerance_absolute = tol;
-      adaptive.optimize_control_points = !no_cpo;
-      opt.max_cells = adaptive.max_cells;  // one budget for the front half and the adaptive loop
-      if (gj_opt->count() > 0) domain_options.polygon_index = geojson_polygon;
-      if (layer_opt->count() > 0) domain_options.layer = layer;
-      if (feature_opt->count() > 0) domain_options.feature = feature;
-      return run_param(input, out_dir, corners, opt, adaptive, samples, domain_options,
-                       tspline_app::output_mode(quiet, json_events), cuts_file);
-    }
   } catch (...) {
     return tspline_app::report_current_exception("tspline");
   }

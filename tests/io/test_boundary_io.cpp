@@ -40,7 +40,7 @@ std::string geojson_ring(const std::vector<V2>& v) {
 
 }  // namespace
 
-TEST_SUITE("boundary") {
+TEST_SUITE("boundary_io") {
   TEST_CASE("text format: comments, blank lines, commas, repeated closing vertex dropped") {
     const std::string txt = "# header\n\n  0 0   # origin\n1,0\n 1 , 1\n\t0 1\n+0.0 0e0\n\n# end\n";
     const Polygon p = io::parse_polygon(txt, "mem.txt");

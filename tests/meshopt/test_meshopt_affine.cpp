@@ -26,7 +26,7 @@ meshopt::AffineTerm as_affine(const Eigen::Vector2d& pa, const Eigen::Vector2d& 
 
 }  // namespace
 
-TEST_SUITE("meshopt") {
+TEST_SUITE("meshopt_affine") {
   TEST_CASE("affine terms reproduce the triangle objective exactly (value, gradient, Hessian)") {
     std::mt19937 rng(11);
     std::uniform_real_distribution<double> u(-1.0, 1.0);

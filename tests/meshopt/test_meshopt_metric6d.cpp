@@ -12,6 +12,8 @@
 #include "meshopt/remesh_mesh.h"
 #include "meshopt/remesh_statistics.h"
 
+TEST_SUITE_BEGIN("meshopt_metric6d");
+
 using namespace meshopt;
 using Eigen::Vector3d;
 
@@ -154,3 +156,5 @@ TEST_CASE("remesh mesh: Euler characteristics, manifold check, compaction") {
   CHECK(m.euler_characteristics().at(0) == 1);
   CHECK(m.feature_curve(0, 3) == 7);
 }
+
+TEST_SUITE_END();

@@ -5,6 +5,8 @@
 #include "meshopt/parametric_star.h"
 #include "meshopt/remesh_geometry.h"
 
+TEST_SUITE_BEGIN("meshopt_parametric_star");
+
 using namespace meshopt;
 using Eigen::Vector2d;
 
@@ -40,3 +42,5 @@ TEST_CASE("projection hint: inside the star of a face's vertices, away from its 
   CHECK_FALSE(h.proves_inside(7, Vector2d(1.0, 0.6), span, false));
   CHECK(h.proves_inside(7, Vector2d(1.6, 1.0), span, false));
 }
+
+TEST_SUITE_END();

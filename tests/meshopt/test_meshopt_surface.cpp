@@ -19,6 +19,8 @@
 #include "surface_test_support.h"
 #include "test_support.h"
 
+TEST_SUITE_BEGIN("meshopt_surface");
+
 using Eigen::Matrix2d;
 using Eigen::Vector2d;
 using Eigen::Vector3d;
@@ -234,3 +236,5 @@ TEST_CASE("surface mesh: bad input gives one clear error") {
   bad.tol_x = -1;
   CHECK_THROWS_AS(smooth_surface(m, bad), std::invalid_argument);
 }
+
+TEST_SUITE_END();

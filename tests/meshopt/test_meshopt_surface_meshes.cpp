@@ -15,6 +15,8 @@
 #include "meshopt/surface_smoother.h"
 #include "surface_test_support.h"
 
+TEST_SUITE_BEGIN("meshopt_surface_meshes");
+
 using Eigen::Vector2d;
 using Eigen::Vector3d;
 using namespace meshopt;
@@ -336,3 +338,5 @@ TEST_CASE("surface smoothing: the size-shape measure follows a size field better
   CHECK(q_ss.mean > q_sh.mean);
   CHECK(q_ss.min > q_sh.min);
 }
+
+TEST_SUITE_END();

@@ -95,3 +95,21 @@ TEST_SUITE("parameterization") {
     CHECK(single.boundary.corners().index == r.corner_trials[0].corners);
   }
 }
+
+TEST_SUITE("parameterization") {
+  TEST_CASE("best_corner_trial: fewest inverted cells first, then the highest min + mean quality") {
+    using tspline::CornerTrial;
+    using tspline::best_corner_trial;
+    const std::array<std::size_t, 4> c{0, 1, 2, 3};
+    CHECK(best_corner_trial({}) == 0);
+    // Fewer inverted cells beat any quality.
+    CHECK(best_corner_trial({{c, 2, 0.9, 0.9}, {c, 1, -0.5, 0.1}, {c, 3, 0.9, 0.9}}) == 1);
+    // Equal inverted cells: the sum min + mean decides (0.2 + 0.6 > 0.5 + 0.2).
+    CHECK(best_corner_trial({{c, 0, 0.5, 0.2}, {c, 0, 0.2, 0.6}, {c, 1, 0.9, 0.9}}) == 1);
+    // A tie keeps the first.
+    CHECK(best_corner_trial({{c, 0, 0.3, 0.5}, {c, 0, 0.5, 0.3}}) == 0);
+    // A trial over the cell budget (ranked with the most inverted cells) loses.
+    constexpr double kWorst = -std::numeric_limits<double>::infinity();
+    CHECK(best_corner_trial({{c, std::numeric_limits<std::size_t>::max(), kWorst, kWorst}, {c, 40, 0.0, 0.1}}) == 1);
+  }
+}

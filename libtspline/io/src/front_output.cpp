@@ -3,6 +3,7 @@
 #include <filesystem>
 
 #include "toolkit/io/atomic_file.h"
+#include "tspline/io/output_files.h"
 
 namespace tspline::io {
 
@@ -146,9 +147,9 @@ void write_front_meshes(const FrontResult& r, const std::string& out_dir) {
   const std::filesystem::path dir(out_dir);
   std::vector<Eigen::Vector2d> param(r.mesh.num_vertices());
   for (int v = 0; v < static_cast<int>(param.size()); ++v) param[v] = r.mesh.vertex_param(v);
-  toolkit::io::write_vtu((dir / "parametric_tmesh.vtu").string(), tmesh_vtu(r.mesh, param));
-  toolkit::io::write_vtu((dir / "physical_tmesh.vtu").string(), tmesh_vtu(r.mesh, r.optimized));
-  toolkit::io::write_vtu((dir / "boundary.vtu").string(), boundary_vtu(r.boundary));
+  toolkit::io::write_vtu((dir / output_files::kParametricTMesh).string(), tmesh_vtu(r.mesh, param));
+  toolkit::io::write_vtu((dir / output_files::kPhysicalTMesh).string(), tmesh_vtu(r.mesh, r.optimized));
+  toolkit::io::write_vtu((dir / output_files::kBoundary).string(), boundary_vtu(r.boundary));
 }
 
 }  // namespace tspline::io

@@ -6,6 +6,7 @@
 #include "tspline/io/front_output.h"
 #include "tspline/io/multipatch_file.h"
 #include "tspline/io/param_output.h"
+#include "tspline/io/output_files.h"
 
 namespace tspline::io {
 namespace {
@@ -134,14 +135,14 @@ void write_multipatch_outputs(const MultiPatchResult& R, const std::string& out_
     phys.push_back(tmesh_vtu(mesh, r.front.optimized));
     boundary.push_back(boundary_vtu(r.front.boundary));
   }
-  write_multipatch_file((dir / "tspline.json").string(), maps, metas, R.layout.interfaces, R.layout.cuts,
+  write_multipatch_file((dir / output_files::kTSpline).string(), maps, metas, R.layout.interfaces, R.layout.cuts,
                         report.value("input", ""));
-  toolkit::io::write_vtu((dir / "surface.vtu").string(), merge_patches(surface));
-  toolkit::io::write_vtu((dir / "control_net.vtu").string(), merge_patches(net));
-  toolkit::io::write_vtu((dir / "parametric_tmesh.vtu").string(), merge_patches(param));
-  toolkit::io::write_vtu((dir / "physical_tmesh.vtu").string(), merge_patches(phys));
-  toolkit::io::write_vtu((dir / "boundary.vtu").string(), merge_patches(boundary));
-  toolkit::io::write_text_atomic((dir / "report.json").string(), report.dump(2) + "\n");
+  toolkit::io::write_vtu((dir / output_files::kSurface).string(), merge_patches(surface));
+  toolkit::io::write_vtu((dir / output_files::kControlNet).string(), merge_patches(net));
+  toolkit::io::write_vtu((dir / output_files::kParametricTMesh).string(), merge_patches(param));
+  toolkit::io::write_vtu((dir / output_files::kPhysicalTMesh).string(), merge_patches(phys));
+  toolkit::io::write_vtu((dir / output_files::kBoundary).string(), merge_patches(boundary));
+  toolkit::io::write_text_atomic((dir / output_files::kReport).string(), report.dump(2) + "\n");
 }
 
 }  // namespace tspline::io

@@ -13,6 +13,7 @@
 #include "tspline/io/front_output.h"
 #include "tspline/io/tspline_file.h"
 #include "tspline/validity/map_quality.h"
+#include "tspline/io/output_files.h"
 
 namespace tspline::io {
 
@@ -72,7 +73,7 @@ AdaptSeriesWriter::AdaptSeriesWriter(std::string out_dir, int samples) : out_dir
 
 void AdaptSeriesWriter::add(int it, const TMesh& mesh, const std::vector<Eigen::Vector2d>& x, const TSplineMap& map) {
   // Created on first use, so that a run failing before the first fit leaves nothing.
-  if (entries_.empty()) toolkit::io::ensure_writable_directory((std::filesystem::path(out_dir_) / "adapt").string());
+  if (entries_.empty()) toolkit::io::ensure_writable_directory((std::filesystem::path(out_dir_) / output_files::kAdaptFolder).string());
   char name[64];
   std::snprintf(name, sizeof name, "adapt/mesh_%03d.vtu", it);
   const std::string mesh_file = name;
@@ -86,7 +87,7 @@ void AdaptSeriesWriter::add(int it, const TMesh& mesh, const std::vector<Eigen::
 }
 
 void AdaptSeriesWriter::finish() const {
-  toolkit::io::write_pvd((std::filesystem::path(out_dir_) / "adapt.pvd").string(), entries_);
+  toolkit::io::write_pvd((std::filesystem::path(out_dir_) / output_files::kAdaptSeries).string(), entries_);
 }
 
 namespace {
@@ -246,10 +247,10 @@ void write_param_outputs(const ParameterizationResult& r, const std::string& out
   meta.source = report.value("input", "");
   meta.boundary = r.front.boundary.polygon();
   meta.corners = r.front.boundary.corners().index;
-  write_tspline_file((dir / "tspline.json").string(), *r.map, meta);
-  toolkit::io::write_vtu((dir / "surface.vtu").string(), surface_vtu(*r.map, samples));
-  toolkit::io::write_vtu((dir / "control_net.vtu").string(), control_net_vtu(*r.map));
-  toolkit::io::write_text_atomic((dir / "report.json").string(), report.dump(2) + "\n");  // last: the run's summary
+  write_tspline_file((dir / output_files::kTSpline).string(), *r.map, meta);
+  toolkit::io::write_vtu((dir / output_files::kSurface).string(), surface_vtu(*r.map, samples));
+  toolkit::io::write_vtu((dir / output_files::kControlNet).string(), control_net_vtu(*r.map));
+  toolkit::io::write_text_atomic((dir / output_files::kReport).string(), report.dump(2) + "\n");  // last: the run's summary
 }
 
 }  // namespace tspline::io

@@ -10,6 +10,7 @@
 #include "toolkit/io/atomic_file.h"
 #include "tspline/io/canvas.h"
 #include "toolkit/io/vtu_reader.h"
+#include "tspline/io/output_files.h"
 
 namespace tspline::io {
 
@@ -180,7 +181,7 @@ RenderSummary render_png(const std::string& dir_name, const std::string& png_pat
     Canvas img(format, tmp, options.width, options.height);
     switch (summary.view) {
       case RenderView::Jacobian: {
-        const fs::path file = dir / "surface.vtu";
+        const fs::path file = dir / output_files::kSurface;
         const toolkit::io::VtuMesh m = read_output(file, param);
         const std::vector<double>& jr = point_array(m, "mean_ratio_jacobian", file);
         // J_r lies in [0, 1] for a valid map; a fold (J_r < 0) is drawn red.
@@ -197,20 +198,20 @@ RenderSummary render_png(const std::string& dir_name, const std::string& png_pat
         break;
       }
       case RenderView::TMesh: {
-        const fs::path file = dir / "surface.vtu";
+        const fs::path file = dir / output_files::kSurface;
         const toolkit::io::VtuMesh m = read_output(file, param);
         Box box;
         box.add(m);
         set_view(img, box, false);
         fill_cells(img, m, std::vector<double>(m.points.size(), 0.0), [](double) { return kFill; });
         draw_cell_borders(img, m, kBlack, 1.0);
-        const fs::path bfile = dir / "boundary.vtu";
+        const fs::path bfile = dir / output_files::kBoundary;
         if (fs::is_regular_file(bfile, ec)) draw_all_edges(img, toolkit::io::read_vtu(bfile.string()), kRed, 1.0);
         summary.source = file.string();
         break;
       }
       case RenderView::ControlNet: {
-        const fs::path file = dir / "control_net.vtu", bfile = dir / "boundary.vtu";
+        const fs::path file = dir / output_files::kControlNet, bfile = dir / output_files::kBoundary;
         const toolkit::io::VtuMesh net = read_output(file, param);
         const toolkit::io::VtuMesh boundary = read_output(bfile, param);
         Box box;

@@ -15,6 +15,8 @@
 #include "meshopt_app_support.h"
 #include "test_support.h"
 
+TEST_SUITE_BEGIN("meshopt_remesh_app");
+
 namespace fs = std::filesystem;
 using test_support::contains;
 
@@ -112,3 +114,5 @@ TEST_CASE("meshopt remesh: bad input gives one clear error and exit 1, unwritabl
   CHECK(r.exit_code == 2);
   CHECK(test_support::count_lines(r.err) == 1);
 }
+
+TEST_SUITE_END();

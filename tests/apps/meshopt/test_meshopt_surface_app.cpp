@@ -17,6 +17,8 @@
 #include "meshopt_app_support.h"
 #include "test_support.h"
 
+TEST_SUITE_BEGIN("meshopt_surface_app");
+
 #if defined(__SANITIZE_ADDRESS__)
 // LeakSanitizer: OpenCASCADE (libTK*, e.g. its STEP reader's static tables),
 // Gmsh, GDAL/PROJ (driver registry, PROJ contexts) and Cairo/fontconfig (font
@@ -180,3 +182,5 @@ TEST_CASE("meshopt smooth: bad input gives one clear error and exit 1") {
   };
   meshopt_app_test::check_bad_inputs(cases, dir, dir / "o.msh");
 }
+
+TEST_SUITE_END();

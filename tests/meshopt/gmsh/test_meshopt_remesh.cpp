@@ -17,6 +17,8 @@
 #include "meshopt/remesh.h"
 #include "meshopt/remesh_statistics.h"
 
+TEST_SUITE_BEGIN("meshopt_remesh");
+
 using namespace meshopt;
 using Eigen::Vector3d;
 
@@ -214,3 +216,5 @@ TEST_CASE("remesh: a torus's long axes follow the direction of least curvature")
                  CHECK(mean < 20.0);  // random orientations would give 45 degrees
                });
 }
+
+TEST_SUITE_END();
