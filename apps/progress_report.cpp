@@ -12,6 +12,7 @@ namespace tspline_app {
 void Progress::report(const tspline::ProgressEvent& e) {
   throw_if_interrupted();  // also from the worker threads of the corner trials (their errors are rethrown)
   using Kind = tspline::ProgressEvent::Kind;
+  if (e.kind == Kind::Heartbeat) return;  // nothing to show; the interrupt check above is its purpose
   const bool transient_kind = e.kind == Kind::Sweep || e.kind == Kind::Untangling;
   switch (mode_) {
     case OutputMode::Quiet: return;

@@ -133,6 +133,4 @@ Eigen::Matrix2d equilateral_ideal_inverse(double h) {
   return ideal_inverse(Eigen::Vector2d::Zero(), Eigen::Vector2d(h, 0.0), Eigen::Vector2d(0.5 * h, 0.5 * std::sqrt(3.0) * h));
 }
 
-Eigen::Matrix2d square_corner_ideal_inverse(double h) { return Eigen::Matrix2d::Identity() / h; }
-
 }  // namespace meshopt

@@ -4,6 +4,8 @@
 // whose kept trial is the run itself.
 #include <doctest/doctest.h>
 
+#include <atomic>
+
 #include <array>
 #include <functional>
 #include <map>
@@ -11,6 +13,7 @@
 #include <string>
 
 #include "test_support.h"
+#include "toolkit/errors.h"
 #include "tspline/pipeline/adaptive_parameterization.h"
 #include "tspline/errors.h"
 #include "tspline/io/polygon_reader.h"
@@ -51,6 +54,7 @@ TEST_SUITE("parameterization_run") {
           CHECK(e.value > 0.0);  // eps
           ++untangling_stages;
           break;
+        case ProgressEvent::Kind::Heartbeat: FAIL("a heartbeat without concurrent corner trials"); break;
       }
     }
     for (const char* s : {"boundary", "tmesh", "coons", "optimization", "boundary_curve", "untangling", "map", "stop"}) {
@@ -110,11 +114,27 @@ TEST_SUITE("parameterization_run") {
     }
   }
 
+  TEST_CASE("a callback that throws during the concurrent corner trials stops them (Ctrl-C in the program)") {
+    const tspline::Polygon poly = tspline::io::read_polygon(test_support::polygon_file("flower.txt"));
+    tspline::ParameterizationOptions opt;
+    REQUIRE(opt.corner_trials > 1);
+    std::atomic<int> beats{0};
+    opt.progress = [&](const ProgressEvent& e) {
+      if (e.kind != ProgressEvent::Kind::Heartbeat) return;
+      CHECK(e.stage == "corners");
+      if (++beats >= 3) throw toolkit::Interrupted("interrupted");  // and at every later one, like the program
+    };
+    CHECK_THROWS_AS(tspline::run_front(poly, opt), toolkit::Interrupted);
+    // Stopped at the third heartbeat: each trial sends one per sweep, and
+    // every trial of the flower runs tens of sweeps.
+    CHECK(beats >= 3);
+  }
+
   TEST_CASE("the kept corner trial is the run: the same T-mesh and nodes as a run with those corners given") {
     const tspline::Polygon poly = tspline::io::read_polygon(test_support::polygon_file("flower.txt"));
     tspline::ParameterizationOptions opt;
     int trial_reports = 0;  // one "trial k of n done" per trial, as each finishes
-    opt.progress = [&](const ProgressEvent& e) { trial_reports += e.stage == "corners" && test_support::contains(e.text, "trial"); };
+    opt.progress = [&](const ProgressEvent& e) { trial_reports += e.kind == ProgressEvent::Kind::Step && e.stage == "corners" && test_support::contains(e.text, "trial"); };
     const tspline::FrontResult automatic = tspline::run_front(poly, opt);
     CHECK(trial_reports == opt.corner_trials);
     REQUIRE(automatic.corner_trials.size() == static_cast<std::size_t>(opt.corner_trials));
@@ -123,7 +143,7 @@ TEST_SUITE("parameterization_run") {
       given[k] = static_cast<long long>(automatic.boundary.polygon().file_index[automatic.boundary.corners().index[k]]);
     opt.corners = given;
     trial_reports = 0;
-    opt.progress = [&](const ProgressEvent& e) { trial_reports += e.stage == "corners" && test_support::contains(e.text, "trial"); };
+    opt.progress = [&](const ProgressEvent& e) { trial_reports += e.kind == ProgressEvent::Kind::Step && e.stage == "corners" && test_support::contains(e.text, "trial"); };
     const tspline::FrontResult explicit_corners = tspline::run_front(poly, opt);
     CHECK(trial_reports == 0);  // corners given: no trials
     REQUIRE(explicit_corners.mesh.num_cells() == automatic.mesh.num_cells());

@@ -30,8 +30,6 @@ struct SurfaceMesh {
   /// Parametric coordinates of element e's corner i on its face at corner_uv[4 e + i];
   /// may be left empty when every node has a valid u on the element's face (one-face meshes).
   std::vector<Eigen::Vector2d> corner_uv;
-
-  std::size_t num_nodes() const { return x.size(); }
 };
 
 /// Ideal element size at a physical point (Sect. 4.3, SETIDEALELEMENTS).

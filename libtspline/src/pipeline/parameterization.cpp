@@ -93,18 +93,21 @@ double bbox_diagonal(const Polygon& p) {
 }
 
 // Runs body(0), ..., body(n - 1) on up to hardware_concurrency threads; the
-// first exception thrown by a body is rethrown here once all have finished.
+// first exception thrown by a body is rethrown here once the running bodies
+// have finished (no body starts after one has thrown).
 template <class Body>
 void for_each_concurrently(std::size_t n, Body&& body) {
   const std::size_t threads = std::min<std::size_t>(n, std::max(1u, std::thread::hardware_concurrency()));
   std::atomic<std::size_t> next{0};
+  std::atomic<bool> failed{false};
   std::vector<std::exception_ptr> errors(n);
   auto work = [&] {
-    for (std::size_t k; (k = next.fetch_add(1)) < n;) {
+    for (std::size_t k; !failed && (k = next.fetch_add(1)) < n;) {
       try {
         body(k);
       } catch (...) {
         errors[k] = std::current_exception();
+        failed = true;
       }
     }
   };
@@ -330,8 +333,19 @@ FrontResult run_front(const Polygon& input, const ParameterizationOptions& opt) 
         ParameterizationOptions o = topt;
         o.progress = nullptr;
         if (opt.progress)
-          o.progress = [&events, k](const ProgressEvent& e) {
-            if (e.kind == ProgressEvent::Kind::Step || e.kind == ProgressEvent::Kind::Note) events[k].push_back(e);
+          o.progress = [&events, &report_mutex, &opt, k](const ProgressEvent& e) {
+            if (e.kind == ProgressEvent::Kind::Step || e.kind == ProgressEvent::Kind::Note) {
+              events[k].push_back(e);
+              return;
+            }
+            // Sweeps and stages of concurrent trials are not shown, but the
+            // caller hears that the run is alive and may stop it (Ctrl-C).
+            ProgressEvent beat;
+            beat.kind = ProgressEvent::Kind::Heartbeat;
+            beat.stage = "corners";
+            beat.text = "corner trial " + std::to_string(k + 1) + " working";
+            const std::lock_guard<std::mutex> lock(report_mutex);
+            opt.progress(beat);
           };
         try {
           results[k].emplace(optimize_front(BoundaryMap(poly, cands[k]), o));

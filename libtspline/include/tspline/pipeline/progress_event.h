@@ -16,6 +16,10 @@ struct ProgressEvent {
     Note,        ///< something the user should know: cleaned input, a warning
     Sweep,       ///< one Gauss-Seidel sweep of the T-mesh optimization
     Untangling,  ///< one epsilon stage of the map's global untangling
+    /// Nothing to show: a concurrent corner trial is still working (sent
+    /// instead of its sweeps). A receiver that stops runs on request (Ctrl-C)
+    /// throws from here, as from any other event, and the run ends with it.
+    Heartbeat,
   };
   Kind kind = Kind::Step;
   /// Pipeline stage: "cleaning", "corners", "boundary", "tmesh", "coons",
@@ -30,7 +34,8 @@ struct ProgressEvent {
 };
 
 /// Called from the thread that runs the pipeline or from its worker threads
-/// (the concurrent corner trials), never from two threads at once.
+/// (the concurrent corner trials), never from two threads at once. An
+/// exception thrown by the callback stops the run and reaches its caller.
 using ProgressCallback = std::function<void(const ProgressEvent&)>;
 
 /// Kind::Step or Kind::Note events, if `callback` is set.
