@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Builds the libFuzzer targets (tests/fuzz: clang, ASan + UBSan, -O1, only the
 # sources they need) into BUILD_DIR (default build-fuzz) and runs each for
-# FUZZ_SECONDS (default 25) on a copy of its seed corpus tests/fuzz/corpus/TARGET
+# FUZZ_SECONDS (default 20) on a copy of its seed corpus tests/fuzz/corpus/TARGET
 # (the copy grows; the corpus in the repository stays as it is). Prints the
 # executions of each run; exits non-zero if a target finds a crash, a leak, a
 # timeout (one input over 10 s) or an unexpected exception (the reproducer is
@@ -9,13 +9,13 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 BUILD_DIR=${BUILD_DIR:-build-fuzz}
-FUZZ_SECONDS=${FUZZ_SECONDS:-25}
+FUZZ_SECONDS=${FUZZ_SECONDS:-20}
 JOBS=${JOBS:-$(nproc)}
 CXX=clang++ cmake -S tests/fuzz -B "$BUILD_DIR" -DCMAKE_BUILD_TYPE=None > "$BUILD_DIR.configure.log" 2>&1 \
   || { cat "$BUILD_DIR.configure.log"; exit 1; }
 cmake --build "$BUILD_DIR" -j "$JOBS"
 status=0
-for t in polygon_text geojson tspline_file front; do
+for t in polygon_text geojson gis tspline_file front; do
   corpus_src=tests/fuzz/corpus/$t
   corpus=$BUILD_DIR/corpus/$t
   findings=$BUILD_DIR/findings/$t
