@@ -10,6 +10,7 @@
 #include "meshopt/node_smoother.h"
 #include "tspline/tmesh/tmesh.h"
 #include "tspline/detail/tmesh_submesh.h"
+#include "tspline/tmesh/smoothing_problem.h"
 
 using tspline::TMesh;
 
@@ -131,7 +132,7 @@ TEST_SUITE("tmesh_submesh") {
 
   TEST_CASE("build_smoothing_problem frees exactly the interior vertices") {
     const TMesh m = regular_124_mesh();
-    const auto prob = tspline::detail::build_smoothing_problem(m);
+    const auto prob = tspline::build_smoothing_problem(m);
     std::size_t interior = 0;
     for (int v = 0; v < static_cast<int>(m.num_vertices()); ++v) interior += m.vertex_on_boundary(v) ? 0 : 1;
     CHECK(prob.size() == interior);

@@ -16,7 +16,7 @@
 #include "tspline/boundary/corners.h"
 #include "tspline/errors.h"
 #include "tspline/boundary/polygon_validation.h"
-#include "tspline/detail/tmesh_submesh.h"
+#include "tspline/tmesh/smoothing_problem.h"
 #include "tspline/tmesh/tmesh_transfer.h"
 
 namespace tspline {
@@ -150,7 +150,7 @@ FrontResult optimize_front(BoundaryMap boundary, const ParameterizationOptions& 
     };
   }
   auto optimize = [&](const std::string& what) {
-    const meshopt::SmoothingProblem problem = detail::build_smoothing_problem(r.mesh, true);
+    const meshopt::SmoothingProblem problem = build_smoothing_problem(r.mesh, true);
     r.smoothing = meshopt::smooth(r.optimized, problem, sopt);
     r.total_sweeps += r.smoothing.sweeps;
     r.node_visits += r.smoothing.node_visits;

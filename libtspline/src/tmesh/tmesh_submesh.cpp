@@ -1,4 +1,5 @@
 #include "tspline/detail/tmesh_submesh.h"
+#include "tspline/tmesh/smoothing_problem.h"
 
 #include <algorithm>
 
@@ -63,6 +64,11 @@ std::vector<meshopt::LocalTriangle> local_submesh(const TMesh& mesh, int v, bool
   return out;
 }
 
+
+}  // namespace tspline::detail
+
+namespace tspline {
+
 meshopt::SmoothingProblem build_smoothing_problem(const TMesh& mesh, bool weighted) {
   meshopt::SmoothingProblem problem;
   problem.nodes.reserve(mesh.num_vertices());
@@ -70,10 +76,10 @@ meshopt::SmoothingProblem build_smoothing_problem(const TMesh& mesh, bool weight
   problem.triangles.reserve(mesh.num_vertices() * 12);
   for (int v = 0; v < static_cast<int>(mesh.num_vertices()); ++v) {
     if (mesh.vertex_on_boundary(v)) continue;
-    const std::vector<meshopt::LocalTriangle> tris = local_submesh(mesh, v, weighted);
+    const std::vector<meshopt::LocalTriangle> tris = detail::local_submesh(mesh, v, weighted);
     problem.add_node(v, tris);
   }
   return problem;
 }
 
-}  // namespace tspline::detail
+}  // namespace tspline

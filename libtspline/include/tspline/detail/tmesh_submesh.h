@@ -16,7 +16,6 @@
 #include <vector>
 
 #include "meshopt/local_objective.h"
-#include "meshopt/node_smoother.h"
 #include "tspline/tmesh/tmesh.h"
 
 namespace tspline::detail {
@@ -26,8 +25,5 @@ namespace tspline::detail {
 /// the unweighted K* (all weights 1), for comparison.
 std::vector<meshopt::LocalTriangle> local_submesh(const TMesh& mesh, int v, bool weighted = true);
 
-/// All interior vertices (not on the boundary of [0,1]^2) as free nodes with
-/// their local submeshes; boundary vertices stay fixed.
-meshopt::SmoothingProblem build_smoothing_problem(const TMesh& mesh, bool weighted = true);
 
 }  // namespace tspline::detail
