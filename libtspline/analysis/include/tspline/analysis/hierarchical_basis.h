@@ -4,7 +4,7 @@
 //
 // Why not the T-spline blending functions of tspline_basis.h: on a T-mesh with
 // hanging vertices the normalized functions R = N / sum N do not reproduce even
-// linear functions near the T-junctions (measured in tests/test_hierarchical_basis.cpp),
+// linear functions near the T-junctions (measured in tests/analysis/test_hierarchical_basis.cpp),
 // and refinement does not give nested spaces, so Galerkin errors decay at about
 // h^2 (L2) and h (H1) instead of h^4 and h^3. Hierarchical B-splines on the same
 // quadtree contain every cubic polynomial, are nested under refinement, and are
