@@ -31,11 +31,11 @@
 #include "expression.h"
 #include "tspline/errors.h"
 #include "toolkit/io/atomic_file.h"
-#include "tspline/io/convergence_plot.h"
+#include "tspline/io/output_files.h"
+#include "tspline/io/poisson_output.h"
 #include "tspline/io/multipatch_file.h"
 #include "tspline/io/tspline_file.h"
 #include "poisson_multipatch.h"
-#include "tspline/io/cell_grid.h"
 #include "toolkit/io/vtu_writer.h"
 #include "petsc_session.h"
 #include "tspline/petsc_solver.h"
@@ -225,218 +225,26 @@ tspline::petsc::IterativeOptions iterative_options(const PoissonArgs& a) {
   return o;
 }
 
-/// Fails (IoError) if `dir` could not be created or written, without creating it:
-/// it must be a writable directory, or its nearest existing ancestor must be one.
-void check_output_directory(const std::string& dir) {
-  std::error_code ec;
-  const fs::path p = fs::absolute(fs::path(dir), ec);
-  if (ec) throw tspline::IoError("cannot use output directory " + dir + ": " + ec.message());
-  auto writable = [](const fs::path& d) { return ::access(d.c_str(), W_OK | X_OK) == 0; };
-  if (fs::exists(p, ec)) {
-    if (!fs::is_directory(p, ec))
-      throw tspline::IoError("output directory " + dir + " exists and is not a directory");
-    if (!writable(p))
-      throw tspline::IoError("output directory " + dir + " is not writable: " + std::strerror(errno));
-    return;
-  }
-  fs::path a = p.parent_path();
-  while (!a.empty() && a != a.root_path() && !fs::exists(a, ec)) a = a.parent_path();
-  if (a.empty()) a = p.root_path();
-  if (!fs::is_directory(a, ec))
-    throw tspline::IoError("cannot create output directory " + dir + ": " + a.string() +
-                           " is not a directory");
-  if (!writable(a))
-    throw tspline::IoError("cannot create output directory " + dir + ": " + a.string() +
-                           " is not writable: " + std::strerror(errno));
-}
-
 // ------------------------------------------------------------------ output
 
-/// The solution sampled per analysis cell with k x k sub-quads.
-toolkit::io::VtuMesh solution_vtu(const tspline::TSplineMap& map, const tspline::PoissonSolution& sol,
-                                  const tspline::PoissonProblem& problem, const std::vector<double>& eta,
-                                  int k) {
-  const tspline::TMesh& mesh = sol.space->mesh();
-  std::vector<double> uh, ue, err, cell_eta;
-  toolkit::io::VtuMesh out = tspline::io::cell_grid_vtu(mesh, k, [&](int c, const Eigen::Vector2d& uv) {
-    const tspline::SolutionValue v = tspline::evaluate_solution(map, sol, c, uv, 0);
-    uh.push_back(v.u);
-    if (problem.exact) {
-      const double u = problem.exact(v.x.x(), v.x.y());
-      ue.push_back(u);
-      err.push_back(v.u - u);
-    }
-    return v.x;
-  });
-  for (int c : out.cell_ints["cell"]) cell_eta.push_back(eta[c]);
-  out.point_scalars["u_h"] = std::move(uh);
-  if (problem.exact) {
-    out.point_scalars["u_exact"] = std::move(ue);
-    out.point_scalars["error"] = std::move(err);
+/// What the program prints of the steps (the files: tspline::io::PoissonOutputWriter).
+void print_header() {
+  std::printf("%4s %9s %9s %11s %11s %11s %8s %-12s %5s %9s %8s %8s %8s %8s\n", "step", "dofs", "cells", "eta",
+              "L2", "H1", "eta/H1", "solver", "its", "residual", "assembly", "solve", "seconds", "peak_MiB");
+}
+void print_row(const tspline::PoissonStep& s, double peak_mib) {
+  char l2[32] = "-", h1[32] = "-", ratio[32] = "-";
+  if (s.has_errors) {
+    std::snprintf(l2, sizeof l2, "%.4e", s.errors.l2);
+    std::snprintf(h1, sizeof h1, "%.4e", s.errors.h1);
+    if (s.errors.h1 > 0) std::snprintf(ratio, sizeof ratio, "%.3f", s.eta / s.errors.h1);
   }
-  out.cell_scalars["eta"] = std::move(cell_eta);
-  return out;
+  std::printf("%4d %9zu %9zu %11.4e %11s %11s %8s %-12s %5d %9.2e %8.3f %8.3f %8.3f %8.1f\n", s.step, s.dofs,
+              s.cells, s.eta, l2, h1, ratio, tspline::io::short_solver_name(s.solver).c_str(), s.solver.iterations,
+              s.solver.relative_residual, s.assembly_seconds, s.solver.seconds, s.seconds, peak_mib);
+  std::fflush(stdout);
 }
 
-std::string short_solver(const tspline::SolverStats& s) {
-  if (s.kind == "CholmodSupernodalLLT") return "CHOLMOD";
-  if (s.kind == "SimplicialLDLT") return "LDLT";
-  if (s.kind == "ConjugateGradient+IncompleteCholesky") return "CG+IC";
-  if (s.kind == "PETSc CG + hypre BoomerAMG") return "CG+BoomerAMG";
-  if (s.kind == "PETSc CG + PETSc GAMG") return "CG+GAMG";
-  return s.kind;
-}
-
-std::string num(double v) {
-  char b[40];
-  std::snprintf(b, sizeof b, "%.17g", v);
-  return b;
-}
-
-/// -2 log(e2/e1) / log(n2/n1): the rate in h for 2D (n ~ h^-2); null if undefined.
-json rate(double e1, double e2, std::size_t n1, std::size_t n2) {
-  if (!(e1 > 0.0) || !(e2 > 0.0) || n1 == n2) return nullptr;
-  const double r = -2.0 * std::log(e2 / e1) / std::log(static_cast<double>(n2) / static_cast<double>(n1));
-  return std::isfinite(r) ? json(r) : json(nullptr);
-}
-
-class PoissonOutput {
- public:
-  PoissonOutput(const PoissonArgs& args, const tspline::TSplineMap& map,
-                const tspline::PoissonProblem& problem, json report, Progress& progress)
-      : args_(args), map_(map), problem_(problem), report_(std::move(report)), progress_(progress) {
-    report_["steps"] = json::array();
-  }
-
-  /// peak_mib: peak resident memory of every process so far (MiB, by rank).
-  void step(const tspline::PoissonStep& st, const tspline::PoissonSolution& sol, const std::vector<double>& eta,
-            const std::vector<double>& peak_mib) {
-    const auto t0 = Clock::now();
-    const fs::path out(args_.out_dir);
-    if (!started_) {
-      // Created on the first completed step: a run failing before it leaves nothing.
-      toolkit::io::ensure_writable_directory(out.string());
-      toolkit::io::ensure_writable_directory((out / "solution").string());
-      started_ = true;
-      if (progress_.human()) print_header();
-    }
-    char name[64];
-    std::snprintf(name, sizeof name, "solution/step_%03d.vtu", st.step);
-    toolkit::io::write_vtu((out / name).string(), solution_vtu(map_, sol, problem_, eta, args_.samples));
-    pvd_.push_back({static_cast<double>(st.step), name, 0});
-
-    json rec = {{"step", st.step},
-                {"dofs", st.dofs},
-                {"interior_dofs", sol.interior_dofs},
-                {"cells", st.cells},
-                {"max_level", sol.space->mesh().max_level()},
-                {"marked", st.marked},
-                {"refined", st.refined},
-                {"eta", st.eta},
-                {"eta_at_roundoff", st.eta_at_roundoff},
-                {"eta_max_cell", eta.empty() ? 0.0 : *std::max_element(eta.begin(), eta.end())},
-                {"solver",
-                 {{"kind", st.solver.kind},
-                  {"seconds", st.solver.seconds},
-                  {"relative_residual", st.solver.relative_residual},
-                  {"iterations", st.solver.iterations},
-                  {"processes", st.solver.processes}}},
-                {"peak_memory_mib",
-                 {{"per_process", peak_mib},
-                  {"max", *std::max_element(peak_mib.begin(), peak_mib.end())},
-                  {"total", std::accumulate(peak_mib.begin(), peak_mib.end(), 0.0)}}},
-                {"dirichlet_seconds", sol.dirichlet_seconds},
-                {"assembly_seconds", st.assembly_seconds},
-                {"solve_seconds", st.solver.seconds},
-                {"step_seconds", st.seconds},
-                {"file", name}};
-    if (st.has_errors) {
-      const tspline::PoissonErrors& e = st.errors;
-      rec["l2"] = e.l2;
-      rec["h1"] = e.h1;
-      rec["l2_relative"] = e.l2_exact > 0 ? json(e.l2 / e.l2_exact) : json(nullptr);
-      rec["h1_relative"] = e.h1_exact > 0 ? json(e.h1 / e.h1_exact) : json(nullptr);
-      rec["max_abs_error_at_quadrature_points"] = e.max_abs_at_qp;
-      rec["eta_over_h1"] = e.h1 > 0 ? json(st.eta / e.h1) : json(nullptr);
-    } else {
-      rec["l2"] = rec["h1"] = rec["eta_over_h1"] = nullptr;
-    }
-    if (!steps_.empty()) {
-      const tspline::PoissonStep& p = steps_.back();
-      rec["rates_vs_dofs"] = {
-          {"eta", rate(p.eta, st.eta, p.dofs, st.dofs)},
-          {"l2", st.has_errors ? rate(p.errors.l2, st.errors.l2, p.dofs, st.dofs) : json(nullptr)},
-          {"h1", st.has_errors ? rate(p.errors.h1, st.errors.h1, p.dofs, st.dofs) : json(nullptr)}};
-    }
-    steps_.push_back(st);
-    peak_total_.push_back(std::accumulate(peak_mib.begin(), peak_mib.end(), 0.0));
-    rec["output_seconds"] = seconds_since(t0);
-    json event = rec;
-    event["event"] = "step";
-    report_["steps"].push_back(std::move(rec));
-    write_tables(false);
-    if (progress_.human()) print_row(st, peak_total_.back());
-    progress_.event(event);
-  }
-
-  bool started() const { return started_; }
-
-  /// Rewrites convergence.csv, solution.pvd and report.json (each atomically).
-  void write_tables(bool finished) {
-    const fs::path out(args_.out_dir);
-    report_["finished"] = finished;
-    std::ostringstream csv;
-    csv << "step,dofs,cells,eta,l2,h1,eta_over_h1,solver,residual,seconds,iterations,assembly_seconds,"
-           "solve_seconds,peak_mib\n";
-    for (std::size_t k = 0; k < steps_.size(); ++k) {
-      const tspline::PoissonStep& s = steps_[k];
-      csv << s.step << ',' << s.dofs << ',' << s.cells << ',' << num(s.eta) << ',';
-      if (s.has_errors)
-        csv << num(s.errors.l2) << ',' << num(s.errors.h1) << ','
-            << (s.errors.h1 > 0 ? num(s.eta / s.errors.h1) : std::string());
-      else
-        csv << ",,";
-      csv << ',' << s.solver.kind << ',' << num(s.solver.relative_residual) << ',' << num(s.seconds) << ','
-          << s.solver.iterations << ',' << num(s.assembly_seconds) << ',' << num(s.solver.seconds) << ','
-          << num(peak_total_[k]) << '\n';
-    }
-    toolkit::io::write_text_atomic((out / "convergence.csv").string(), csv.str());
-    tspline::io::write_convergence_plot((out / "convergence.png").string(), steps_);
-    toolkit::io::write_pvd((out / "solution.pvd").string(), pvd_);
-    toolkit::io::write_text_atomic((out / "report.json").string(), report_.dump(2) + "\n");
-  }
-
-  json& report() { return report_; }
-  const std::vector<tspline::PoissonStep>& steps() const { return steps_; }
-
- private:
-  static void print_header() {
-    std::printf("%4s %9s %9s %11s %11s %11s %8s %-12s %5s %9s %8s %8s %8s %8s\n", "step", "dofs", "cells", "eta",
-                "L2", "H1", "eta/H1", "solver", "its", "residual", "assembly", "solve", "seconds", "peak_MiB");
-  }
-  static void print_row(const tspline::PoissonStep& s, double peak_mib) {
-    char l2[32] = "-", h1[32] = "-", ratio[32] = "-";
-    if (s.has_errors) {
-      std::snprintf(l2, sizeof l2, "%.4e", s.errors.l2);
-      std::snprintf(h1, sizeof h1, "%.4e", s.errors.h1);
-      if (s.errors.h1 > 0) std::snprintf(ratio, sizeof ratio, "%.3f", s.eta / s.errors.h1);
-    }
-    std::printf("%4d %9zu %9zu %11.4e %11s %11s %8s %-12s %5d %9.2e %8.3f %8.3f %8.3f %8.1f\n", s.step, s.dofs,
-                s.cells, s.eta, l2, h1, ratio, short_solver(s.solver).c_str(), s.solver.iterations,
-                s.solver.relative_residual, s.assembly_seconds, s.solver.seconds, s.seconds, peak_mib);
-    std::fflush(stdout);
-  }
-
-  const PoissonArgs& args_;
-  const tspline::TSplineMap& map_;
-  const tspline::PoissonProblem& problem_;
-  json report_;
-  std::vector<tspline::PoissonStep> steps_;
-  std::vector<double> peak_total_;  // per step: sum over the processes of their peak memory, MiB
-  std::vector<toolkit::io::PvdEntry> pvd_;
-  bool started_ = false;
-  Progress& progress_;
-};
 
 // ------------------------------------------------------------------ run
 
@@ -488,14 +296,19 @@ int run_poisson_process(const PoissonArgs& args, const PetscSession& session,
       {"dirichlet", "L2 projection of g onto the boundary functions' traces on the parameter square's border"},
       {"quadrature", {{"assembly", "4x4 Gauss"}, {"errors", "6x6 Gauss"}, {"estimator", "4x4 Gauss"}}}};
   Progress progress(root ? output_mode(args.quiet, args.json) : OutputMode::Quiet);
-  PoissonOutput output(args, t.map, setup.problem, std::move(report), progress);
-  std::vector<tspline::PoissonStep> steps;
+  tspline::io::PoissonOutputWriter output(args.out_dir, args.samples, t.map, setup.problem, std::move(report));
+  tspline::AdaptiveSolveResult run;
   try {
-    steps = tspline::solve_adaptive(t.map, setup.problem, opt,
+    run = tspline::solve_adaptive(t.map, setup.problem, opt,
                                     [&](const tspline::PoissonStep& st, const tspline::PoissonSolution& sol,
                                         const std::vector<double>& eta) {
                                       const std::vector<double> peak = tspline::petsc::peak_memory_mib();
-                                      if (root) output.step(st, sol, eta, peak);
+                                      if (!root) return;
+                                      if (!output.started() && progress.human()) print_header();
+                                      json event = output.add_step(st, sol, eta, peak);
+                                      if (progress.human()) print_row(st, output.peak_total_mib().back());
+                                      event["event"] = "step";
+                                      progress.event(event);
                                     });
   } catch (const std::exception& e) {
     // Keep what was written consistent and say why the run stopped.
@@ -509,28 +322,29 @@ int run_poisson_process(const PoissonArgs& args, const PetscSession& session,
     }
     throw;
   }
-  std::string stop;
-  if (static_cast<int>(steps.size()) == args.steps)
-    stop = "all " + std::to_string(args.steps) + " steps done";
-  else if (!steps.empty() && steps.back().eta_at_roundoff)
-    stop = "the estimator is at round-off (u_h solves the problem exactly): nothing to refine";
-  else if (!steps.empty() && steps.back().marked == 0)
-    stop = "no cell marked (eta = 0 everywhere)";
-  else
-    stop = "the next space would have more than --max-dofs " + std::to_string(args.max_dofs) + " DOFs";
+  // The library's words, with the limit named as the option the user set.
+  const std::string stop = run.stop == tspline::AdaptiveSolveStop::MaxDofs
+                               ? "the next space would have more than --max-dofs " + std::to_string(args.max_dofs) +
+                                     " DOFs"
+                               : tspline::describe(run.stop, opt);
   if (!root) return 0;
   output.report()["stop_reason"] = stop;
   output.report()["seconds_total"] = seconds_since(t_start);
   output.write_tables(true);
+  std::vector<std::string> files;
+  std::string file_list;
+  for (const std::string_view f : tspline::io::output_files::kPoisson) {
+    files.emplace_back(f);
+    file_list += (file_list.empty() ? "" : ", ") + files.back();
+  }
   progress.event({{"event", "result"},
-                  {"steps", steps.size()},
+                  {"steps", run.steps.size()},
                   {"stop_reason", stop},
                   {"out", args.out_dir},
-                  {"files", {"convergence.csv", "convergence.png", "report.json", "solution.pvd", "solution/"}}});
+                  {"files", files}});
   if (progress.human())
-    std::cout << steps.size() << " steps (" << stop
-              << "); wrote convergence.csv, convergence.png, report.json, solution.pvd, solution/"
-              << " to " << args.out_dir << std::endl;
+    std::cout << run.steps.size() << " steps (" << stop << "); wrote " << file_list << " to " << args.out_dir
+              << std::endl;
   return 0;
 }
 
@@ -538,7 +352,7 @@ int run_poisson(const PoissonArgs& args) {
   const auto t_start = Clock::now();
   // Everything that can be checked is checked before OUTDIR is created.
   validate_options(args);
-  check_output_directory(args.out_dir);
+  toolkit::io::check_writable_directory(args.out_dir);
   const PetscSession session;
   if (session.rank() == 0) return run_poisson_process(args, session, t_start);
   // Other ranks fail alike (same input, same collective calls); only rank 0 prints the message.

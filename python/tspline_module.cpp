@@ -201,7 +201,7 @@ Solution poisson(std::shared_ptr<Map> m, const py::object& f, const py::object& 
       m->map, problem, opt,
       [&](const tspline::PoissonStep&, const tspline::PoissonSolution& sol, const std::vector<double>&) {
         out.solution = sol;
-      });
+      }).steps;
   for (const auto& s : records) out.steps.append(step_dict(s));
   return out;
 }

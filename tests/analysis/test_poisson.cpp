@@ -184,8 +184,10 @@ TEST_SUITE("poisson") {
     // The adaptive loop recognizes the round-off estimator and refines nothing.
     tspline::AdaptiveSolveOptions o;
     o.steps = 3;
-    const auto steps = tspline::solve_adaptive(map, cub, o);
+    const tspline::AdaptiveSolveResult run = tspline::solve_adaptive(map, cub, o);
+    const auto& steps = run.steps;
     REQUIRE(steps.size() == 1);
+    CHECK(run.stop == tspline::AdaptiveSolveStop::EstimatorAtRoundoff);
     CHECK(steps[0].eta_at_roundoff);
     CHECK(steps[0].marked == 0);
     CHECK(steps[0].errors.h1 <= 1e-11);
@@ -196,8 +198,11 @@ TEST_SUITE("poisson") {
     tspline::AdaptiveSolveOptions o;
     o.refine = tspline::AdaptiveSolveOptions::Refine::Uniform;
     o.steps = 5;  // 4x4 .. 64x64 cells: four refinements
-    const auto steps = tspline::solve_adaptive(map, sinsin(), o);
+    const tspline::AdaptiveSolveResult run = tspline::solve_adaptive(map, sinsin(), o);
+    const auto& steps = run.steps;
     REQUIRE(steps.size() == 5);
+    CHECK(run.stop == tspline::AdaptiveSolveStop::AllSteps);
+    CHECK(tspline::describe(run.stop, o) == "all 5 steps done");
     for (const Rates& r : uniform_rates(steps, "square")) {
       CHECK(r.l2_cells == doctest::Approx(4.0).epsilon(0.3 / 4.0));
       CHECK(r.h1_cells == doctest::Approx(3.0).epsilon(0.3 / 3.0));
@@ -239,7 +244,7 @@ TEST_SUITE("poisson") {
     tspline::AdaptiveSolveOptions o;
     o.refine = tspline::AdaptiveSolveOptions::Refine::Uniform;
     o.steps = 4;  // 8x8 .. 64x64 analysis cells
-    const auto steps = tspline::solve_adaptive(map, sinsin(), o);
+    const auto steps = tspline::solve_adaptive(map, sinsin(), o).steps;
     REQUIRE(steps.size() == 4);
     // The map is a fixed cubic spline, so u o S is smooth per geometry cell and
     // the rates are optimal, but the coarse steps are pre-asymptotic (measured
@@ -268,7 +273,7 @@ TEST_SUITE("poisson") {
     o.refine = tspline::AdaptiveSolveOptions::Refine::Uniform;
     o.steps = 4;
     o.max_dofs = 100000;
-    const auto steps = tspline::solve_adaptive(map, sinsin(), o);
+    const auto steps = tspline::solve_adaptive(map, sinsin(), o).steps;
     REQUIRE(steps.size() == 4);
     const auto rates = uniform_rates(steps, "disk default");
     for (const Rates& r : rates) {
@@ -297,6 +302,20 @@ TEST_SUITE("poisson") {
     tspline::AnalysisSpace before(map, m);
     tspline::AnalysisSpace after(map, tspline::refine_cells(m, tspline::refinement_patch(m, {centre})));
     CHECK(after.num_dofs() == before.num_dofs() + 9);
+  }
+
+  TEST_CASE("the adaptive loop says why it stopped: the DOF limit before a space that exceeds it") {
+    const auto map = identity_map(2);  // 4 x 4 cubic cells: 7^2 = 49 functions, then 11^2 = 121, 19^2 = 361
+    tspline::AdaptiveSolveOptions o;
+    o.refine = tspline::AdaptiveSolveOptions::Refine::Uniform;
+    o.steps = 5;
+    o.max_dofs = 121;
+    const tspline::AdaptiveSolveResult run = tspline::solve_adaptive(map, sinsin(), o);
+    REQUIRE(run.steps.size() == 2);
+    CHECK(run.steps[0].dofs == 49);
+    CHECK(run.steps[1].dofs == 121);
+    CHECK(run.stop == tspline::AdaptiveSolveStop::MaxDofs);
+    CHECK(tspline::describe(run.stop, o) == "the next space would have more than 121 DOFs (max_dofs)");
   }
 
   TEST_CASE("marking picks exactly the cells above gamma max eta") {
@@ -336,12 +355,12 @@ TEST_SUITE("poisson") {
     tspline::AdaptiveSolveOptions uo;
     uo.refine = tspline::AdaptiveSolveOptions::Refine::Uniform;
     uo.steps = 3;  // 4x4 .. 16x16 cells
-    const auto uni = tspline::solve_adaptive(map, p, uo);
+    const auto uni = tspline::solve_adaptive(map, p, uo).steps;
     tspline::AdaptiveSolveOptions ao;
     ao.gamma = 0.5;
     ao.steps = 6;
     ao.max_dofs = uni.back().dofs;
-    const auto ad = tspline::solve_adaptive(map, p, ao);
+    const auto ad = tspline::solve_adaptive(map, p, ao).steps;
     for (const auto& s : uni)
       MESSAGE("uniform  dofs " << s.dofs << " H1 " << s.errors.h1 << " L2 " << s.errors.l2 << " eta " << s.eta
                                << " eta/H1 " << s.eta / s.errors.h1);

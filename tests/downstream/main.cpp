@@ -41,7 +41,7 @@ int main() {
   tspline::AdaptiveSolveOptions o;
   o.refine = tspline::AdaptiveSolveOptions::Refine::Uniform;
   o.steps = 2;
-  const std::vector<tspline::PoissonStep> steps = tspline::solve_adaptive(back.map, p, o);
+  const std::vector<tspline::PoissonStep> steps = tspline::solve_adaptive(back.map, p, o).steps;
   const double e0 = steps.front().errors.l2 / steps.front().errors.l2_exact;
   const double e1 = steps.back().errors.l2 / steps.back().errors.l2_exact;
   std::printf("cells %zu, min J_r %.3f, file round trip %.1e, Poisson relative L2 error %.2e -> %.2e\n",

@@ -111,4 +111,27 @@ void ensure_writable_directory(const std::string& dir) {
   if (ec) fail("directory is not writable", dir, "cannot remove probe file: " + ec.message());
 }
 
+void check_writable_directory(const std::string& dir) {
+  std::error_code ec;
+  const fs::path p = fs::absolute(fs::path(dir), ec);
+  if (ec) throw IoError("cannot use output directory " + dir + ": " + ec.message());
+  auto writable = [](const fs::path& d) { return ::access(d.c_str(), W_OK | X_OK) == 0; };
+  if (fs::exists(p, ec)) {
+    if (!fs::is_directory(p, ec))
+      throw IoError("output directory " + dir + " exists and is not a directory");
+    if (!writable(p))
+      throw IoError("output directory " + dir + " is not writable: " + std::strerror(errno));
+    return;
+  }
+  fs::path a = p.parent_path();
+  while (!a.empty() && a != a.root_path() && !fs::exists(a, ec)) a = a.parent_path();
+  if (a.empty()) a = p.root_path();
+  if (!fs::is_directory(a, ec))
+    throw IoError("cannot create output directory " + dir + ": " + a.string() +
+                           " is not a directory");
+  if (!writable(a))
+    throw IoError("cannot create output directory " + dir + ": " + a.string() +
+                           " is not writable: " + std::strerror(errno));
+}
+
 }  // namespace toolkit::io

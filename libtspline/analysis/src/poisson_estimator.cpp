@@ -118,17 +118,33 @@ std::vector<int> mark_cells(const std::vector<double>& eta, double gamma) {
   return marked;
 }
 
-std::vector<PoissonStep> solve_adaptive(const TSplineMap& map, const PoissonProblem& problem,
-                                        const AdaptiveSolveOptions& options, const PoissonStepCallback& callback) {
+std::string describe(AdaptiveSolveStop stop, const AdaptiveSolveOptions& options) {
+  switch (stop) {
+    case AdaptiveSolveStop::AllSteps: return "all " + std::to_string(options.steps) + " steps done";
+    case AdaptiveSolveStop::EstimatorAtRoundoff:
+      return "the estimator is at round-off (u_h solves the problem exactly): nothing to refine";
+    case AdaptiveSolveStop::NothingMarked: return "no cell marked (eta = 0 everywhere)";
+    case AdaptiveSolveStop::MaxDofs:
+      return "the next space would have more than " + std::to_string(options.max_dofs) + " DOFs (max_dofs)";
+  }
+  return "unknown";
+}
+
+AdaptiveSolveResult solve_adaptive(const TSplineMap& map, const PoissonProblem& problem,
+                                   const AdaptiveSolveOptions& options, const PoissonStepCallback& callback) {
   if (options.steps < 1) throw InputError("Poisson: steps must be at least 1");
   if (!(options.gamma >= 0.0 && options.gamma <= 1.0))
     throw InputError("gamma must lie in [0, 1], got " + std::to_string(options.gamma));
-  std::vector<PoissonStep> steps;
+  AdaptiveSolveResult result;
+  std::vector<PoissonStep>& steps = result.steps;
   TMesh mesh = map.mesh();
   for (int k = 0; k < options.steps; ++k) {
     const auto t0 = Clock::now();
     auto space = std::make_shared<const AnalysisSpace>(map, mesh);
-    if (k > 0 && space->num_dofs() > options.max_dofs) break;
+    if (k > 0 && space->num_dofs() > options.max_dofs) {
+      result.stop = AdaptiveSolveStop::MaxDofs;
+      break;
+    }
     const PoissonSolution sol = solve_poisson(map, space, problem, options.solver);
     PoissonStep st;
     st.step = k;
@@ -167,11 +183,14 @@ std::vector<PoissonStep> solve_adaptive(const TSplineMap& map, const PoissonProb
     steps.push_back(st);
     if (callback) callback(st, sol, eta);
     if (k + 1 < options.steps) {
-      if (marked.empty()) break;  // nothing to refine (estimator zero or at round-off)
+      if (marked.empty()) {  // nothing to refine
+        result.stop = st.eta_at_roundoff ? AdaptiveSolveStop::EstimatorAtRoundoff : AdaptiveSolveStop::NothingMarked;
+        break;
+      }
       mesh = refine_cells(mesh, marked);
     }
   }
-  return steps;
+  return result;
 }
 
 }  // namespace tspline

@@ -18,4 +18,10 @@ void write_atomic(const std::string& path, const std::function<void(const std::s
 /// \throw IoError naming the directory if it cannot be created or written.
 void ensure_writable_directory(const std::string& dir);
 
+/// Checks, without creating anything, that `dir` could be created and written:
+/// it is a writable directory, or its nearest existing ancestor is one (for
+/// programs that create their output folder only once there is something to
+/// put in it). \throw IoError naming the directory and the reason.
+void check_writable_directory(const std::string& dir);
+
 }  // namespace toolkit::io

@@ -4,6 +4,7 @@
 // split them with their refinement patch, or split every cell (uniform), repeat.
 #include <cstddef>
 #include <functional>
+#include <string>
 #include <vector>
 
 #include "tspline/analysis/poisson_estimator.h"
@@ -39,9 +40,25 @@ struct PoissonStep {
 using PoissonStepCallback =
     std::function<void(const PoissonStep&, const PoissonSolution&, const std::vector<double>& eta)>;
 
+/// Why the adaptive loop stopped.
+enum class AdaptiveSolveStop {
+  AllSteps,             ///< options.steps solves done
+  EstimatorAtRoundoff,  ///< eta below kRoundoffResidual of its scale: u_h solves the problem exactly
+  NothingMarked,        ///< eta = 0 in every cell: nothing to refine
+  MaxDofs,              ///< the next space would have more than options.max_dofs DOFs
+};
+
+/// One line for a user ("all 5 steps done", ...); `options` for the numbers in it.
+std::string describe(AdaptiveSolveStop stop, const AdaptiveSolveOptions& options);
+
+struct AdaptiveSolveResult {
+  std::vector<PoissonStep> steps;  ///< one per solve, in order
+  AdaptiveSolveStop stop = AdaptiveSolveStop::AllSteps;
+};
+
 /// Solve, estimate, mark (adaptive) or split all cells (uniform), repeat.
 /// \throw InputError for bad options (steps < 1, gamma outside [0,1]).
-std::vector<PoissonStep> solve_adaptive(const TSplineMap& map, const PoissonProblem& problem,
-                                        const AdaptiveSolveOptions& options, const PoissonStepCallback& callback = {});
+AdaptiveSolveResult solve_adaptive(const TSplineMap& map, const PoissonProblem& problem,
+                                   const AdaptiveSolveOptions& options, const PoissonStepCallback& callback = {});
 
 }  // namespace tspline
