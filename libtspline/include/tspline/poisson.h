@@ -114,9 +114,10 @@ class InteriorSystemSolver {
   /// Whether it solves a system of ni unknowns; if not, the built-in direct solver does.
   virtual bool accepts(std::size_t ni) const = 0;
   /// Starts the system: dof[a] = interior number of basis function a (-1 for a
-  /// Dirichlet function), ni unknowns. Returns the cells [first, last) this
-  /// process assembles.
-  virtual std::pair<int, int> begin(const AnalysisSpace& space, const std::vector<int>& dof, int ni) = 0;
+  /// Dirichlet function), ni unknowns. Returns the cells this process
+  /// assembles, ascending (a distributed solver may ask two processes for the
+  /// same cell, each keeping the rows it owns).
+  virtual std::vector<int> begin(const AnalysisSpace& space, const std::vector<int>& dof, int ni) = 0;
   /// One cell's contribution: rows[k] = interior number of the cell's k-th
   /// function (-1: Dirichlet, to be ignored); Kloc its element stiffness matrix
   /// (LOWER triangle filled, K(r, s) for r >= s); floc its load with the
