@@ -2,6 +2,7 @@
 // IGA Poisson solver (see poisson.h).
 #include <Eigen/Dense>
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 
@@ -25,13 +26,16 @@ Eigen::Vector2d exact_gradient(const PoissonProblem& p, double x, double y) {
 
 }  // namespace
 
-PoissonErrors compute_errors(const TSplineMap& map, const PoissonSolution& sol, const PoissonProblem& problem) {
+PoissonErrors compute_errors(const TSplineMap& map, const PoissonSolution& sol, const PoissonProblem& problem,
+                             const InteriorSystemSolver* distributed) {
   if (!problem.exact) throw InputError("Poisson errors: no exact solution given");
   const TMesh& mesh = sol.space->mesh();
   std::vector<QuadraturePoint> qp;
   PoissonErrors e;
   double l2 = 0, h1 = 0, l2u = 0, h1u = 0;
-  for (int c = 0; c < static_cast<int>(mesh.num_cells()); ++c) {
+  const int nc = static_cast<int>(mesh.num_cells());
+  const auto [first, last] = distributed ? distributed->cell_share(nc) : std::pair<int, int>{0, nc};
+  for (int c = first; c < last; ++c) {
     box_quadrature(mesh.cell_min(c), mesh.cell_max(c), 6, qp, map.basis(), sol.space->geometry_cell(c));
     for (const QuadraturePoint& q : qp) {
       const SolutionValue v = evaluate_solution(map, sol, c, q.uv, 1);
@@ -45,6 +49,15 @@ PoissonErrors compute_errors(const TSplineMap& map, const PoissonSolution& sol, 
       e.max_abs_at_qp = std::max(e.max_abs_at_qp, std::abs(ue - v.u));
     }
   }
+  if (distributed) {  // the integrals are sums over the cells
+    std::array<double, 4> sums{l2, h1, l2u, h1u};
+    distributed->sum_over_processes(sums);
+    l2 = sums[0];
+    h1 = sums[1];
+    l2u = sums[2];
+    h1u = sums[3];
+    distributed->max_over_processes({&e.max_abs_at_qp, 1});
+  }
   e.l2 = std::sqrt(l2);
   e.h1 = std::sqrt(h1);
   e.l2_exact = std::sqrt(l2u);
@@ -53,12 +66,14 @@ PoissonErrors compute_errors(const TSplineMap& map, const PoissonSolution& sol, 
 }
 
 std::vector<double> estimate_cells(const TSplineMap& map, const PoissonSolution& sol, const PoissonProblem& problem,
-                                   std::vector<double>* eta_scale) {
+                                   std::vector<double>* eta_scale, const InteriorSystemSolver* distributed) {
   const TMesh& mesh = sol.space->mesh();
   std::vector<QuadraturePoint> qp;
   std::vector<double> eta(mesh.num_cells(), 0.0);
   if (eta_scale) eta_scale->assign(mesh.num_cells(), 0.0);
-  for (int c = 0; c < static_cast<int>(mesh.num_cells()); ++c) {
+  const int nc = static_cast<int>(mesh.num_cells());
+  const auto [first, last] = distributed ? distributed->cell_share(nc) : std::pair<int, int>{0, nc};
+  for (int c = first; c < last; ++c) {
     const Eigen::Vector2d lo = mesh.cell_min(c), hi = mesh.cell_max(c);
     const int g = sol.space->geometry_cell(c);
     // h_e: the longer diagonal of the image of the cell's corners.
@@ -78,6 +93,10 @@ std::vector<double> estimate_cells(const TSplineMap& map, const PoissonSolution&
     }
     eta[c] = h * std::sqrt(s);
     if (eta_scale) (*eta_scale)[c] = h * std::sqrt(scale);
+  }
+  if (distributed) {  // every process gets every cell's value (the others' are 0 here)
+    distributed->sum_over_processes(eta);
+    if (eta_scale) distributed->sum_over_processes(*eta_scale);
   }
   return eta;
 }
@@ -138,10 +157,10 @@ std::vector<PoissonStep> solve_adaptive(const TSplineMap& map, const PoissonProb
     st.assembly_seconds = sol.assembly_seconds;
     if (problem.exact) {
       st.has_errors = true;
-      st.errors = compute_errors(map, sol, problem);
+      st.errors = compute_errors(map, sol, problem, options.solver);
     }
     std::vector<double> scale;
-    const std::vector<double> eta = estimate_cells(map, sol, problem, &scale);
+    const std::vector<double> eta = estimate_cells(map, sol, problem, &scale, options.solver);
     double s = 0, s_scale = 0;
     for (std::size_t c = 0; c < eta.size(); ++c) {
       s += eta[c] * eta[c];

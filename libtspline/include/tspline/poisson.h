@@ -102,6 +102,7 @@ struct SolverStats {
   double relative_residual = 0.0;  ///< ||K u - b|| / ||b|| of the interior system (0 if b = 0)
   int iterations = 0;              ///< CG iterations (0 for the direct solver)
   int processes = 1;               ///< processes that shared the solve
+  double tolerance = 0.0;          ///< an iterative solver's relative tolerance (0 for the direct solver)
 };
 
 /// An external solver of the interior system K u = b (K symmetric positive
@@ -129,6 +130,13 @@ class InteriorSystemSolver {
   /// Solves; u receives all ni interior values (on every process). \throw
   /// NumericalError if the solve does not converge.
   virtual SolverStats solve(Eigen::VectorXd& u) = 0;
+  /// The share [first, last) of nc cells whose error and estimator terms this
+  /// process computes (compute_errors, estimate_cells); default: all of them.
+  virtual std::pair<int, int> cell_share(int nc) const { return {0, nc}; }
+  /// Sums (or takes the maximum of) v element-wise over the processes, in place,
+  /// the result on every process (collective); default: one process, v stays.
+  virtual void sum_over_processes(std::span<double> v) const { (void)v; }
+  virtual void max_over_processes(std::span<double> v) const { (void)v; }
 };
 
 struct PoissonSolution {
@@ -181,14 +189,19 @@ struct PoissonErrors {
   double max_abs_at_qp = 0.0;  ///< max |u - u_h| over the quadrature points
 };
 
-/// \throw InputError if problem.exact is missing.
-PoissonErrors compute_errors(const TSplineMap& map, const PoissonSolution& sol, const PoissonProblem& problem);
+/// \throw InputError if problem.exact is missing. With `distributed` (collective
+/// then), each process integrates its cell_share() and the sums are combined
+/// over the processes (the same result up to the order of the additions).
+PoissonErrors compute_errors(const TSplineMap& map, const PoissonSolution& sol, const PoissonProblem& problem,
+                             const InteriorSystemSolver* distributed = nullptr);
 
 /// eta_e per analysis cell (not squared). If eta_scale is given it receives per
 /// cell h_e (||f||^2 + ||Laplace u_h||^2)^{1/2} over the cell's image: the size of
 /// the two terms whose sum is the residual, to recognize a residual at round-off.
+/// With `distributed`, as compute_errors: each process its share, every process gets all cells.
 std::vector<double> estimate_cells(const TSplineMap& map, const PoissonSolution& sol, const PoissonProblem& problem,
-                                   std::vector<double>* eta_scale = nullptr);
+                                   std::vector<double>* eta_scale = nullptr,
+                                   const InteriorSystemSolver* distributed = nullptr);
 
 /// An estimator below this fraction of its scale (see estimate_cells) is round-off:
 /// the adaptive loop then refines nothing. (Discrete solutions measure ~1e-15.)

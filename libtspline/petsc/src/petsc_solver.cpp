@@ -65,6 +65,11 @@ SolverChoice parse_solver_choice(const std::string& name) {
   throw InputError("unknown solver '" + name + "' (expected auto, direct or iterative)");
 }
 
+double automatic_rtol(std::size_t n) {
+  const double nn = static_cast<double>(std::max<std::size_t>(n, 1));
+  return std::min(1e-10, std::max(kAutoRtolFloor, kAutoRtolScale / (nn * nn)));
+}
+
 int process_rank() {
   PetscMPIInt r = 0;
   MPI_Comm_rank(PETSC_COMM_WORLD, &r);
@@ -115,8 +120,8 @@ struct PetscPoissonSolver::Impl {
 };
 
 PetscPoissonSolver::PetscPoissonSolver(const IterativeOptions& options) : impl_(std::make_unique<Impl>()) {
-  if (!(options.rtol > 0.0) || !std::isfinite(options.rtol))
-    throw InputError("the iterative solver's relative tolerance must be > 0, got " + g3(options.rtol));
+  if (options.rtol && (!(*options.rtol > 0.0) || !std::isfinite(*options.rtol)))
+    throw InputError("the iterative solver's relative tolerance must be > 0, got " + g3(*options.rtol));
   if (options.max_iterations < 1)
     throw InputError("the iterative solver's iteration limit must be at least 1, got " +
                      std::to_string(options.max_iterations));
@@ -409,7 +414,9 @@ SolverStats PetscPoissonSolver::solve(Eigen::VectorXd& u) {
   }
   // Stop on the true (unpreconditioned) residual: ||b - K u|| <= rtol ||b||.
   check(KSPSetNormType(ksp, KSP_NORM_UNPRECONDITIONED), "KSPSetNormType");
-  check(KSPSetTolerances(ksp, o.rtol, 1e-300, PETSC_DEFAULT, o.max_iterations), "KSPSetTolerances");
+  const double rtol = o.rtol ? *o.rtol : automatic_rtol(static_cast<std::size_t>(m.n));
+  st.tolerance = rtol;
+  check(KSPSetTolerances(ksp, rtol, 1e-300, PETSC_DEFAULT, o.max_iterations), "KSPSetTolerances");
   check(KSPSetFromOptions(ksp), "KSPSetFromOptions");
   check(MatCreateVecs(m.A, &x, nullptr), "MatCreateVecs");
   check(KSPSolve(ksp, m.b, x), "KSPSolve");
@@ -431,7 +438,7 @@ SolverStats PetscPoissonSolver::solve(Eigen::VectorXd& u) {
     throw NumericalError("iterative solve (" + st.kind + ") did not converge: " + KSPConvergedReasons[reason] +
                          " after " + std::to_string(its) + " iterations (limit " +
                          std::to_string(o.max_iterations) + "), relative residual " +
-                         g3(st.relative_residual) + " (rtol " + g3(o.rtol) + ")");
+                         g3(st.relative_residual) + " (rtol " + g3(rtol) + ")");
 
   // Gather the solution on every process and undo the renumbering.
   check(VecScatterCreateToAll(x, &gather, &xall), "VecScatterCreateToAll");
@@ -444,6 +451,21 @@ SolverStats PetscPoissonSolver::solve(Eigen::VectorXd& u) {
   check(VecRestoreArrayRead(xall, &xa), "VecRestoreArrayRead");
   st.seconds = seconds_since(t0);
   return st;
+}
+
+std::pair<int, int> PetscPoissonSolver::cell_share(int nc) const {
+  const int P = process_count(), R = process_rank();
+  return {block_start(nc, R, P), block_start(nc, R + 1, P)};
+}
+
+void PetscPoissonSolver::sum_over_processes(std::span<double> v) const {
+  if (process_count() > 1 && !v.empty())
+    MPI_Allreduce(MPI_IN_PLACE, v.data(), static_cast<int>(v.size()), MPI_DOUBLE, MPI_SUM, PETSC_COMM_WORLD);
+}
+
+void PetscPoissonSolver::max_over_processes(std::span<double> v) const {
+  if (process_count() > 1 && !v.empty())
+    MPI_Allreduce(MPI_IN_PLACE, v.data(), static_cast<int>(v.size()), MPI_DOUBLE, MPI_MAX, PETSC_COMM_WORLD);
 }
 
 }  // namespace tspline::petsc

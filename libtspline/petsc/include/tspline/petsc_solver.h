@@ -27,10 +27,13 @@
 // GAMG, stopping when ||b - K u|| <= rtol ||b|| (the unpreconditioned residual,
 // so that rtol means the same for every preconditioner). PETSC_OPTIONS (e.g.
 // "-ksp_monitor -pc_hypre_boomeramg_strong_threshold 0.5") overrides the
-// choices (KSPSetFromOptions). The solution is gathered on every process.
+// choices (KSPSetFromOptions). The solution is gathered on every process;
+// the error norms and the estimator then split the cells over the processes
+// (cell_share) and add up (sum_over_processes).
 
 #include <cstddef>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -53,14 +56,32 @@ enum class Preconditioner {
 /// crossover of CHOLMOD and CG + BoomerAMG in time on the benchmark (bench/README.md).
 inline constexpr std::size_t kAutoIterativeFrom = 20000;
 
+/// The automatic relative tolerance for n interior unknowns:
+///   rtol(n) = min(1e-10, max(kAutoRtolFloor, kAutoRtolScale / n^2)).
+/// Why n^-2: CG stops at ||b - K u_k|| <= rtol ||b||. For the 2D stiffness matrix
+/// of a quasi-uniform space with n ~ h^-2 unknowns, lambda_min(K) ~ h^2 and
+/// ||b|| ~ h (n entries of size h^2 f), so the coefficient error is at most
+/// ||K^-1|| rtol ||b|| ~ rtol / h and its L2 norm (a factor h) ~ rtol ||u||: the
+/// algebraic L2 error does not shrink with h at fixed rtol, while the cubic
+/// discretization error does, like h^4 ~ n^-2 for smooth solutions. A
+/// tolerance proportional to n^-2 keeps their ratio fixed; the constant is
+/// calibrated on the disk (bench/README.md, "IGA Poisson at scale"): at
+/// 1.66e5 DOFs rtol 1e-10 / 1e-12 / 1e-13 leave the L2 error 1.2e-3 / 4.6e-8 /
+/// 4e-10 relative from the direct solve's; 0.02 / n^2 = 7.3e-13 there, with
+/// ~25 % more CG iterations than 1e-10. The floor: CG's true residual stagnates near eps ||K|| ||u|| /
+/// ||b|| ~ eps n (both solvers' round-off), so a smaller rtol only adds
+/// iterations on the recursive residual. Non-smooth solutions (larger
+/// discretization errors) are then solved more accurately than they need.
+inline constexpr double kAutoRtolScale = 0.02;
+inline constexpr double kAutoRtolFloor = 1e-15;
+double automatic_rtol(std::size_t n);
+
 struct IterativeOptions {
   SolverChoice choice = SolverChoice::Auto;
   Preconditioner preconditioner = Preconditioner::BoomerAMG;
-  /// Relative residual ||b - K u|| / ||b|| to reach (> 0). 1e-10: the algebraic
-  /// error is then far below the discretization error of the cubic space up to
-  /// millions of DOFs; by Galerkin orthogonality the energy error grows only by
-  /// the square of their ratio.
-  double rtol = 1e-10;
+  /// Relative residual ||b - K u|| / ||b|| to reach (> 0); unset: automatic_rtol(n)
+  /// for the n unknowns of each system.
+  std::optional<double> rtol;
   int max_iterations = 1000;  ///< >= 1; more is a NumericalError
   std::size_t auto_threshold = kAutoIterativeFrom;
 };
@@ -86,6 +107,11 @@ class PetscPoissonSolver final : public InteriorSystemSolver {
   bool end_assembly(bool ok) override;
   /// \throw NumericalError if CG does not reach rtol within max_iterations (or diverges).
   SolverStats solve(Eigen::VectorXd& u) override;
+  /// Process r of P: the cells [r nc / P, (r+1) nc / P) (its assembly block).
+  std::pair<int, int> cell_share(int nc) const override;
+  /// MPI_Allreduce over PETSC_COMM_WORLD.
+  void sum_over_processes(std::span<double> v) const override;
+  void max_over_processes(std::span<double> v) const override;
 
  private:
   struct Impl;
