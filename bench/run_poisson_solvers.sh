@@ -29,7 +29,7 @@ T=$(mktemp -d)
 for solver in direct iterative; do
   steps=6; if [ "$solver" = iterative ]; then steps=7; fi
   ./build/apps/tspline poisson "$T/disk/tspline.json" --problem sinsin --refine uniform --steps "$steps" --samples 1 \
-    --solver "$solver" -q --out "$T/$solver"
+    --max-dofs 700000 --solver "$solver" -q --out "$T/$solver"
   python3 -c "
 import json,sys
 for s in json.load(open('$T/$solver/report.json'))['steps']:
