@@ -50,6 +50,10 @@
 // h_e = physical cell diameter, taken as the longer of the two diagonals of the
 // image of the cell's corners, |S(c00) - S(c11)| and |S(c10) - S(c01)|.
 // Laplace u_h uses the physical Hessian (see physical_hessian()).
+// Errors and estimator evaluate u_h and S per cell from the univariate B-spline
+// factors tabulated at the distinct quadrature coordinates (the values of
+// evaluate_solution()); with a distributed solver each process integrates its
+// cell_share() and the sums are combined (InteriorSystemSolver).
 
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
