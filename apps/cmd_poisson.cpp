@@ -21,6 +21,7 @@
 #include <nlohmann/json.hpp>
 #include <numbers>
 #include <numeric>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <utility>
@@ -60,10 +61,26 @@ std::string fmt(double v) {
   return b;
 }
 
+/// --rtol: "auto" (nullopt) or a number > 0. \throw InputError otherwise.
+std::optional<double> parse_rtol(const std::string& text) {
+  if (text == "auto") return std::nullopt;
+  double v = 0.0;
+  std::size_t used = 0;
+  try {
+    v = std::stod(text, &used);
+  } catch (const std::exception&) {
+    used = 0;
+  }
+  if (used == 0 || used != text.size())
+    throw tspline::InputError("--rtol must be 'auto' or a number > 0, got '" + text + "'");
+  if (!(v > 0.0) || !std::isfinite(v)) throw tspline::InputError("--rtol must be > 0, got " + fmt(v));
+  return v;
+}
+
 struct PoissonArgs {
   std::string file, out_dir, f, g, exact, problem, refine = "adaptive";
   std::string solver = "auto", preconditioner = "boomeramg";
-  double rtol = tspline::petsc::IterativeOptions{}.rtol;
+  std::string rtol = "auto";  // "auto" (tspline::petsc::automatic_rtol) or a number > 0
   int max_iterations = tspline::petsc::IterativeOptions{}.max_iterations;
   std::size_t direct_below = tspline::petsc::kAutoIterativeFrom;
   int steps = 5;
@@ -210,7 +227,7 @@ void validate_options(const PoissonArgs& a) {
   if (a.out_dir.empty()) throw tspline::InputError("--out: empty path");
   tspline::petsc::parse_solver_choice(a.solver);
   tspline::petsc::parse_preconditioner(a.preconditioner);
-  if (!(a.rtol > 0.0) || !std::isfinite(a.rtol)) throw tspline::InputError("--rtol must be > 0, got " + fmt(a.rtol));
+  parse_rtol(a.rtol);
   if (a.max_iterations < 1)
     throw tspline::InputError("--max-iterations must be at least 1, got " + std::to_string(a.max_iterations));
 }
@@ -219,7 +236,7 @@ tspline::petsc::IterativeOptions iterative_options(const PoissonArgs& a) {
   tspline::petsc::IterativeOptions o;
   o.choice = tspline::petsc::parse_solver_choice(a.solver);
   o.preconditioner = tspline::petsc::parse_preconditioner(a.preconditioner);
-  o.rtol = a.rtol;
+  o.rtol = parse_rtol(a.rtol);
   o.max_iterations = a.max_iterations;
   o.auto_threshold = a.direct_below;
   return o;
@@ -429,7 +446,11 @@ void add_poisson_command(CLI::App& app, CommandAction& action) {
                   "AMG preconditioner of the iterative solver: boomeramg (hypre) or gamg (PETSc)")
       ->type_name("boomeramg|gamg")
       ->capture_default_str();
-  cmd->add_option("--rtol", a->rtol, "Iterative solver: stop when ||b - K u|| <= rtol ||b|| (rtol > 0)")
+  cmd->add_option("--rtol", a->rtol,
+                  "Iterative solver: stop when ||b - K u|| <= rtol ||b|| (rtol > 0); auto: "
+                  "min(1e-10, max(1e-15, 0.02 / n^2)) for n unknowns, so that the algebraic error stays below "
+                  "the discretization error")
+      ->type_name("auto|R")
       ->capture_default_str();
   cmd->add_option("--max-iterations", a->max_iterations,
                   "Iterative solver: CG iterations at most; not converging by then is an error (exit 3)")

@@ -3,14 +3,16 @@
 // T-mesh, control points at the Greville abscissae), u = sin(pi x) sin(pi y).
 // Prints one table row:
 //   level cells dofs space_s dirichlet_s assembly_s solve_s solver residual max_err peak_MiB
-//   ranks its peak_total_MiB
+//   ranks its peak_total_MiB assembly_cpu_s solve_cpu_s
 // (peak_MiB: the largest peak of one process; peak_total_MiB: their sum.)
 // (space_s: analysis T-mesh + hierarchical B-spline basis; solve_s: factorization + solve;
 // max_err: max |u - u_h| at the centres of about 16 x 16 cells, a cheap check
-// that the solve is right).
+// that the solve is right; *_cpu_s: CPU time of rank 0's process (std::clock)
+// for the iterative solver's assembly and solve, which a loaded machine
+// inflates less than the wall times; -1 for the direct solver).
 // Usage: [mpirun -n P] bench_poisson LEVEL [direct|iterative] [boomeramg|gamg] [RTOL]
 // (default direct; the iterative solver is PETSc CG + AMG, tspline/petsc_solver.h,
-// with the default rtol of `tspline poisson`.)
+// with the default (automatic) rtol of `tspline poisson` unless RTOL is given.)
 // Run one size per process so the peak memory (getrusage) belongs to that size.
 #include <petscsys.h>
 
@@ -19,6 +21,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <ctime>
 #include <memory>
 #include <numbers>
 #include <numeric>
@@ -43,6 +46,37 @@ tspline::TSplineMap identity_map(int level) {
   return tspline::greville_identity_map(std::move(m));
 }
 
+/// The PETSc solver, with the CPU time of its assembly (begin .. end_assembly)
+/// and solve measured around it.
+class TimedSolver final : public tspline::InteriorSystemSolver {
+ public:
+  explicit TimedSolver(tspline::InteriorSystemSolver& inner) : inner_(inner) {}
+  bool accepts(std::size_t ni) const override { return inner_.accepts(ni); }
+  std::vector<int> begin(const tspline::AnalysisSpace& space, const std::vector<int>& dof, int ni) override {
+    c0_ = std::clock();
+    return inner_.begin(space, dof, ni);
+  }
+  void add_cell(std::span<const int> rows, const Eigen::MatrixXd& Kloc, const Eigen::VectorXd& floc) override {
+    inner_.add_cell(rows, Kloc, floc);
+  }
+  bool end_assembly(bool ok) override {
+    const bool r = inner_.end_assembly(ok);
+    assembly_cpu = cpu_since(c0_);
+    return r;
+  }
+  tspline::SolverStats solve(Eigen::VectorXd& u) override {
+    const std::clock_t c = std::clock();
+    tspline::SolverStats st = inner_.solve(u);
+    solve_cpu = cpu_since(c);
+    return st;
+  }
+  double assembly_cpu = -1, solve_cpu = -1;
+
+ private:
+  static double cpu_since(std::clock_t c) { return static_cast<double>(std::clock() - c) / CLOCKS_PER_SEC; }
+  tspline::InteriorSystemSolver& inner_;
+  std::clock_t c0_ = 0;
+};
 
 int run(int argc, char** argv) {
   if (argc < 2) {
@@ -62,7 +96,8 @@ int run(int argc, char** argv) {
   if (io.choice == tspline::petsc::SolverChoice::Auto) io.choice = tspline::petsc::SolverChoice::Direct;
   if (argc > 3) io.preconditioner = tspline::petsc::parse_preconditioner(argv[3]);
   if (argc > 4) io.rtol = std::atof(argv[4]);
-  tspline::petsc::PetscPoissonSolver solver(io);
+  tspline::petsc::PetscPoissonSolver petsc_solver(io);
+  TimedSolver solver(petsc_solver);
   constexpr double pi = std::numbers::pi;
   tspline::PoissonProblem p;
   p.exact = [](double x, double y) { return std::sin(pi * x) * std::sin(pi * y); };
@@ -96,11 +131,11 @@ int run(int argc, char** argv) {
                      : k == "PETSc CG + hypre BoomerAMG" ? "BoomerAMG"
                      : k == "PETSc CG + PETSc GAMG"      ? "GAMG"
                                                          : "CG+IC";
-  std::printf("%5d %9zu %9zu %8.3f %11.3f %10.3f %8.3f %-9s %9.1e %9.1e %9.1f %5d %5d %9.1f\n", level,
+  std::printf("%5d %9zu %9zu %8.3f %11.3f %10.3f %8.3f %-9s %9.1e %9.1e %9.1f %5d %5d %9.1f %8.3f %8.3f\n", level,
               m.num_cells(), space->num_dofs(), space_s, sol.dirichlet_seconds, sol.assembly_seconds,
               sol.solver.seconds, name, sol.solver.relative_residual, max_err,
               *std::max_element(peak.begin(), peak.end()), tspline::petsc::process_count(), sol.solver.iterations,
-              std::accumulate(peak.begin(), peak.end(), 0.0));
+              std::accumulate(peak.begin(), peak.end(), 0.0), solver.assembly_cpu, solver.solve_cpu);
   return 0;
 }
 

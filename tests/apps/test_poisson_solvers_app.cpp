@@ -5,6 +5,7 @@
 // refinement; bad solver options and a solve that does not converge are errors.
 #include <doctest/doctest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -99,7 +100,11 @@ TEST_SUITE("poisson_solvers_app") {
         // AMG: 12-17 iterations on the square; on the disk, whose map is singular at the
         // four points that the square's corners go to, 24-73, leveling off near 50 under refinement.
         CHECK(s["solver"]["iterations"].get<int>() <= 100);
-        CHECK(s["solver"]["relative_residual"].get<double>() <= 1e-10);  // the default --rtol
+        // The default --rtol auto: min(1e-10, max(1e-15, 0.02 / n^2)) for n interior DOFs.
+        const double n = s["interior_dofs"].get<double>();
+        const double rtol = std::min(1e-10, std::max(1e-15, 0.02 / (n * n)));
+        CHECK(s["solver"]["rtol"].get<double>() == doctest::Approx(rtol).epsilon(1e-12));
+        CHECK(s["solver"]["relative_residual"].get<double>() <= 2 * rtol);
         CHECK(s["solver"]["processes"] == 1);
         CHECK(s["peak_memory_mib"]["per_process"].size() == 1);
         CHECK(s["peak_memory_mib"]["total"].get<double>() > 1.0);
@@ -141,7 +146,14 @@ TEST_SUITE("poisson_solvers_app") {
     CAPTURE(b.err);
     REQUIRE(b.exit_code == 0);
     const json rb = report(d / "mpi");
-    check_same_errors(report(d / "direct"), rb);
+    const json ra = report(d / "direct");
+    check_same_errors(ra, rb);
+    // The estimator, split over the two processes and summed, marks the same
+    // cells (same DOFs, checked above) and has the same value.
+    for (std::size_t k = 0; k < ra["steps"].size(); ++k) {
+      const double ea = ra["steps"][k]["eta"].get<double>(), eb = rb["steps"][k]["eta"].get<double>();
+      CHECK(std::abs(ea - eb) <= 1e-6 * ea);
+    }
     CHECK(rb["options"]["processes"] == 2);
     for (const json& s : rb["steps"]) {
       CHECK(s["solver"]["processes"] == 2);
@@ -167,6 +179,7 @@ TEST_SUITE("poisson_solvers_app") {
                           Case{"--preconditioner ilu", "unknown preconditioner 'ilu'"},
                           Case{"--rtol 0", "--rtol must be > 0, got 0"},
                           Case{"--rtol -1e-8", "--rtol must be > 0"},
+                          Case{"--rtol tight", "--rtol must be 'auto' or a number > 0, got 'tight'"},
                           Case{"--max-iterations 0", "--max-iterations must be at least 1"}}) {
       const std::string args = "poisson " + sq + " --problem sinsin " + c.args + " --out " + q(d / "out");
       CAPTURE(args);

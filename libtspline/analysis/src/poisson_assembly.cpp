@@ -475,11 +475,11 @@ Eigen::SparseMatrix<double> assemble_stiffness(const TSplineMap& map, const Anal
 void assemble_external(const TSplineMap& map, const AnalysisSpace& sp, const ScalarField& f,
                        const std::vector<int>& dof, int ni, const Eigen::VectorXd& coefficients,
                        InteriorSystemSolver& solver) {
-  const auto [first, last] = solver.begin(sp, dof, ni);
+  const std::vector<int> cells = solver.begin(sp, dof, ni);
   std::exception_ptr failure;
   try {
     CellKernel cell(map, sp, f, dof, coefficients);
-    for (int c = first; c < last; ++c) {
+    for (int c : cells) {
       cell.compute(c);
       solver.add_cell(cell.rows, cell.Kloc, cell.floc);
     }

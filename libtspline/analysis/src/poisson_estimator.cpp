@@ -2,8 +2,12 @@
 // IGA Poisson solver (see poisson.h).
 #include <Eigen/Dense>
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
+#include <span>
+#include <stdexcept>
+#include <vector>
 
 #include "tspline/spline/bezier_extraction.h"
 #include "tspline/errors.h"
@@ -23,18 +27,177 @@ Eigen::Vector2d exact_gradient(const PoissonProblem& p, double x, double y) {
   return {(p.exact(x + h, y) - p.exact(x - h, y)) / (2 * h), (p.exact(x, y + h) - p.exact(x, y - h)) / (2 * h)};
 }
 
+/// u_h and the map at the quadrature points of one analysis cell, from
+/// tabulated univariate factors: the same values as evaluate_solution() (up to
+/// the order of the additions), without evaluating both bases at every point.
+/// Every function here, analysis or geometry, is a product N[kx](x) N[ky](y);
+/// a cell's functions share few distinct knot vectors and its quadrature points
+/// lie on few distinct x and y lines, so each distinct factor is evaluated once
+/// per distinct coordinate (as the assembly's CellKernel does).
+class CellEvaluator {
+ public:
+  CellEvaluator(const TSplineMap& map, const PoissonSolution& sol) : map_(map), sol_(sol) {}
+
+  /// Tabulates cell c at the points qp, derivatives up to `order` (1 or 2).
+  void set_cell(int c, const std::vector<QuadraturePoint>& qp, int order) {
+    order_ = order;
+    xs_.clear();
+    ys_.clear();
+    qx_.resize(qp.size());
+    qy_.resize(qp.size());
+    for (std::size_t q = 0; q < qp.size(); ++q) {
+      qx_[q] = index_of(xs_, qp[q].uv.x());
+      qy_[q] = index_of(ys_, qp[q].uv.y());
+    }
+    const HierarchicalBasis& basis = sol_.space->basis();
+    ids_ = basis.functions_on_cell(c);
+    coef_.resize(ids_.size());
+    for (std::size_t k = 0; k < ids_.size(); ++k) coef_[k] = sol_.coefficients[ids_[k]];
+    analysis_.build(
+        ids_.size(), [&](std::size_t k) -> const auto& { return basis.function(ids_[k]).knots_xi; },
+        [&](std::size_t k) -> const auto& { return basis.function(ids_[k]).knots_eta; }, xs_, ys_, order);
+    const TSplineBasis& gb = map_.basis();
+    gids_ = &gb.functions_on_cell(sol_.space->geometry_cell(c));
+    geometry_.build(
+        gids_->size(), [&](std::size_t k) -> const auto& { return gb.function((*gids_)[k]).knots_xi; },
+        [&](std::size_t k) -> const auto& { return gb.function((*gids_)[k]).knots_eta; }, xs_, ys_, order);
+  }
+
+  /// evaluate_solution(map, sol, c, qp[q].uv, order) of the current cell.
+  SolutionValue at(std::size_t q) const {
+    const bool d2 = order_ >= 2;
+    // S = A / W with A = sum N_a P_a, W = sum N_a (TSplineBasis: R_a = N_a / W);
+    // differentiating A = S W: S_i = (A_i - S W_i) / W,
+    // S_ij = (A_ij - S_i W_j - S_j W_i - S W_ij) / W.
+    const std::vector<Eigen::Vector2d>& P = map_.control_points();
+    double W = 0, Wx = 0, Wy = 0, Wxx = 0, Wxy = 0, Wyy = 0;
+    Eigen::Vector2d A = Eigen::Vector2d::Zero(), Ax = A, Ay = A, Axx = A, Axy = A, Ayy = A;
+    for (std::size_t k = 0; k < gids_->size(); ++k) {
+      const Factor a = geometry_.x(qx_[q], k), b = geometry_.y(qy_[q], k);
+      const Eigen::Vector2d& p = P[(*gids_)[k]];
+      const double n = a.v * b.v, nx = a.d * b.v, ny = a.v * b.d;
+      W += n;
+      Wx += nx;
+      Wy += ny;
+      A += n * p;
+      Ax += nx * p;
+      Ay += ny * p;
+      if (d2) {
+        const double nxx = a.dd * b.v, nxy = a.d * b.d, nyy = a.v * b.dd;
+        Wxx += nxx;
+        Wxy += nxy;
+        Wyy += nyy;
+        Axx += nxx * p;
+        Axy += nxy * p;
+        Ayy += nyy * p;
+      }
+    }
+    if (!(W > 0.0)) throw std::logic_error("Poisson errors: the blending functions vanish at a quadrature point");
+    MapDerivatives d;
+    d.x = A / W;
+    d.J.col(0) = (Ax - d.x * Wx) / W;
+    d.J.col(1) = (Ay - d.x * Wy) / W;
+    if (d2) {
+      d.xixi = (Axx - 2.0 * d.J.col(0) * Wx - d.x * Wxx) / W;
+      d.xieta = (Axy - d.J.col(0) * Wy - d.J.col(1) * Wx - d.x * Wxy) / W;
+      d.etaeta = (Ayy - 2.0 * d.J.col(1) * Wy - d.x * Wyy) / W;
+    }
+    // u_h = sum c_a X_a(x) Y_a(y) (hierarchical B-splines are not normalized).
+    SolutionValue out;
+    out.x = d.x;
+    out.det_j = d.J.determinant();
+    Eigen::Vector2d g_xi = Eigen::Vector2d::Zero();
+    Eigen::Matrix2d h_xi = Eigen::Matrix2d::Zero();
+    for (std::size_t k = 0; k < coef_.size(); ++k) {
+      const Factor a = analysis_.x(qx_[q], k), b = analysis_.y(qy_[q], k);
+      const double ca = coef_[k];
+      out.u += ca * a.v * b.v;
+      g_xi += ca * Eigen::Vector2d(a.d * b.v, a.v * b.d);
+      if (d2) {
+        h_xi(0, 0) += ca * a.dd * b.v;
+        h_xi(0, 1) += ca * a.d * b.d;
+        h_xi(1, 1) += ca * a.v * b.dd;
+      }
+    }
+    h_xi(1, 0) = h_xi(0, 1);
+    out.grad = d.J.transpose().partialPivLu().solve(g_xi);
+    if (d2) out.hessian = physical_hessian(out.grad, h_xi, d);
+    return out;
+  }
+
+ private:
+  struct Factor {
+    double v = 0.0, d = 0.0, dd = 0.0;  // value, first and second derivative
+  };
+  template <class List, class T>
+  static std::size_t index_of(List& list, const T& value) {
+    for (std::size_t i = 0; i < list.size(); ++i)
+      if (list[i] == value) return i;
+    list.push_back(value);
+    return list.size() - 1;
+  }
+  class TensorFactors {
+   public:
+    template <class KnotsX, class KnotsY>
+    void build(std::size_t nf, KnotsX knots_x, KnotsY knots_y, const std::vector<double>& xs,
+               const std::vector<double>& ys, int order) {
+      knx_.clear();
+      kny_.clear();
+      kx_.resize(nf);
+      ky_.resize(nf);
+      for (std::size_t k = 0; k < nf; ++k) {
+        kx_[k] = index_of(knx_, knots_x(k));
+        ky_[k] = index_of(kny_, knots_y(k));
+      }
+      tabulate(knx_, xs, ux_, order);
+      tabulate(kny_, ys, uy_, order);
+    }
+    Factor x(std::size_t i, std::size_t k) const { return ux_[i * knx_.size() + kx_[k]]; }
+    Factor y(std::size_t i, std::size_t k) const { return uy_[i * kny_.size() + ky_[k]]; }
+
+   private:
+    static void tabulate(const std::vector<std::array<double, 5>>& knots, const std::vector<double>& ts,
+                         std::vector<Factor>& out, int order) {
+      out.resize(ts.size() * knots.size());
+      for (std::size_t i = 0; i < ts.size(); ++i)
+        for (std::size_t j = 0; j < knots.size(); ++j) {
+          Factor& u = out[i * knots.size() + j];
+          u.v = cubic_bspline(knots[j], ts[i], &u.d, order >= 2 ? &u.dd : nullptr);
+        }
+    }
+    std::vector<std::array<double, 5>> knx_, kny_;
+    std::vector<std::size_t> kx_, ky_;
+    std::vector<Factor> ux_, uy_;
+  };
+
+  const TSplineMap& map_;
+  const PoissonSolution& sol_;
+  int order_ = 1;
+  std::span<const int> ids_;
+  const std::vector<int>* gids_ = nullptr;
+  std::vector<double> coef_, xs_, ys_;
+  std::vector<std::size_t> qx_, qy_;
+  TensorFactors analysis_, geometry_;
+};
+
 }  // namespace
 
-PoissonErrors compute_errors(const TSplineMap& map, const PoissonSolution& sol, const PoissonProblem& problem) {
+PoissonErrors compute_errors(const TSplineMap& map, const PoissonSolution& sol, const PoissonProblem& problem,
+                             const InteriorSystemSolver* distributed) {
   if (!problem.exact) throw InputError("Poisson errors: no exact solution given");
   const TMesh& mesh = sol.space->mesh();
   std::vector<QuadraturePoint> qp;
   PoissonErrors e;
   double l2 = 0, h1 = 0, l2u = 0, h1u = 0;
-  for (int c = 0; c < static_cast<int>(mesh.num_cells()); ++c) {
+  const int nc = static_cast<int>(mesh.num_cells());
+  const auto [first, last] = distributed ? distributed->cell_share(nc) : std::pair<int, int>{0, nc};
+  CellEvaluator cell(map, sol);
+  for (int c = first; c < last; ++c) {
     box_quadrature(mesh.cell_min(c), mesh.cell_max(c), 6, qp, map.basis(), sol.space->geometry_cell(c));
-    for (const QuadraturePoint& q : qp) {
-      const SolutionValue v = evaluate_solution(map, sol, c, q.uv, 1);
+    cell.set_cell(c, qp, 1);
+    for (std::size_t iq = 0; iq < qp.size(); ++iq) {
+      const QuadraturePoint& q = qp[iq];
+      const SolutionValue v = cell.at(iq);
       const double w = q.weight * std::abs(v.det_j);
       const double ue = problem.exact(v.x.x(), v.x.y());
       const Eigen::Vector2d ge = exact_gradient(problem, v.x.x(), v.x.y());
@@ -45,6 +208,15 @@ PoissonErrors compute_errors(const TSplineMap& map, const PoissonSolution& sol, 
       e.max_abs_at_qp = std::max(e.max_abs_at_qp, std::abs(ue - v.u));
     }
   }
+  if (distributed) {  // the integrals are sums over the cells
+    std::array<double, 4> sums{l2, h1, l2u, h1u};
+    distributed->sum_over_processes(sums);
+    l2 = sums[0];
+    h1 = sums[1];
+    l2u = sums[2];
+    h1u = sums[3];
+    distributed->max_over_processes({&e.max_abs_at_qp, 1});
+  }
   e.l2 = std::sqrt(l2);
   e.h1 = std::sqrt(h1);
   e.l2_exact = std::sqrt(l2u);
@@ -53,12 +225,15 @@ PoissonErrors compute_errors(const TSplineMap& map, const PoissonSolution& sol, 
 }
 
 std::vector<double> estimate_cells(const TSplineMap& map, const PoissonSolution& sol, const PoissonProblem& problem,
-                                   std::vector<double>* eta_scale) {
+                                   std::vector<double>* eta_scale, const InteriorSystemSolver* distributed) {
   const TMesh& mesh = sol.space->mesh();
   std::vector<QuadraturePoint> qp;
   std::vector<double> eta(mesh.num_cells(), 0.0);
   if (eta_scale) eta_scale->assign(mesh.num_cells(), 0.0);
-  for (int c = 0; c < static_cast<int>(mesh.num_cells()); ++c) {
+  const int nc = static_cast<int>(mesh.num_cells());
+  const auto [first, last] = distributed ? distributed->cell_share(nc) : std::pair<int, int>{0, nc};
+  CellEvaluator cell(map, sol);
+  for (int c = first; c < last; ++c) {
     const Eigen::Vector2d lo = mesh.cell_min(c), hi = mesh.cell_max(c);
     const int g = sol.space->geometry_cell(c);
     // h_e: the longer diagonal of the image of the cell's corners.
@@ -68,8 +243,10 @@ std::vector<double> estimate_cells(const TSplineMap& map, const PoissonSolution&
     const double h = std::max((p11 - p00).norm(), (p01 - p10).norm());
     double s = 0, scale = 0;
     box_quadrature(lo, hi, 4, qp, map.basis(), g);
-    for (const QuadraturePoint& q : qp) {
-      const SolutionValue v = evaluate_solution(map, sol, c, q.uv, 2);
+    cell.set_cell(c, qp, 2);
+    for (std::size_t iq = 0; iq < qp.size(); ++iq) {
+      const QuadraturePoint& q = qp[iq];
+      const SolutionValue v = cell.at(iq);
       const double w = q.weight * std::abs(v.det_j);
       const double fv = problem.f(v.x.x(), v.x.y()), lap = v.hessian.trace();
       const double r = fv + lap;
@@ -78,6 +255,10 @@ std::vector<double> estimate_cells(const TSplineMap& map, const PoissonSolution&
     }
     eta[c] = h * std::sqrt(s);
     if (eta_scale) (*eta_scale)[c] = h * std::sqrt(scale);
+  }
+  if (distributed) {  // every process gets every cell's value (the others' are 0 here)
+    distributed->sum_over_processes(eta);
+    if (eta_scale) distributed->sum_over_processes(*eta_scale);
   }
   return eta;
 }
@@ -154,10 +335,10 @@ AdaptiveSolveResult solve_adaptive(const TSplineMap& map, const PoissonProblem& 
     st.assembly_seconds = sol.assembly_seconds;
     if (problem.exact) {
       st.has_errors = true;
-      st.errors = compute_errors(map, sol, problem);
+      st.errors = compute_errors(map, sol, problem, options.solver);
     }
     std::vector<double> scale;
-    const std::vector<double> eta = estimate_cells(map, sol, problem, &scale);
+    const std::vector<double> eta = estimate_cells(map, sol, problem, &scale, options.solver);
     double s = 0, s_scale = 0;
     for (std::size_t c = 0; c < eta.size(); ++c) {
       s += eta[c] * eta[c];

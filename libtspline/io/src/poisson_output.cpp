@@ -105,6 +105,7 @@ json PoissonOutputWriter::add_step(const PoissonStep& st, const PoissonSolution&
                 {"seconds", st.solver.seconds},
                 {"relative_residual", st.solver.relative_residual},
                 {"iterations", st.solver.iterations},
+                {"rtol", st.solver.tolerance},
                 {"processes", st.solver.processes}}},
               {"peak_memory_mib",
                {{"per_process", peak_mib},

@@ -1,13 +1,20 @@
 // PETSc CG + AMG for the IGA Poisson interior system (see petsc_solver.h).
 #include "tspline/petsc_solver.h"
 
+#include <_hypre_parcsr_mv.h>
 #include <petscksp.h>
+#include <petscmathypre.h>
 #include <sys/resource.h>
 
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <limits>
+#include <stdexcept>
+#if defined(__GLIBC__)
+#include <malloc.h>
+#endif
 #include <string>
 
 #include "tspline/errors.h"
@@ -58,6 +65,11 @@ SolverChoice parse_solver_choice(const std::string& name) {
   throw InputError("unknown solver '" + name + "' (expected auto, direct or iterative)");
 }
 
+double automatic_rtol(std::size_t n) {
+  const double nn = static_cast<double>(std::max<std::size_t>(n, 1));
+  return std::min(1e-10, std::max(kAutoRtolFloor, kAutoRtolScale / (nn * nn)));
+}
+
 int process_rank() {
   PetscMPIInt r = 0;
   MPI_Comm_rank(PETSC_COMM_WORLD, &r);
@@ -85,22 +97,31 @@ struct PetscPoissonSolver::Impl {
   Vec b = nullptr;
   std::vector<PetscInt> perm;  // interior DOF -> global row (process-by-process numbering)
   PetscInt row_begin = 0, row_end = 0, n = 0;
-  std::vector<std::size_t> local;   // add_cell scratch: the cell's interior functions
-  std::vector<PetscInt> g;          // add_cell scratch: their global rows
-  std::vector<PetscScalar> kv, fv;  // add_cell scratch: full element matrix (row-major) and load
+  // This process's rows, built in place as hypre's ParCSR matrix (see begin()):
+  // diag (columns in [row_begin, row_end), local numbers, the diagonal entry
+  // first, the others ascending) and offd (the other columns, ascending in
+  // col_map, hypre's sorted list of their global numbers).
+  hypre_ParCSRMatrix* parcsr = nullptr;
+  HYPRE_Int *di = nullptr, *dj = nullptr, *oi = nullptr, *oj = nullptr;
+  HYPRE_Complex *dv = nullptr, *ov = nullptr;
+  HYPRE_BigInt* col_map = nullptr;
+  std::vector<double> load;  // own rows of b
+  std::vector<std::pair<PetscInt, int>> cell_cols;  // add_cell scratch: (global column, row of Kloc), sorted
 
   void release() {
     if (A) MatDestroy(&A);
     if (b) VecDestroy(&b);
+    if (parcsr) hypre_ParCSRMatrixDestroy(parcsr);
     A = nullptr;
     b = nullptr;
+    parcsr = nullptr;
   }
   ~Impl() { release(); }
 };
 
 PetscPoissonSolver::PetscPoissonSolver(const IterativeOptions& options) : impl_(std::make_unique<Impl>()) {
-  if (!(options.rtol > 0.0) || !std::isfinite(options.rtol))
-    throw InputError("the iterative solver's relative tolerance must be > 0, got " + g3(options.rtol));
+  if (options.rtol && (!(*options.rtol > 0.0) || !std::isfinite(*options.rtol)))
+    throw InputError("the iterative solver's relative tolerance must be > 0, got " + g3(*options.rtol));
   if (options.max_iterations < 1)
     throw InputError("the iterative solver's iteration limit must be at least 1, got " +
                      std::to_string(options.max_iterations));
@@ -118,15 +139,22 @@ bool PetscPoissonSolver::accepts(std::size_t ni) const {
   return ni >= impl_->options.auto_threshold;
 }
 
-std::pair<int, int> PetscPoissonSolver::begin(const AnalysisSpace& space, const std::vector<int>& dof, int ni) {
+std::vector<int> PetscPoissonSolver::begin(const AnalysisSpace& space, const std::vector<int>& dof, int ni) {
   Impl& m = *impl_;
   m.release();
+#if defined(__GLIBC__)
+  // Building the analysis space (hash maps of the basis and T-mesh
+  // construction) leaves ~0.35 GB of freed small blocks in the heap at 1e6
+  // DOFs, which glibc keeps resident; the matrix arrays below are large
+  // (mmap'ed) and would not reuse them. Give them back first.
+  malloc_trim(0);
+#endif
   const HierarchicalBasis& basis = space.basis();
   const int nc = static_cast<int>(space.mesh().num_cells());
   const int P = process_count(), R = process_rank();
-  const int c0 = block_start(nc, R, P), c1 = block_start(nc, R + 1, P);
 
-  // Owner of interior DOF i: the process whose block holds the first cell of its support.
+  // Owner of interior DOF i: the process whose block of cells
+  // [r nc / P, (r+1) nc / P) holds the first cell of its support.
   std::vector<int> first_cell(static_cast<std::size_t>(ni), -1);
   for (int c = 0; c < nc; ++c)
     for (int a : basis.functions_on_cell(c))
@@ -134,16 +162,16 @@ std::pair<int, int> PetscPoissonSolver::begin(const AnalysisSpace& space, const 
   std::vector<int> owner(static_cast<std::size_t>(ni));
   std::vector<PetscInt> count(static_cast<std::size_t>(P) + 1, 0);
   {
-    int r = 0;  // block of cell c: the last r with block_start(r) <= c (blocks ascend with r)
     std::vector<int> starts(static_cast<std::size_t>(P) + 1);
     for (int q = 0; q <= P; ++q) starts[q] = block_start(nc, q, P);
-    for (int i = 0; i < ni; ++i) {
+    for (int i = 0; i < ni; ++i) {  // block of cell c: the last r with starts[r] <= c
       const int c = first_cell[i];
-      r = static_cast<int>(std::upper_bound(starts.begin(), starts.end() - 1, c) - starts.begin()) - 1;
+      const int r = static_cast<int>(std::upper_bound(starts.begin(), starts.end() - 1, c) - starts.begin()) - 1;
       owner[i] = std::max(r, 0);
       ++count[owner[i] + 1];
     }
   }
+  std::vector<int>().swap(first_cell);
   for (int q = 0; q < P; ++q) count[q + 1] += count[q];  // prefix: first row of each process
   m.row_begin = count[R];
   m.row_end = count[R + 1];
@@ -153,83 +181,154 @@ std::pair<int, int> PetscPoissonSolver::begin(const AnalysisSpace& space, const 
     std::vector<PetscInt> next(count.begin(), count.end() - 1);
     for (int i = 0; i < ni; ++i) m.perm[i] = next[owner[i]]++;
   }
+  std::vector<int>().swap(owner);
+  const auto own = [&m](PetscInt g) { return g >= m.row_begin && g < m.row_end; };
 
-  // Exact preallocation: for each own row, the distinct columns of the cells in
-  // its support, inside ([row_begin, row_end)) and outside the diagonal block.
+  // The cells of this process: every cell in the support of an own row. Row k
+  // of K is sum over those cells of their element rows, so the process adds
+  // them up itself and no entry is sent to another process; a cell on the
+  // border of two processes' rows is computed by both (about 1 % of the cells
+  // with 2 processes at 1e6 DOFs).
   const PetscInt nloc = m.row_end - m.row_begin;
   std::vector<std::int64_t> start(static_cast<std::size_t>(nloc) + 1, 0);  // own row -> cells (CSR)
-  for (int c = 0; c < nc; ++c)
+  std::vector<int> cells_mine;
+  for (int c = 0; c < nc; ++c) {
+    bool mine = false;
     for (int a : basis.functions_on_cell(c))
-      if (dof[a] >= 0) {
-        const PetscInt row = m.perm[dof[a]];
-        if (row >= m.row_begin && row < m.row_end) ++start[row - m.row_begin + 1];
+      if (dof[a] >= 0 && own(m.perm[dof[a]])) {
+        ++start[m.perm[dof[a]] - m.row_begin + 1];
+        mine = true;
       }
+    if (mine) cells_mine.push_back(c);
+  }
   for (PetscInt k = 0; k < nloc; ++k) start[k + 1] += start[k];
   std::vector<int> cells(static_cast<std::size_t>(start[nloc]));
   {
     std::vector<std::int64_t> fill(start.begin(), start.end() - 1);
-    for (int c = 0; c < nc; ++c)
+    for (int c : cells_mine)
       for (int a : basis.functions_on_cell(c))
-        if (dof[a] >= 0) {
-          const PetscInt row = m.perm[dof[a]];
-          if (row >= m.row_begin && row < m.row_end) cells[fill[row - m.row_begin]++] = c;
-        }
+        if (dof[a] >= 0 && own(m.perm[dof[a]])) cells[fill[m.perm[dof[a]] - m.row_begin]++] = c;
   }
-  std::vector<PetscInt> d_nnz(static_cast<std::size_t>(nloc), 0), o_nnz(static_cast<std::size_t>(nloc), 0);
-  std::vector<PetscInt> mark(static_cast<std::size_t>(ni), -1);
-  for (PetscInt k = 0; k < nloc; ++k)
+
+  // Row k's columns: the interior functions of the cells of its support, each
+  // once (mark), in global numbers, sorted. Pass 1 counts them (and collects
+  // the off-process ones); pass 2 writes them into hypre's arrays.
+  std::vector<PetscInt> mark(static_cast<std::size_t>(ni), -1), cols;
+  const auto row_columns = [&](PetscInt k) {
+    cols.clear();
     for (std::int64_t e = start[k]; e < start[k + 1]; ++e)
       for (int a : basis.functions_on_cell(cells[e])) {
         if (dof[a] < 0 || mark[dof[a]] == k) continue;
         mark[dof[a]] = k;
-        const PetscInt col = m.perm[dof[a]];
-        ++(col >= m.row_begin && col < m.row_end ? d_nnz[k] : o_nnz[k]);
+        cols.push_back(m.perm[dof[a]]);
       }
-
-  check(MatCreate(PETSC_COMM_WORLD, &m.A), "MatCreate");
-  check(MatSetSizes(m.A, nloc, nloc, ni, ni), "MatSetSizes");
-  if (m.options.preconditioner == Preconditioner::BoomerAMG) {
-    // Assembled directly as hypre's ParCSR matrix: PCHYPRE would otherwise copy
-    // an AIJ matrix into one, and both would live through the solve (at 1e6
-    // DOFs ~0.6 GB each: 49 entries per row).
-    check(MatSetType(m.A, MATHYPRE), "MatSetType(hypre)");
-    check(MatHYPRESetPreallocation(m.A, 0, d_nnz.data(), 0, o_nnz.data()), "MatHYPRESetPreallocation");
-  } else {
-    check(MatSetType(m.A, MATAIJ), "MatSetType");
-    check(MatSeqAIJSetPreallocation(m.A, 0, d_nnz.data()), "MatSeqAIJSetPreallocation");
-    check(MatMPIAIJSetPreallocation(m.A, 0, d_nnz.data(), 0, o_nnz.data()), "MatMPIAIJSetPreallocation");
-    check(MatSetOption(m.A, MAT_NEW_NONZERO_ALLOCATION_ERR, PETSC_TRUE), "MatSetOption");
+    std::sort(cols.begin(), cols.end());
+  };
+  std::vector<HYPRE_Int> d_nnz(static_cast<std::size_t>(nloc)), o_nnz(static_cast<std::size_t>(nloc));
+  std::vector<HYPRE_BigInt> offd_cols;
+  std::int64_t nnz_d = 0, nnz_o = 0;
+  for (PetscInt k = 0; k < nloc; ++k) {
+    row_columns(k);
+    HYPRE_Int nd = 0, no = 0;
+    for (PetscInt g : cols) {
+      if (own(g)) {
+        ++nd;
+      } else {
+        ++no;
+        offd_cols.push_back(static_cast<HYPRE_BigInt>(g));
+      }
+    }
+    d_nnz[k] = nd;
+    o_nnz[k] = no;
+    nnz_d += nd;
+    nnz_o += no;
   }
-  check(VecCreateMPI(PETSC_COMM_WORLD, nloc, ni, &m.b), "VecCreateMPI");
-  check(VecSet(m.b, 0.0), "VecSet");
-  return {c0, c1};
+  std::sort(offd_cols.begin(), offd_cols.end());
+  offd_cols.erase(std::unique(offd_cols.begin(), offd_cols.end()), offd_cols.end());
+  if (nnz_d > std::numeric_limits<HYPRE_Int>::max() || nnz_o > std::numeric_limits<HYPRE_Int>::max())
+    throw NumericalError("iterative solver: " + std::to_string(nnz_d + nnz_o) +
+                         " matrix entries on one process exceed hypre's 32-bit index (use more processes)");
+
+  // hypre_ParCSRMatrix of the own rows (hypre's conventions: diag column
+  // indices local, the diagonal entry first in each row, which its smoothers
+  // rely on; offd column indices into the ascending col_map_offd).
+  HYPRE_BigInt starts[2] = {static_cast<HYPRE_BigInt>(m.row_begin), static_cast<HYPRE_BigInt>(m.row_end)};
+  m.parcsr = hypre_ParCSRMatrixCreate(PETSC_COMM_WORLD, ni, ni, starts, starts,
+                                      static_cast<HYPRE_Int>(offd_cols.size()), static_cast<HYPRE_Int>(nnz_d),
+                                      static_cast<HYPRE_Int>(nnz_o));
+  if (!m.parcsr || hypre_ParCSRMatrixInitialize_v2(m.parcsr, HYPRE_MEMORY_HOST) != 0)
+    throw NumericalError("iterative solver: hypre_ParCSRMatrixCreate failed");
+  hypre_CSRMatrix* diag = hypre_ParCSRMatrixDiag(m.parcsr);
+  hypre_CSRMatrix* offd = hypre_ParCSRMatrixOffd(m.parcsr);
+  m.di = hypre_CSRMatrixI(diag);
+  m.dj = hypre_CSRMatrixJ(diag);
+  m.dv = hypre_CSRMatrixData(diag);
+  m.oi = hypre_CSRMatrixI(offd);
+  m.oj = hypre_CSRMatrixJ(offd);
+  m.ov = hypre_CSRMatrixData(offd);
+  m.col_map = hypre_ParCSRMatrixColMapOffd(m.parcsr);
+  std::copy(offd_cols.begin(), offd_cols.end(), m.col_map);
+  m.di[0] = 0;
+  m.oi[0] = 0;
+  for (PetscInt k = 0; k < nloc; ++k) {
+    m.di[k + 1] = m.di[k] + d_nnz[k];
+    m.oi[k + 1] = m.oi[k] + o_nnz[k];
+  }
+  std::vector<HYPRE_Int>().swap(d_nnz);
+  std::vector<HYPRE_Int>().swap(o_nnz);
+  std::fill(mark.begin(), mark.end(), -1);
+  for (PetscInt k = 0; k < nloc; ++k) {
+    row_columns(k);
+    HYPRE_Int pd = m.di[k], po = m.oi[k];
+    m.dj[pd++] = static_cast<HYPRE_Int>(k);  // the diagonal first
+    for (PetscInt g : cols) {
+      if (g == m.row_begin + k) continue;
+      if (own(g))
+        m.dj[pd++] = static_cast<HYPRE_Int>(g - m.row_begin);
+      else
+        m.oj[po++] = static_cast<HYPRE_Int>(
+            std::lower_bound(offd_cols.begin(), offd_cols.end(), static_cast<HYPRE_BigInt>(g)) - offd_cols.begin());
+    }
+  }
+  std::fill(m.dv, m.dv + nnz_d, 0.0);
+  std::fill(m.ov, m.ov + nnz_o, 0.0);
+  m.load.assign(static_cast<std::size_t>(nloc), 0.0);
+  return cells_mine;
 }
 
 void PetscPoissonSolver::add_cell(std::span<const int> rows, const Eigen::MatrixXd& Kloc,
                                   const Eigen::VectorXd& floc) {
   Impl& m = *impl_;
-  // The interior functions only (rows[k] < 0: Dirichlet), in global numbering.
-  m.local.clear();
-  m.g.clear();
+  // The interior functions only (rows[k] < 0: Dirichlet), by global column.
+  m.cell_cols.clear();
   for (std::size_t k = 0; k < rows.size(); ++k)
-    if (rows[k] >= 0) {
-      m.local.push_back(k);
-      m.g.push_back(m.perm[rows[k]]);
-    }
-  const std::size_t nf = m.local.size();
-  m.kv.resize(nf * nf);
-  m.fv.resize(nf);
-  for (std::size_t i = 0; i < nf; ++i) {  // symmetric: the lower triangle mirrored, row-major
-    const std::size_t r = m.local[i];
-    m.fv[i] = floc[static_cast<Eigen::Index>(r)];
-    for (std::size_t j = 0; j < nf; ++j) {
-      const std::size_t s = m.local[j];
-      m.kv[i * nf + j] = r >= s ? Kloc(r, s) : Kloc(s, r);
+    if (rows[k] >= 0) m.cell_cols.emplace_back(m.perm[rows[k]], static_cast<int>(k));
+  std::sort(m.cell_cols.begin(), m.cell_cols.end());
+  // Kloc holds the lower triangle: K(r, s) for r >= s.
+  const auto K = [&Kloc](int r, int s) { return r >= s ? Kloc(r, s) : Kloc(s, r); };
+  for (const auto& [gi, ki] : m.cell_cols) {
+    if (gi < m.row_begin || gi >= m.row_end) continue;  // another process's row
+    const PetscInt k = gi - m.row_begin;
+    m.load[k] += floc[ki];
+    // The row's columns and the cell's are both ascending (diag: after the
+    // diagonal entry), so one forward scan of each part finds every position.
+    HYPRE_Int pd = m.di[k] + 1, po = m.oi[k];
+    for (const auto& [gj, kj] : m.cell_cols) {
+      const double v = K(ki, kj);
+      if (gj == gi) {
+        m.dv[m.di[k]] += v;
+      } else if (gj >= m.row_begin && gj < m.row_end) {
+        const auto lj = static_cast<HYPRE_Int>(gj - m.row_begin);
+        while (pd < m.di[k + 1] && m.dj[pd] != lj) ++pd;
+        if (pd == m.di[k + 1]) throw std::logic_error("PETSc assembly: a column outside the preallocated pattern");
+        m.dv[pd] += v;
+      } else {
+        while (po < m.oi[k + 1] && m.col_map[m.oj[po]] != gj) ++po;
+        if (po == m.oi[k + 1]) throw std::logic_error("PETSc assembly: a column outside the preallocated pattern");
+        m.ov[po] += v;
+      }
     }
   }
-  const auto n = static_cast<PetscInt>(nf);
-  check(MatSetValues(m.A, n, m.g.data(), n, m.g.data(), m.kv.data(), ADD_VALUES), "MatSetValues");
-  check(VecSetValues(m.b, n, m.g.data(), m.fv.data(), ADD_VALUES), "VecSetValues");
 }
 
 bool PetscPoissonSolver::end_assembly(bool ok) {
@@ -240,10 +339,22 @@ bool PetscPoissonSolver::end_assembly(bool ok) {
     m.release();
     return false;
   }
-  check(MatAssemblyBegin(m.A, MAT_FINAL_ASSEMBLY), "MatAssemblyBegin");
-  check(MatAssemblyEnd(m.A, MAT_FINAL_ASSEMBLY), "MatAssemblyEnd");
-  check(VecAssemblyBegin(m.b), "VecAssemblyBegin");
-  check(VecAssemblyEnd(m.b), "VecAssemblyEnd");
+  hypre_ParCSRMatrixSetNumNonzeros(m.parcsr);
+  hypre_ParCSRMatrixSetDNumNonzeros(m.parcsr);
+  // PETSc takes the ParCSR matrix over (freed with the Mat). BoomerAMG uses it
+  // as it is (MATHYPRE); GAMG needs a PETSc AIJ matrix, converted in place.
+  hypre_ParCSRMatrix* parcsr = m.parcsr;
+  m.parcsr = nullptr;
+  check(MatCreateFromParCSR(parcsr, m.options.preconditioner == Preconditioner::BoomerAMG ? MATHYPRE : MATAIJ,
+                            PETSC_OWN_POINTER, &m.A),
+        "MatCreateFromParCSR");
+  const PetscInt nloc = m.row_end - m.row_begin;
+  check(VecCreateMPI(PETSC_COMM_WORLD, nloc, m.n, &m.b), "VecCreateMPI");
+  PetscScalar* bv = nullptr;
+  check(VecGetArray(m.b, &bv), "VecGetArray");
+  std::copy(m.load.begin(), m.load.end(), bv);
+  check(VecRestoreArray(m.b, &bv), "VecRestoreArray");
+  std::vector<double>().swap(m.load);
   check(MatSetOption(m.A, MAT_SPD, PETSC_TRUE), "MatSetOption(MAT_SPD)");
   return true;
 }
@@ -303,7 +414,9 @@ SolverStats PetscPoissonSolver::solve(Eigen::VectorXd& u) {
   }
   // Stop on the true (unpreconditioned) residual: ||b - K u|| <= rtol ||b||.
   check(KSPSetNormType(ksp, KSP_NORM_UNPRECONDITIONED), "KSPSetNormType");
-  check(KSPSetTolerances(ksp, o.rtol, 1e-300, PETSC_DEFAULT, o.max_iterations), "KSPSetTolerances");
+  const double rtol = o.rtol ? *o.rtol : automatic_rtol(static_cast<std::size_t>(m.n));
+  st.tolerance = rtol;
+  check(KSPSetTolerances(ksp, rtol, 1e-300, PETSC_DEFAULT, o.max_iterations), "KSPSetTolerances");
   check(KSPSetFromOptions(ksp), "KSPSetFromOptions");
   check(MatCreateVecs(m.A, &x, nullptr), "MatCreateVecs");
   check(KSPSolve(ksp, m.b, x), "KSPSolve");
@@ -325,7 +438,7 @@ SolverStats PetscPoissonSolver::solve(Eigen::VectorXd& u) {
     throw NumericalError("iterative solve (" + st.kind + ") did not converge: " + KSPConvergedReasons[reason] +
                          " after " + std::to_string(its) + " iterations (limit " +
                          std::to_string(o.max_iterations) + "), relative residual " +
-                         g3(st.relative_residual) + " (rtol " + g3(o.rtol) + ")");
+                         g3(st.relative_residual) + " (rtol " + g3(rtol) + ")");
 
   // Gather the solution on every process and undo the renumbering.
   check(VecScatterCreateToAll(x, &gather, &xall), "VecScatterCreateToAll");
@@ -338,6 +451,21 @@ SolverStats PetscPoissonSolver::solve(Eigen::VectorXd& u) {
   check(VecRestoreArrayRead(xall, &xa), "VecRestoreArrayRead");
   st.seconds = seconds_since(t0);
   return st;
+}
+
+std::pair<int, int> PetscPoissonSolver::cell_share(int nc) const {
+  const int P = process_count(), R = process_rank();
+  return {block_start(nc, R, P), block_start(nc, R + 1, P)};
+}
+
+void PetscPoissonSolver::sum_over_processes(std::span<double> v) const {
+  if (process_count() > 1 && !v.empty())
+    MPI_Allreduce(MPI_IN_PLACE, v.data(), static_cast<int>(v.size()), MPI_DOUBLE, MPI_SUM, PETSC_COMM_WORLD);
+}
+
+void PetscPoissonSolver::max_over_processes(std::span<double> v) const {
+  if (process_count() > 1 && !v.empty())
+    MPI_Allreduce(MPI_IN_PLACE, v.data(), static_cast<int>(v.size()), MPI_DOUBLE, MPI_MAX, PETSC_COMM_WORLD);
 }
 
 }  // namespace tspline::petsc

@@ -9,28 +9,37 @@
 // and finalizes PETSc (PetscInitialize / PetscFinalize; the tspline program does
 // it in apps/petsc_session.h). No I/O: errors are exceptions (tspline/errors.h).
 //
-// Distribution. Every process holds the whole analysis space (T-mesh and basis:
-// small next to the matrix). Process r of P assembles the contiguous block of
-// cells [r nc / P, (r+1) nc / P). The matrix rows are distributed by ranges of
-// a renumbering of the interior DOFs: a DOF belongs to the process that
-// assembles the first cell (lowest cell number) in its support, and the DOFs
-// are numbered process by process. As the cells of a quadtree are numbered
-// leaf by leaf, a cell block is a compact region, and only the element rows of
-// DOFs near its border go to another process (MatSetValues stashes them; they
-// are sent in MatAssemblyBegin/End). The preallocation is exact (every process
-// counts, for its own rows, the columns in and outside its diagonal block).
-// With BoomerAMG the matrix is assembled as hypre's own (MATHYPRE), so that
-// PCHYPRE uses it without a copy; with GAMG it is a PETSc AIJ matrix.
+// Distribution. Every process holds the whole analysis space (T-mesh and
+// basis). The cells are split into contiguous blocks [r nc / P, (r+1) nc / P).
+// The matrix rows are distributed by ranges of a renumbering of the interior
+// DOFs: a DOF belongs to the process whose block holds the first cell (lowest
+// cell number) of its support, and the DOFs are numbered process by process.
+// As the cells of a quadtree are numbered leaf by leaf, a block is a compact
+// region. Row i of K is the sum over the cells of its support of their element
+// rows, so each process computes every cell in the support of its own rows
+// (its block and a border layer that the neighbouring process computes too)
+// and keeps only its own rows: no entry is sent. The rows are built in place as
+// hypre's ParCSR matrix with the exact pattern (diag: the columns of the own
+// rows, local, diagonal entry first; offd: the others through an ascending
+// column map), each element row added by one forward scan of the matrix row.
+// PETSc takes the matrix over (MatCreateFromParCSR): BoomerAMG uses it without
+// a copy (MATHYPRE); for GAMG it is converted in place to AIJ. (Assembling
+// through MatSetValues into MATHYPRE went through hypre's auxiliary row
+// storage, a second copy of the matrix: 1.79 GB instead of 1.39 GB peak, and
+// 1.5x the assembly time, at 1e6 DOFs.)
 //
 // Solve: CG (the system is SPD) preconditioned by hypre's BoomerAMG (HMIS
 // coarsening, ext+i interpolation with P_max 4, one aggressive level) or PETSc's
 // GAMG, stopping when ||b - K u|| <= rtol ||b|| (the unpreconditioned residual,
 // so that rtol means the same for every preconditioner). PETSC_OPTIONS (e.g.
 // "-ksp_monitor -pc_hypre_boomeramg_strong_threshold 0.5") overrides the
-// choices (KSPSetFromOptions). The solution is gathered on every process.
+// choices (KSPSetFromOptions). The solution is gathered on every process;
+// the error norms and the estimator then split the cells over the processes
+// (cell_share) and add up (sum_over_processes).
 
 #include <cstddef>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -53,14 +62,32 @@ enum class Preconditioner {
 /// crossover of CHOLMOD and CG + BoomerAMG in time on the benchmark (bench/README.md).
 inline constexpr std::size_t kAutoIterativeFrom = 20000;
 
+/// The automatic relative tolerance for n interior unknowns:
+///   rtol(n) = min(1e-10, max(kAutoRtolFloor, kAutoRtolScale / n^2)).
+/// Why n^-2: CG stops at ||b - K u_k|| <= rtol ||b||. For the 2D stiffness matrix
+/// of a quasi-uniform space with n ~ h^-2 unknowns, lambda_min(K) ~ h^2 and
+/// ||b|| ~ h (n entries of size h^2 f), so the coefficient error is at most
+/// ||K^-1|| rtol ||b|| ~ rtol / h and its L2 norm (a factor h) ~ rtol ||u||: the
+/// algebraic L2 error does not shrink with h at fixed rtol, while the cubic
+/// discretization error does, like h^4 ~ n^-2 for smooth solutions. A
+/// tolerance proportional to n^-2 keeps their ratio fixed; the constant is
+/// calibrated on the disk (bench/README.md, "IGA Poisson at scale"): at
+/// 1.66e5 DOFs rtol 1e-10 / 1e-12 / 1e-13 leave the L2 error 1.2e-3 / 4.6e-8 /
+/// 4e-10 relative from the direct solve's; 0.02 / n^2 = 7.5e-13 there leaves
+/// 1.7e-8, with 27 % more CG iterations than 1e-10. The floor: CG's true
+/// residual stagnates near eps ||K|| ||u|| / ||b|| ~ eps n (both solvers'
+/// round-off), so a smaller rtol only adds iterations on the recursive residual. Non-smooth solutions (larger
+/// discretization errors) are then solved more accurately than they need.
+inline constexpr double kAutoRtolScale = 0.02;
+inline constexpr double kAutoRtolFloor = 1e-15;
+double automatic_rtol(std::size_t n);
+
 struct IterativeOptions {
   SolverChoice choice = SolverChoice::Auto;
   Preconditioner preconditioner = Preconditioner::BoomerAMG;
-  /// Relative residual ||b - K u|| / ||b|| to reach (> 0). 1e-10: the algebraic
-  /// error is then far below the discretization error of the cubic space up to
-  /// millions of DOFs; by Galerkin orthogonality the energy error grows only by
-  /// the square of their ratio.
-  double rtol = 1e-10;
+  /// Relative residual ||b - K u|| / ||b|| to reach (> 0); unset: automatic_rtol(n)
+  /// for the n unknowns of each system.
+  std::optional<double> rtol;
   int max_iterations = 1000;  ///< >= 1; more is a NumericalError
   std::size_t auto_threshold = kAutoIterativeFrom;
 };
@@ -81,11 +108,16 @@ class PetscPoissonSolver final : public InteriorSystemSolver {
   PetscPoissonSolver& operator=(const PetscPoissonSolver&) = delete;
 
   bool accepts(std::size_t ni) const override;
-  std::pair<int, int> begin(const AnalysisSpace& space, const std::vector<int>& dof, int ni) override;
+  std::vector<int> begin(const AnalysisSpace& space, const std::vector<int>& dof, int ni) override;
   void add_cell(std::span<const int> rows, const Eigen::MatrixXd& Kloc, const Eigen::VectorXd& floc) override;
   bool end_assembly(bool ok) override;
   /// \throw NumericalError if CG does not reach rtol within max_iterations (or diverges).
   SolverStats solve(Eigen::VectorXd& u) override;
+  /// Process r of P: the cells [r nc / P, (r+1) nc / P) (its assembly block).
+  std::pair<int, int> cell_share(int nc) const override;
+  /// MPI_Allreduce over PETSC_COMM_WORLD.
+  void sum_over_processes(std::span<double> v) const override;
+  void max_over_processes(std::span<double> v) const override;
 
  private:
   struct Impl;

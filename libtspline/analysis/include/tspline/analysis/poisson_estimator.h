@@ -16,8 +16,10 @@ namespace tspline {
 /// eta_e per analysis cell (not squared). If eta_scale is given it receives per
 /// cell h_e (||f||^2 + ||Laplace u_h||^2)^{1/2} over the cell's image: the size of
 /// the two terms whose sum is the residual, to recognize a residual at round-off.
+/// With `distributed`, as compute_errors: each process its share, every process gets all cells.
 std::vector<double> estimate_cells(const TSplineMap& map, const PoissonSolution& sol, const PoissonProblem& problem,
-                                   std::vector<double>* eta_scale = nullptr);
+                                   std::vector<double>* eta_scale = nullptr,
+                                   const InteriorSystemSolver* distributed = nullptr);
 
 /// An estimator below this fraction of its scale (see estimate_cells) is round-off:
 /// the adaptive loop then refines nothing. (Discrete solutions measure ~1e-15.)

@@ -47,6 +47,11 @@
 // differences with the absolute step kGradientStep (error ~ step^2 |u'''|/6 plus
 // round-off ~ eps |u| / step).
 //
+// Errors and estimator (poisson_estimator.h) evaluate u_h and S per cell from
+// the univariate B-spline factors tabulated at the distinct quadrature
+// coordinates (the values of evaluate_solution()); with a distributed solver
+// each process integrates its cell_share() and the sums are combined
+// (InteriorSystemSolver).
 
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
@@ -100,6 +105,7 @@ struct SolverStats {
   double relative_residual = 0.0;  ///< ||K u - b|| / ||b|| of the interior system (0 if b = 0)
   int iterations = 0;              ///< CG iterations (0 for the direct solver)
   int processes = 1;               ///< processes that shared the solve
+  double tolerance = 0.0;          ///< an iterative solver's relative tolerance (0 for the direct solver)
 };
 
 /// An external solver of the interior system K u = b (K symmetric positive
@@ -112,9 +118,10 @@ class InteriorSystemSolver {
   /// Whether it solves a system of ni unknowns; if not, the built-in direct solver does.
   virtual bool accepts(std::size_t ni) const = 0;
   /// Starts the system: dof[a] = interior number of basis function a (-1 for a
-  /// Dirichlet function), ni unknowns. Returns the cells [first, last) this
-  /// process assembles.
-  virtual std::pair<int, int> begin(const AnalysisSpace& space, const std::vector<int>& dof, int ni) = 0;
+  /// Dirichlet function), ni unknowns. Returns the cells this process
+  /// assembles, ascending (a distributed solver may ask two processes for the
+  /// same cell, each keeping the rows it owns).
+  virtual std::vector<int> begin(const AnalysisSpace& space, const std::vector<int>& dof, int ni) = 0;
   /// One cell's contribution: rows[k] = interior number of the cell's k-th
   /// function (-1: Dirichlet, to be ignored); Kloc its element stiffness matrix
   /// (LOWER triangle filled, K(r, s) for r >= s); floc its load with the
@@ -126,6 +133,13 @@ class InteriorSystemSolver {
   /// Solves; u receives all ni interior values (on every process). \throw
   /// NumericalError if the solve does not converge.
   virtual SolverStats solve(Eigen::VectorXd& u) = 0;
+  /// The share [first, last) of nc cells whose error and estimator terms this
+  /// process computes (compute_errors, estimate_cells); default: all of them.
+  virtual std::pair<int, int> cell_share(int nc) const { return {0, nc}; }
+  /// Sums (or takes the maximum of) v element-wise over the processes, in place,
+  /// the result on every process (collective); default: one process, v stays.
+  virtual void sum_over_processes(std::span<double> v) const { (void)v; }
+  virtual void max_over_processes(std::span<double> v) const { (void)v; }
 };
 
 struct PoissonSolution {
@@ -178,7 +192,10 @@ struct PoissonErrors {
   double max_abs_at_qp = 0.0;  ///< max |u - u_h| over the quadrature points
 };
 
-/// \throw InputError if problem.exact is missing.
-PoissonErrors compute_errors(const TSplineMap& map, const PoissonSolution& sol, const PoissonProblem& problem);
+/// \throw InputError if problem.exact is missing. With `distributed` (collective
+/// then), each process integrates its cell_share() and the sums are combined
+/// over the processes (the same result up to the order of the additions).
+PoissonErrors compute_errors(const TSplineMap& map, const PoissonSolution& sol, const PoissonProblem& problem,
+                             const InteriorSystemSolver* distributed = nullptr);
 
 }  // namespace tspline
