@@ -4,6 +4,7 @@
 #include <cmath>
 #include <unordered_set>
 
+#include "meshopt/chordal_estimate.h"
 #include "meshopt/flip_energy.h"
 #include "remesher.h"
 
@@ -27,6 +28,13 @@ double triangle_min_angle6d(const RemeshMesh& m, int t, double s) {
   const RemeshVertex& v2 = m.vertices[tr.v[2]];
   return min_angle6d(embed6d(v0.x, v0.normal(tr.patch), s), embed6d(v1.x, v1.normal(tr.patch), s),
                      embed6d(v2.x, v2.normal(tr.patch), s));
+}
+
+double triangle_deviation(const RemeshMesh& m, int t) {
+  const RemeshTriangle& tr = m.triangles[t];
+  const auto& v = m.vertices;
+  return triangle_deviation_estimate({v[tr.v[0]].x, v[tr.v[1]].x, v[tr.v[2]].x},
+                                     {v[tr.v[0]].normal(tr.patch), v[tr.v[1]].normal(tr.patch), v[tr.v[2]].normal(tr.patch)});
 }
 
 namespace detail {
@@ -61,6 +69,33 @@ double Remesher::min_angle(const std::array<int, 3>& t, int patch) const {
   const auto n = normals(t, patch);
   return min_angle6d(embed6d(m_.vertices[t[0]].x, n[0], s), embed6d(m_.vertices[t[1]].x, n[1], s),
                      embed6d(m_.vertices[t[2]].x, n[2], s));
+}
+
+double Remesher::deviation(const std::array<int, 3>& t, int patch) const {
+  return triangle_deviation_estimate(positions(t), normals(t, patch));
+}
+
+bool Remesher::breaks_cap(const std::array<int, 3>& t, int patch, double before) const {
+  if (!(o_.max_deviation > 0.0)) return false;
+  const double d = deviation(t, patch);
+  return d > o_.max_deviation && d > before;
+}
+
+Edge Remesher::most_curved_edge(int t) const {
+  const RemeshTriangle& tr = m_.triangles[t];
+  const auto x = positions(tr.v);
+  const auto n = normals(tr.v, tr.patch);
+  Edge best{tr.v[0], tr.v[1]};
+  double best_term = -1.0;
+  for (int i = 0; i < 3; ++i) {
+    const int j = (i + 1) % 3;
+    const double term = std::abs(chord_curvature_term(x[i], n[i], x[j], n[j]));
+    if (term > best_term) {
+      best_term = term;
+      best = {tr.v[i], tr.v[j]};
+    }
+  }
+  return best;
 }
 
 double Remesher::pair_energy(const std::array<int, 3>& t1, const std::array<int, 3>& t2, int patch) const {
@@ -121,7 +156,7 @@ int Remesher::split(int a, int b) {
   const int curve = m_.feature_curve(a, b);
   if (curve >= 0) {
     nv.kind = VertexKind::curve;
-    nv.on = g_.project_to_curve(curve, mid);
+    nv.on = g_.curve_midpoint(curve, m_.vertices[a].kind, m_.vertices[a].on, m_.vertices[b].kind, m_.vertices[b].on);
   } else {
     nv.kind = VertexKind::surface;
     nv.on = g_.project_to_patch(m_.triangles[ts[0]].patch, mid, hint(ts, {a, b}));
@@ -194,6 +229,7 @@ bool Remesher::collapse_onto(int a, int b, double max_length) {
     // No fold: the triangle keeps its side.
     const auto xo = positions(tr.v), xn = positions(nv);
     if (triangle_normal(xo[0], xo[1], xo[2]).dot(triangle_normal(xn[0], xn[1], xn[2])) <= 0.0) return false;
+    if (breaks_cap(nv, tr.patch, deviation(tr.v, tr.patch))) return false;
     for (int w : nv)
       if (w != b && length6d(vb.x, vb.normal(tr.patch), m_.vertices[w].x, m_.vertices[w].normal(tr.patch),
                              o_.anisotropy) > max_length)
@@ -250,6 +286,10 @@ bool Remesher::flip(int a, int b) {
   } else {
     better = !inverted(n1, p) && !inverted(n2, p) &&  // criterion (b)
              std::min(min_angle(n1, p), min_angle(n2, p)) > std::min(min_angle(t1, p), min_angle(t2, p)) + 1e-12;
+    if (better && o_.max_deviation > 0.0) {
+      const double before = std::max(deviation(t1, p), deviation(t2, p));
+      better = !breaks_cap(n1, p, before) && !breaks_cap(n2, p, before);
+    }
   }
   if (!better) return false;
   m_.set_triangle(ts[0], n1);
@@ -318,9 +358,11 @@ bool Remesher::move_vertex(int v, const Eigen::Vector3d& target) {
   const std::vector<int> star = m_.triangles_of(v);
   double old_min = 10.0;
   std::vector<char> was_inverted;
+  std::vector<double> old_deviation;
   for (int t : star) {
     was_inverted.push_back(inverted(m_.triangles[t].v, m_.triangles[t].patch));
     old_min = std::min(old_min, min_angle(t));
+    if (o_.max_deviation > 0.0) old_deviation.push_back(deviation(t));
   }
   const std::vector<int> around = m_.neighbours(v);
   std::vector<double> old_length;
@@ -348,6 +390,7 @@ bool Remesher::move_vertex(int v, const Eigen::Vector3d& target) {
   for (std::size_t k = 0; k < star.size() && ok; ++k) {
     const RemeshTriangle& tr = m_.triangles[star[k]];
     if (!was_inverted[k] && inverted(tr.v, tr.patch)) ok = false;
+    if (o_.max_deviation > 0.0 && breaks_cap(tr.v, tr.patch, old_deviation[k])) ok = false;
     new_min = std::min(new_min, min_angle(star[k]));
   }
   if (ok && new_min >= std::min(old_min, o_.min_angle)) return true;

@@ -21,6 +21,12 @@ class Remesher {
   double min_angle(int t) const { return triangle_min_angle6d(m_, t, o_.anisotropy); }
   /// Longest (or shortest) 6D edge of live triangle t.
   Edge extreme_edge(int t, bool longest) const;
+  /// Estimated chordal deviation of live triangle t (chordal_estimate.h).
+  double deviation(int t) const { return deviation(m_.triangles[t].v, m_.triangles[t].patch); }
+  /// True if options.max_deviation is set and live triangle t exceeds it.
+  bool too_deviant(int t) const { return o_.max_deviation > 0.0 && deviation(t) > o_.max_deviation; }
+  /// The edge of live triangle t with the largest |II(e, e)| (the most curved chord).
+  Edge most_curved_edge(int t) const;
 
   /// Splits edge (a, b) at its midpoint projected onto the model (onto the
   /// feature curve for a feature edge). Returns the new vertex or -1.
@@ -49,6 +55,10 @@ class Remesher {
   std::array<Eigen::Vector3d, 3> normals(const std::array<int, 3>& t, int patch) const;
   bool inverted(const std::array<int, 3>& t, int patch) const;
   double min_angle(const std::array<int, 3>& t, int patch) const;
+  double deviation(const std::array<int, 3>& t, int patch) const;
+  /// True if a triangle `t` that replaces one of estimated deviation `before`
+  /// breaks the cap: above options.max_deviation (when set) and above `before`.
+  bool breaks_cap(const std::array<int, 3>& t, int patch, double before) const;
   /// Eq. 5 for the two triangles t1, t2 (given as corner triples in one patch).
   double pair_energy(const std::array<int, 3>& t1, const std::array<int, 3>& t2, int patch) const;
   /// The projection hint of triangles `tris`, with the faces of `first` first.

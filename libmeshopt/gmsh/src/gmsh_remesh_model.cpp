@@ -281,6 +281,55 @@ GeometryPoint GmshRemeshGeometry::project_to_curve(int curve, const Eigen::Vecto
   return {y, curve, t};
 }
 
+GeometryPoint GmshRemeshGeometry::curve_midpoint(int curve, VertexKind ka, const GeometryPoint& a, VertexKind kb,
+                                               const GeometryPoint& b) const {
+  // Curve parameters of the end points (a corner's by projection).
+  auto param = [&](VertexKind k, const GeometryPoint& p) {
+    return k == VertexKind::curve && p.entity == curve ? p.param.x() : closest_point(1, curve, p.x).second.x();
+  };
+  const double ta = param(ka, a), tb = param(kb, b);
+  std::vector<double> lo, hi;
+  gmsh::model::getParametrizationBounds(1, curve, lo, hi);
+  if (!std::isfinite(ta) || !std::isfinite(tb) || lo.empty() || hi.empty()) return project_to_curve(curve, 0.5 * (a.x + b.x));
+  const double period = hi[0] - lo[0];
+  // Sample the arc t(l) = ta + l (tb - ta) and, on a closed curve, the arc
+  // through its seam; keep the shorter; the arc-length midpoint by linear
+  // interpolation of the cumulative chord length over kSamples pieces.
+  constexpr int kSamples = 16;
+  std::vector<double> ends;
+  gmsh::model::getValue(1, curve, {lo[0], hi[0]}, ends);
+  const bool closed = (vec3(ends, 0) - vec3(ends, 1)).norm() <= 1e-9 * f_.diagonal;
+  std::vector<double> deltas{tb - ta};
+  if (closed && tb != ta) deltas.push_back(tb - ta - std::copysign(period, tb - ta));
+  auto wrap = [&](double t) { return closed ? lo[0] + std::fmod(std::fmod(t - lo[0], period) + period, period) : t; };
+  GeometryPoint best;
+  double best_length = kInf;
+  for (double delta : deltas) {
+    std::vector<double> ts, xs;
+    for (int k = 0; k <= kSamples; ++k) ts.push_back(wrap(ta + delta * k / kSamples));
+    try {
+      gmsh::model::getValue(1, curve, ts, xs);
+    } catch (...) {
+      continue;
+    }
+    std::vector<double> cumulative{0.0};
+    for (int k = 1; k <= kSamples; ++k) cumulative.push_back(cumulative.back() + (vec3(xs, k) - vec3(xs, k - 1)).norm());
+    if (!(cumulative.back() < best_length)) continue;
+    best_length = cumulative.back();
+    const double half = 0.5 * cumulative.back();
+    int k = 1;
+    while (k < kSamples && cumulative[k] < half) ++k;
+    const double piece = cumulative[k] - cumulative[k - 1];
+    const double w = piece > 0.0 ? (half - cumulative[k - 1]) / piece : 0.0;
+    const double t = wrap(ta + delta * (k - 1 + w) / kSamples);
+    std::vector<double> x;
+    gmsh::model::getValue(1, curve, {t}, x);
+    best = {vec3(x), curve, Eigen::Vector2d(t, 0.0)};
+  }
+  if (!(best_length < kInf)) return project_to_curve(curve, 0.5 * (a.x + b.x));
+  return best;
+}
+
 Eigen::Vector3d GmshRemeshGeometry::patch_normal(int patch, VertexKind kind, const GeometryPoint& p) const {
   if (kind == VertexKind::surface) return face_normal(p.entity, p.param);
   const std::vector<int>& around = kind == VertexKind::curve ? f_.curve_faces.at(p.entity) : f_.point_faces.at(p.entity);
