@@ -40,7 +40,13 @@ class Remesher {
   /// Edge flips from the stack S until none applies (Sect. 3.1, with the
   /// paper's second stack S1; at most options.max_flip_passes passes).
   void improve_by_flips(std::vector<Edge> stack);
-  void improve_all_by_flips() { improve_by_flips(m_.edges()); }
+  /// improve_by_flips on every edge that may decide differently since the last
+  /// call: the edges of the triangles around vertices that a split, collapse,
+  /// flip or smoothing move touched (all edges the first time). An edge's flip
+  /// depends only on its two triangles' corners (positions, normals) and on
+  /// whether the other diagonal is an edge, which only a change at one of
+  /// those corners alters.
+  void improve_all_by_flips();
   /// Vertex smoothing (Eq. 6 with 6D distances, f(d) = -d, alpha = 1/#omega),
   /// then projection; `fraction` of the movable vertices that would move most.
   void smooth(double fraction);
@@ -49,7 +55,8 @@ class Remesher {
   bool can_remove(int a, int b) const;
   bool collapse_onto(int a, int b, double max_length);
   /// Eq. 6 step of vertex v in R^3 (tangential for surface vertices), zero if fixed.
-  Eigen::Vector3d smoothing_step(int v) const;
+  /// `mean_length`, if given, receives the mean 3D length of v's edges.
+  Eigen::Vector3d smoothing_step(int v, double* mean_length = nullptr) const;
   bool move_vertex(int v, const Eigen::Vector3d& target);
   std::array<Eigen::Vector3d, 3> positions(const std::array<int, 3>& t) const;
   std::array<Eigen::Vector3d, 3> normals(const std::array<int, 3>& t, int patch) const;
@@ -68,6 +75,11 @@ class Remesher {
   const RemeshGeometry& g_;
   const RemeshOptions& o_;
   RemeshReport& r_;
+  void touch(int v);
+  std::vector<int> touched_;      ///< vertices touched since the last improve_all_by_flips
+  std::vector<char> is_touched_;  ///< per vertex
+  bool all_touched_ = true;
+  mutable std::vector<int> neighbour_scratch_;  ///< smoothing_step's, reused (no allocation per call)
 };
 
 }  // namespace meshopt::detail

@@ -11,6 +11,7 @@
 #include <limits>
 #include <numbers>
 #include <numeric>
+#include <optional>
 #include <set>
 #include <unordered_map>
 
@@ -42,6 +43,27 @@ std::pair<Eigen::Vector3d, Eigen::Vector2d> closest_point(int dim, int tag, cons
     const double nan = std::numeric_limits<double>::quiet_NaN();
     return {Eigen::Vector3d::Constant(nan), Eigen::Vector2d::Constant(nan)};
   }
+}
+
+/// The foot point on `face` of x by Gauss-Newton from uv (the parameters of a
+/// nearby mesh vertex): uv += (J^T J)^-1 J^T (x - phi(uv)), J = (phi_u, phi_v),
+/// until the tangential step is below tol. A local closest point, at a few
+/// evaluations of phi and its first derivatives instead of OCC's global
+/// extremum search and inverse mapping. Empty if it leaves the parameter box
+/// (a periodic face's seam, a face's end) or does not converge in 8 steps.
+std::optional<Eigen::Vector2d> local_foot(const GmshFace& face, Eigen::Vector2d uv, const Eigen::Vector3d& x,
+                                          double tol) {
+  for (int it = 0; it < 8; ++it) {
+    const SurfacePoint p = face.evaluate(uv, 1);
+    const Eigen::Matrix2d jtj = p.d.transpose() * p.d;
+    if (!(std::abs(jtj.determinant()) > 1e-14 * jtj.squaredNorm())) return std::nullopt;  // degenerate point
+    const Eigen::Vector2d step = jtj.inverse() * (p.d.transpose() * (x - p.x));
+    uv += step;
+    if (!uv.allFinite() || (uv.array() < face.lower().array()).any() || (uv.array() > face.upper().array()).any())
+      return std::nullopt;
+    if ((p.d * step).norm() <= tol) return uv;
+  }
+  return std::nullopt;
 }
 
 /// (u, v) on `face` of point x = the point `tag` (dim 0) or curve `tag` at t
@@ -238,6 +260,22 @@ GeometryPoint GmshRemeshGeometry::project_to_patch(int patch, const Eigen::Vecto
         for (int g : f_.curve_faces.at(c)) add(g);
   }
   if (cand.empty()) cand = f_.patch_faces.at(patch);
+  // The usual case, a short move on one face: the local foot point from the
+  // nearest hint corner on that face, accepted where the hint's triangles prove
+  // it inside the trimmed face (then no other face of the smooth patch is nearer
+  // for a move within the star).
+  for (int fc : hint.faces) {
+    if (std::find(cand.begin(), cand.end(), fc) == cand.end()) continue;
+    const GeometryPoint* start = nullptr;
+    for (const auto& t : hint.triangles)
+      for (const GeometryPoint& c : t)
+        if (c.entity == fc && (!start || (c.x - x).squaredNorm() < (start->x - x).squaredNorm())) start = &c;
+    if (!start) continue;
+    const GmshFace& gf = face(fc);
+    const auto uv = local_foot(gf, start->param, x, 1e-10 * f_.diagonal);
+    if (uv && hint.proves_inside(fc, *uv, 0.5 * (gf.upper() - gf.lower()), f_.smooth_boundary.at(fc)))
+      return {gf.value(*uv), fc, *uv};
+  }
   // Closest points on the untrimmed faces, nearest first; the first inside its
   // trimmed face wins (the hint's mesh triangles spare most exact tests).
   std::vector<std::pair<double, GeometryPoint>> found;
