@@ -7,6 +7,7 @@
 #include <gmsh.h>
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <cmath>
 #include <functional>
 #include <numbers>
@@ -212,5 +213,36 @@ TEST_CASE("remesh: a torus's long axes follow the direction of least curvature")
                                                                                                 << n << " triangles");
                  CHECK(n > q.size() / 4);
                  CHECK(mean < 20.0);  // random orientations would give 45 degrees
+               });
+}
+
+TEST_CASE("remesh: max_deviation caps the chordal deviation measured at the centroids") {
+  // Torus R = 2, r = 0.6 with L = 0.4, s = 2: unit 6D edges alone deviate up to
+  // L^2 / (16 s) = 0.005 (at kappa = 1 / s), more within the 0.5-1.5 L band.
+  gmsh_io::Session session;
+  auto max_deviation = [](const RemeshMesh& m, const gmsh_io::GmshRemeshGeometry& g) {
+    const auto c = gmsh_io::project_centroids(m, g);
+    return *std::max_element(c.distance.begin(), c.distance.end());
+  };
+  RemeshOptions opt;
+  opt.length = 0.4;
+  opt.anisotropy = 2.0;
+  opt.rounds = 2;
+  double free_deviation = 0.0;
+  std::size_t free_triangles = 0;
+  remesh_model([] { gmsh::model::occ::addTorus(0, 0, 0, 2.0, 0.6); }, 0.4, opt,
+               [&](const RemeshMesh& m, const gmsh_io::GmshRemeshGeometry& g) {
+                 free_deviation = max_deviation(m, g);
+                 free_triangles = m.live_triangles();
+               });
+  opt.max_deviation = 0.003;
+  remesh_model([] { gmsh::model::occ::addTorus(0, 0, 0, 2.0, 0.6); }, 0.4, opt,
+               [&](const RemeshMesh& m, const gmsh_io::GmshRemeshGeometry& g) {
+                 const double d = max_deviation(m, g);
+                 MESSAGE("torus: max deviation " << free_deviation << " (" << free_triangles << " triangles) without "
+                                                 << "the cap, " << d << " (" << m.live_triangles() << ") with D = 0.003");
+                 CHECK(free_deviation > 0.004);
+                 CHECK(d <= 1.05 * opt.max_deviation);
+                 CHECK(m.live_triangles() > free_triangles);
                });
 }
