@@ -13,8 +13,9 @@
 // and, for the remesher's 8 worst triangles, their deviation (measured and
 // estimated from the corner normals), 6D edge lengths / L and principal curvatures,
 // and the histogram of 6D edge length / L.
-// Usage: bench_remesh_vs_gmsh [L [S [D]]]   (defaults 0.2, 1, 0: D is
-// RemeshOptions::max_deviation, the remesher's estimated-deviation cap)
+// Usage: bench_remesh_vs_gmsh [L [S [D [cylinder_sphere]]]]   (defaults 0.2, 1,
+// 0: D is RemeshOptions::max_deviation, the remesher's estimated-deviation cap;
+// cylinder_sphere: the fused cylinder r 0.5 and sphere r 0.8 of cad_fixtures)
 #include <gmsh.h>
 
 #include <algorithm>
@@ -23,6 +24,7 @@
 #include <cstdlib>
 #include <functional>
 #include <numbers>
+#include <string>
 #include <vector>
 
 #include "cad_fixtures.h"
@@ -39,9 +41,14 @@ struct Sample {
   double deviation = 0.0;
 };
 
+bool cylinder_sphere = false;  ///< the fused cylinder and sphere of cad_fixtures instead
+
 void make_model() {
   gmsh::clear();
-  cad_fixtures::add_torus_pipe();
+  if (cylinder_sphere)
+    cad_fixtures::add_cylinder_sphere();
+  else
+    cad_fixtures::add_torus_pipe();
 }
 
 /// Where the remesher's deviation comes from: its worst triangles, and the 6D lengths.
@@ -111,6 +118,7 @@ int main(int argc, char** argv) {
   const double length = argc > 1 ? std::atof(argv[1]) : 0.2;
   const double s = argc > 2 ? std::atof(argv[2]) : 1.0;
   const double cap = argc > 3 ? std::atof(argv[3]) : 0.0;
+  cylinder_sphere = argc > 4 && std::string(argv[4]) == "cylinder_sphere";
   std::setvbuf(stdout, nullptr, _IOLBF, 0);
   meshopt::gmsh_io::Session session;
   make_model();

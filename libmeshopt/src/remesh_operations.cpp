@@ -346,8 +346,8 @@ void Remesher::improve_by_flips(std::vector<Edge> stack) {
     while (!stack.empty()) {
       const auto [a, b] = stack.back();
       stack.pop_back();
-      if (!m_.has_edge(a, b)) continue;
-      std::vector<int> ts = m_.edge_triangles(a, b);
+      const std::vector<int> ts = m_.edge_triangles(a, b);
+      if (ts.empty()) continue;  // gone
       std::array<int, 2> opp{-1, -1};
       for (std::size_t k = 0; k < ts.size() && k < 2; ++k)
         for (int w : m_.triangles[ts[k]].v)
