@@ -179,7 +179,9 @@ int main(int argc, char** argv) {
       app.add_subcommand("remesh", "curvature-adapted anisotropic remeshing in the R^6 embedding (Dassi et al. 2014)");
   remesh->add_option("MODEL", r.model, "CAD model: STEP, IGES, BRep or Gmsh .geo")->required();
   remesh->add_option("--out", r.out, "output mesh (.msh, MSH 4.1, nodes on their CAD entities)")->required();
-  remesh->add_option("--length", r.length, "target edge length L in R^6")->required();
+  remesh->add_option("--length", r.length, "target edge length L in R^6 (default 160 D with --max-deviation D)");
+  remesh->add_option("--max-deviation", r.max_deviation,
+                     "D: split triangles whose estimated chordal deviation exceeds D (absolute, model units)");
   remesh->add_option("--anisotropy", r.anisotropy, "s in (x, s n) (default 5 L; 0: isotropic)");
   remesh->add_option("--mesh", r.mesh, "initial mesh of MODEL with parametric coordinates (default: Gmsh meshes it)");
   remesh->add_option("--feature-angle", r.feature_angle,

@@ -30,8 +30,12 @@ std::array<double, 3> triangle_angles6d(const Point6d& p0, const Point6d& p1, co
 }
 
 double min_angle6d(const Point6d& p0, const Point6d& p1, const Point6d& p2) {
-  const auto a = triangle_angles6d(p0, p1, p2);
-  return std::min({a[0], a[1], a[2]});
+  // acos is decreasing: the smallest angle has the largest cosine (one acos, not three).
+  const Point6d e01 = p1 - p0, e12 = p2 - p1, e20 = p0 - p2;
+  const double l01 = e01.norm(), l12 = e12.norm(), l20 = e20.norm();
+  if (!(l01 > 0.0) || !(l12 > 0.0) || !(l20 > 0.0)) return 0.0;
+  const double c0 = -e01.dot(e20) / (l01 * l20), c1 = -e12.dot(e01) / (l12 * l01), c2 = -e20.dot(e12) / (l20 * l12);
+  return std::acos(std::clamp(std::max({c0, c1, c2}), -1.0, 1.0));
 }
 
 }  // namespace meshopt

@@ -27,6 +27,7 @@ void validate(const RemeshOptions& o) {
   if (o.rounds < 0 || o.outer < 0 || o.inner < 0) bad("K, I and J must be >= 0");
   if (!(o.smooth_fraction >= 0.0) || !(o.smooth_fraction <= 1.0)) bad("the smoothed fraction must be in [0, 1]");
   if (!(o.inversion_angle > 0.0) || !(o.inversion_angle <= std::numbers::pi)) bad("alpha must be in (0, pi]");
+  if (!(o.max_deviation >= 0.0) || !std::isfinite(o.max_deviation)) bad("the maximum deviation must be finite and >= 0");
   if (o.max_flip_passes < 1) bad("max_flip_passes must be >= 1");
 }
 
@@ -49,8 +50,15 @@ void sampling(Remesher& r, const RemeshOptions& o) {
     const int f = q.front();
     q.pop_front();
     if (!m.triangles[f].alive) continue;
-    const auto [a, b] = r.extreme_edge(f, true);
-    if (!(r.length(a, b) > 1.5 * o.length)) continue;
+    auto [a, b] = r.extreme_edge(f, true);
+    if (!(r.length(a, b) > 1.5 * o.length)) {
+      // The accuracy cap: split the most curved chord (each half has about a
+      // quarter of its II(e, e), chordal_estimate.h).
+      if (!r.too_deviant(f)) continue;
+      const detail::Edge e = r.most_curved_edge(f);
+      a = e[0];
+      b = e[1];
+    }
     const int c = r.split(a, b);
     if (c < 0) continue;
     ++splits;

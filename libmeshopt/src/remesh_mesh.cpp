@@ -6,12 +6,6 @@
 
 namespace meshopt {
 
-Eigen::Vector3d RemeshVertex::normal(int patch) const {
-  for (const auto& [p, n] : normals)
-    if (p == patch) return n;
-  return Eigen::Vector3d::Zero();
-}
-
 std::uint64_t RemeshMesh::key(int a, int b) {
   if (a > b) std::swap(a, b);
   return (static_cast<std::uint64_t>(static_cast<std::uint32_t>(a)) << 32) | static_cast<std::uint32_t>(b);
@@ -75,10 +69,15 @@ int RemeshMesh::feature_curve(int a, int b) const {
 
 std::vector<int> RemeshMesh::neighbours(int v) const {
   std::vector<int> out;
+  neighbours(v, out);
+  return out;
+}
+
+void RemeshMesh::neighbours(int v, std::vector<int>& out) const {
+  out.clear();
   for (int t : incident_[v])
     for (int w : triangles[t].v)
       if (w != v && std::find(out.begin(), out.end(), w) == out.end()) out.push_back(w);
-  return out;
 }
 
 std::vector<std::array<int, 2>> RemeshMesh::edges() const {

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <unordered_set>
 
+#include "meshopt/chordal_estimate.h"
 #include "meshopt/flip_energy.h"
 #include "remesher.h"
 
@@ -13,10 +14,12 @@ double edge_length6d(const RemeshMesh& m, int a, int b, double s) {
   const RemeshVertex& va = m.vertices[a];
   const RemeshVertex& vb = m.vertices[b];
   double len = -1.0;
-  for (int t : m.edge_triangles(a, b)) {
+  if (va.normals.size() == 1 && vb.normals.size() == 1 && va.normals[0].first == vb.normals[0].first)
+    return length6d(va.x, va.normals[0].second, vb.x, vb.normals[0].second, s);  // one patch: the usual case
+  m.for_each_edge_triangle(a, b, [&](int t) {
     const int p = m.triangles[t].patch;
     len = std::max(len, length6d(va.x, va.normal(p), vb.x, vb.normal(p), s));
-  }
+  });
   return len >= 0.0 ? len : (va.x - vb.x).norm();
 }
 
@@ -27,6 +30,13 @@ double triangle_min_angle6d(const RemeshMesh& m, int t, double s) {
   const RemeshVertex& v2 = m.vertices[tr.v[2]];
   return min_angle6d(embed6d(v0.x, v0.normal(tr.patch), s), embed6d(v1.x, v1.normal(tr.patch), s),
                      embed6d(v2.x, v2.normal(tr.patch), s));
+}
+
+double triangle_deviation(const RemeshMesh& m, int t) {
+  const RemeshTriangle& tr = m.triangles[t];
+  const auto& v = m.vertices;
+  return triangle_deviation_estimate({v[tr.v[0]].x, v[tr.v[1]].x, v[tr.v[2]].x},
+                                     {v[tr.v[0]].normal(tr.patch), v[tr.v[1]].normal(tr.patch), v[tr.v[2]].normal(tr.patch)});
 }
 
 namespace detail {
@@ -61,6 +71,33 @@ double Remesher::min_angle(const std::array<int, 3>& t, int patch) const {
   const auto n = normals(t, patch);
   return min_angle6d(embed6d(m_.vertices[t[0]].x, n[0], s), embed6d(m_.vertices[t[1]].x, n[1], s),
                      embed6d(m_.vertices[t[2]].x, n[2], s));
+}
+
+double Remesher::deviation(const std::array<int, 3>& t, int patch) const {
+  return triangle_deviation_estimate(positions(t), normals(t, patch));
+}
+
+bool Remesher::breaks_cap(const std::array<int, 3>& t, int patch, double before) const {
+  if (!(o_.max_deviation > 0.0)) return false;
+  const double d = deviation(t, patch);
+  return d > o_.max_deviation && d > before;
+}
+
+Edge Remesher::most_curved_edge(int t) const {
+  const RemeshTriangle& tr = m_.triangles[t];
+  const auto x = positions(tr.v);
+  const auto n = normals(tr.v, tr.patch);
+  Edge best{tr.v[0], tr.v[1]};
+  double best_term = -1.0;
+  for (int i = 0; i < 3; ++i) {
+    const int j = (i + 1) % 3;
+    const double term = std::abs(chord_curvature_term(x[i], n[i], x[j], n[j]));
+    if (term > best_term) {
+      best_term = term;
+      best = {tr.v[i], tr.v[j]};
+    }
+  }
+  return best;
 }
 
 double Remesher::pair_energy(const std::array<int, 3>& t1, const std::array<int, 3>& t2, int patch) const {
@@ -121,7 +158,7 @@ int Remesher::split(int a, int b) {
   const int curve = m_.feature_curve(a, b);
   if (curve >= 0) {
     nv.kind = VertexKind::curve;
-    nv.on = g_.project_to_curve(curve, mid);
+    nv.on = g_.curve_midpoint(curve, m_.vertices[a].kind, m_.vertices[a].on, m_.vertices[b].kind, m_.vertices[b].on);
   } else {
     nv.kind = VertexKind::surface;
     nv.on = g_.project_to_patch(m_.triangles[ts[0]].patch, mid, hint(ts, {a, b}));
@@ -150,6 +187,10 @@ int Remesher::split(int a, int b) {
     m_.set_triangle(ts[k], halves[k][0]);
     m_.add_triangle({halves[k][1], p, true});
   }
+  touch(a);
+  touch(b);
+  touch(c);
+  for (const auto& h : halves) touch(h[0][2]);
   if (curve >= 0) {
     m_.feature_edges.erase(RemeshMesh::key(a, b));
     m_.feature_edges[RemeshMesh::key(a, c)] = curve;
@@ -194,6 +235,7 @@ bool Remesher::collapse_onto(int a, int b, double max_length) {
     // No fold: the triangle keeps its side.
     const auto xo = positions(tr.v), xn = positions(nv);
     if (triangle_normal(xo[0], xo[1], xo[2]).dot(triangle_normal(xn[0], xn[1], xn[2])) <= 0.0) return false;
+    if (breaks_cap(nv, tr.patch, deviation(tr.v, tr.patch))) return false;
     for (int w : nv)
       if (w != b && length6d(vb.x, vb.normal(tr.patch), m_.vertices[w].x, m_.vertices[w].normal(tr.patch),
                              o_.anisotropy) > max_length)
@@ -202,8 +244,10 @@ bool Remesher::collapse_onto(int a, int b, double max_length) {
   for (int t : removed) m_.kill_triangle(t);
   for (int t : moved) {
     std::array<int, 3> nv = m_.triangles[t].v;
-    for (int& v : nv)
+    for (int& v : nv) {
       if (v == a) v = b;
+      touch(v);
+    }
     m_.set_triangle(t, nv);
   }
   for (int w : m_.neighbours(b)) {
@@ -250,12 +294,48 @@ bool Remesher::flip(int a, int b) {
   } else {
     better = !inverted(n1, p) && !inverted(n2, p) &&  // criterion (b)
              std::min(min_angle(n1, p), min_angle(n2, p)) > std::min(min_angle(t1, p), min_angle(t2, p)) + 1e-12;
+    if (better && o_.max_deviation > 0.0) {
+      const double before = std::max(deviation(t1, p), deviation(t2, p));
+      better = !breaks_cap(n1, p, before) && !breaks_cap(n2, p, before);
+    }
   }
   if (!better) return false;
   m_.set_triangle(ts[0], n1);
   m_.set_triangle(ts[1], n2);
+  for (int v : {a, b, c, d}) touch(v);
   ++r_.flips;
   return true;
+}
+
+void Remesher::touch(int v) {
+  if (all_touched_) return;
+  if (is_touched_.size() < m_.vertices.size()) is_touched_.resize(m_.vertices.size(), 0);
+  if (!is_touched_[v]) {
+    is_touched_[v] = 1;
+    touched_.push_back(v);
+  }
+}
+
+void Remesher::improve_all_by_flips() {
+  std::vector<Edge> stack;
+  if (all_touched_) {
+    stack = m_.edges();
+  } else {
+    std::vector<std::uint64_t> keys;
+    for (int v : touched_)
+      for (int t : m_.triangles_of(v)) {
+        const auto& c = m_.triangles[t].v;
+        for (int i = 0; i < 3; ++i) keys.push_back(RemeshMesh::key(c[i], c[(i + 1) % 3]));
+      }
+    std::sort(keys.begin(), keys.end());
+    keys.erase(std::unique(keys.begin(), keys.end()), keys.end());
+    // Larger vertex first, as m_.edges() lists them: the stack pops the last.
+    for (std::uint64_t k : keys) stack.push_back({static_cast<int>(k >> 32), static_cast<int>(k & 0xffffffffu)});
+  }
+  for (int v : touched_) is_touched_[v] = 0;
+  touched_.clear();
+  all_touched_ = false;
+  improve_by_flips(std::move(stack));
 }
 
 void Remesher::improve_by_flips(std::vector<Edge> stack) {
@@ -266,8 +346,8 @@ void Remesher::improve_by_flips(std::vector<Edge> stack) {
     while (!stack.empty()) {
       const auto [a, b] = stack.back();
       stack.pop_back();
-      if (!m_.has_edge(a, b)) continue;
-      std::vector<int> ts = m_.edge_triangles(a, b);
+      const std::vector<int> ts = m_.edge_triangles(a, b);
+      if (ts.empty()) continue;  // gone
       std::array<int, 2> opp{-1, -1};
       for (std::size_t k = 0; k < ts.size() && k < 2; ++k)
         for (int w : m_.triangles[ts[k]].v)
@@ -288,23 +368,30 @@ void Remesher::improve_by_flips(std::vector<Edge> stack) {
   }
 }
 
-Eigen::Vector3d Remesher::smoothing_step(int v) const {
+Eigen::Vector3d Remesher::smoothing_step(int v, double* mean_length) const {
   const RemeshVertex& vv = m_.vertices[v];
   if (vv.kind == VertexKind::corner || m_.triangles_of(v).empty()) return Eigen::Vector3d::Zero();
-  std::vector<int> omega;
-  for (int w : m_.neighbours(v))
-    if (vv.kind == VertexKind::surface || m_.feature_curve(v, w) == vv.on.entity) omega.push_back(w);
-  if (vv.kind == VertexKind::curve && omega.size() != 2) return Eigen::Vector3d::Zero();
-  if (omega.empty()) return Eigen::Vector3d::Zero();
+  std::vector<int>& nb = neighbour_scratch_;
+  m_.neighbours(v, nb);
+  if (mean_length) {
+    double mean = 0.0;
+    for (int w : nb) mean += (m_.vertices[w].x - vv.x).norm();
+    *mean_length = nb.empty() ? 0.0 : mean / static_cast<double>(nb.size());
+  }
+  // Omega: all neighbours of a surface vertex; the two along the curve of a curve vertex.
+  if (vv.kind == VertexKind::curve)
+    std::erase_if(nb, [&](int w) { return m_.feature_curve(v, w) != vv.on.entity; });
+  if (vv.kind == VertexKind::curve && nb.size() != 2) return Eigen::Vector3d::Zero();
+  if (nb.empty()) return Eigen::Vector3d::Zero();
   // Eq. 6: p' = p + alpha sum f(d(p, p_i)) u_i with u_i = (p - p_i)/|p - p_i|,
   // f(d) = -d and alpha = 1/#omega (Laplacian smoothing), d measured in R^6.
   Eigen::Vector3d step = Eigen::Vector3d::Zero();
-  for (int w : omega) {
+  for (int w : nb) {
     const Eigen::Vector3d e = vv.x - m_.vertices[w].x;
     const double len = e.norm();
     if (len > 0.0) step -= length(v, w) * e / len;
   }
-  step /= static_cast<double>(omega.size());
+  step /= static_cast<double>(nb.size());
   if (vv.kind == VertexKind::surface) {
     const Eigen::Vector3d n = vv.normals.front().second;
     step -= step.dot(n) * n;  // tangential; the projection puts it back on the surface
@@ -318,9 +405,11 @@ bool Remesher::move_vertex(int v, const Eigen::Vector3d& target) {
   const std::vector<int> star = m_.triangles_of(v);
   double old_min = 10.0;
   std::vector<char> was_inverted;
+  std::vector<double> old_deviation;
   for (int t : star) {
     was_inverted.push_back(inverted(m_.triangles[t].v, m_.triangles[t].patch));
     old_min = std::min(old_min, min_angle(t));
+    if (o_.max_deviation > 0.0) old_deviation.push_back(deviation(t));
   }
   const std::vector<int> around = m_.neighbours(v);
   std::vector<double> old_length;
@@ -348,9 +437,13 @@ bool Remesher::move_vertex(int v, const Eigen::Vector3d& target) {
   for (std::size_t k = 0; k < star.size() && ok; ++k) {
     const RemeshTriangle& tr = m_.triangles[star[k]];
     if (!was_inverted[k] && inverted(tr.v, tr.patch)) ok = false;
+    if (o_.max_deviation > 0.0 && breaks_cap(tr.v, tr.patch, old_deviation[k])) ok = false;
     new_min = std::min(new_min, min_angle(star[k]));
   }
-  if (ok && new_min >= std::min(old_min, o_.min_angle)) return true;
+  if (ok && new_min >= std::min(old_min, o_.min_angle)) {
+    touch(v);
+    return true;
+  }
   vv = old;
   return false;
 }
@@ -360,12 +453,9 @@ void Remesher::smooth(double fraction) {
   // their mean 3D edge length; smooth the `fraction` that would move most.
   std::vector<std::pair<double, int>> score;
   for (std::size_t v = 0; v < m_.vertices.size(); ++v) {
-    const Eigen::Vector3d step = smoothing_step(static_cast<int>(v));
-    if (step.isZero()) continue;
     double mean = 0.0;
-    const std::vector<int> nb = m_.neighbours(static_cast<int>(v));
-    for (int w : nb) mean += (m_.vertices[w].x - m_.vertices[v].x).norm();
-    mean /= static_cast<double>(nb.size());
+    const Eigen::Vector3d step = smoothing_step(static_cast<int>(v), &mean);
+    if (step.isZero()) continue;
     if (mean > 0.0) score.emplace_back(step.norm() / mean, static_cast<int>(v));
   }
   const std::size_t count = std::min(score.size(), static_cast<std::size_t>(std::ceil(fraction * score.size())));

@@ -11,6 +11,7 @@
 #include <limits>
 #include <numbers>
 #include <numeric>
+#include <optional>
 #include <set>
 #include <unordered_map>
 
@@ -42,6 +43,27 @@ std::pair<Eigen::Vector3d, Eigen::Vector2d> closest_point(int dim, int tag, cons
     const double nan = std::numeric_limits<double>::quiet_NaN();
     return {Eigen::Vector3d::Constant(nan), Eigen::Vector2d::Constant(nan)};
   }
+}
+
+/// The foot point on `face` of x by Gauss-Newton from uv (the parameters of a
+/// nearby mesh vertex): uv += (J^T J)^-1 J^T (x - phi(uv)), J = (phi_u, phi_v),
+/// until the tangential step is below tol. A local closest point, at a few
+/// evaluations of phi and its first derivatives instead of OCC's global
+/// extremum search and inverse mapping. Empty if it leaves the parameter box
+/// (a periodic face's seam, a face's end) or does not converge in 8 steps.
+std::optional<Eigen::Vector2d> local_foot(const GmshFace& face, Eigen::Vector2d uv, const Eigen::Vector3d& x,
+                                          double tol) {
+  for (int it = 0; it < 8; ++it) {
+    const SurfacePoint p = face.evaluate(uv, 1);
+    const Eigen::Matrix2d jtj = p.d.transpose() * p.d;
+    if (!(std::abs(jtj.determinant()) > 1e-14 * jtj.squaredNorm())) return std::nullopt;  // degenerate point
+    const Eigen::Vector2d step = jtj.inverse() * (p.d.transpose() * (x - p.x));
+    uv += step;
+    if (!uv.allFinite() || (uv.array() < face.lower().array()).any() || (uv.array() > face.upper().array()).any())
+      return std::nullopt;
+    if ((p.d * step).norm() <= tol) return uv;
+  }
+  return std::nullopt;
 }
 
 /// (u, v) on `face` of point x = the point `tag` (dim 0) or curve `tag` at t
@@ -238,6 +260,22 @@ GeometryPoint GmshRemeshGeometry::project_to_patch(int patch, const Eigen::Vecto
         for (int g : f_.curve_faces.at(c)) add(g);
   }
   if (cand.empty()) cand = f_.patch_faces.at(patch);
+  // The usual case, a short move on one face: the local foot point from the
+  // nearest hint corner on that face, accepted where the hint's triangles prove
+  // it inside the trimmed face (then no other face of the smooth patch is nearer
+  // for a move within the star).
+  for (int fc : hint.faces) {
+    if (std::find(cand.begin(), cand.end(), fc) == cand.end()) continue;
+    const GeometryPoint* start = nullptr;
+    for (const auto& t : hint.triangles)
+      for (const GeometryPoint& c : t)
+        if (c.entity == fc && (!start || (c.x - x).squaredNorm() < (start->x - x).squaredNorm())) start = &c;
+    if (!start) continue;
+    const GmshFace& gf = face(fc);
+    const auto uv = local_foot(gf, start->param, x, 1e-10 * f_.diagonal);
+    if (uv && hint.proves_inside(fc, *uv, 0.5 * (gf.upper() - gf.lower()), f_.smooth_boundary.at(fc)))
+      return {gf.value(*uv), fc, *uv};
+  }
   // Closest points on the untrimmed faces, nearest first; the first inside its
   // trimmed face wins (the hint's mesh triangles spare most exact tests).
   std::vector<std::pair<double, GeometryPoint>> found;
@@ -279,6 +317,55 @@ Eigen::Vector2d GmshRemeshGeometry::boundary_uv(int face, VertexKind kind, const
 GeometryPoint GmshRemeshGeometry::project_to_curve(int curve, const Eigen::Vector3d& x) const {
   const auto [y, t] = closest_point(1, curve, x);
   return {y, curve, t};
+}
+
+GeometryPoint GmshRemeshGeometry::curve_midpoint(int curve, VertexKind ka, const GeometryPoint& a, VertexKind kb,
+                                               const GeometryPoint& b) const {
+  // Curve parameters of the end points (a corner's by projection).
+  auto param = [&](VertexKind k, const GeometryPoint& p) {
+    return k == VertexKind::curve && p.entity == curve ? p.param.x() : closest_point(1, curve, p.x).second.x();
+  };
+  const double ta = param(ka, a), tb = param(kb, b);
+  std::vector<double> lo, hi;
+  gmsh::model::getParametrizationBounds(1, curve, lo, hi);
+  if (!std::isfinite(ta) || !std::isfinite(tb) || lo.empty() || hi.empty()) return project_to_curve(curve, 0.5 * (a.x + b.x));
+  const double period = hi[0] - lo[0];
+  // Sample the arc t(l) = ta + l (tb - ta) and, on a closed curve, the arc
+  // through its seam; keep the shorter; the arc-length midpoint by linear
+  // interpolation of the cumulative chord length over kSamples pieces.
+  constexpr int kSamples = 16;
+  std::vector<double> ends;
+  gmsh::model::getValue(1, curve, {lo[0], hi[0]}, ends);
+  const bool closed = (vec3(ends, 0) - vec3(ends, 1)).norm() <= 1e-9 * f_.diagonal;
+  std::vector<double> deltas{tb - ta};
+  if (closed && tb != ta) deltas.push_back(tb - ta - std::copysign(period, tb - ta));
+  auto wrap = [&](double t) { return closed ? lo[0] + std::fmod(std::fmod(t - lo[0], period) + period, period) : t; };
+  GeometryPoint best;
+  double best_length = kInf;
+  for (double delta : deltas) {
+    std::vector<double> ts, xs;
+    for (int k = 0; k <= kSamples; ++k) ts.push_back(wrap(ta + delta * k / kSamples));
+    try {
+      gmsh::model::getValue(1, curve, ts, xs);
+    } catch (...) {
+      continue;
+    }
+    std::vector<double> cumulative{0.0};
+    for (int k = 1; k <= kSamples; ++k) cumulative.push_back(cumulative.back() + (vec3(xs, k) - vec3(xs, k - 1)).norm());
+    if (!(cumulative.back() < best_length)) continue;
+    best_length = cumulative.back();
+    const double half = 0.5 * cumulative.back();
+    int k = 1;
+    while (k < kSamples && cumulative[k] < half) ++k;
+    const double piece = cumulative[k] - cumulative[k - 1];
+    const double w = piece > 0.0 ? (half - cumulative[k - 1]) / piece : 0.0;
+    const double t = wrap(ta + delta * (k - 1 + w) / kSamples);
+    std::vector<double> x;
+    gmsh::model::getValue(1, curve, {t}, x);
+    best = {vec3(x), curve, Eigen::Vector2d(t, 0.0)};
+  }
+  if (!(best_length < kInf)) return project_to_curve(curve, 0.5 * (a.x + b.x));
+  return best;
 }
 
 Eigen::Vector3d GmshRemeshGeometry::patch_normal(int patch, VertexKind kind, const GeometryPoint& p) const {

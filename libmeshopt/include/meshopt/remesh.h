@@ -12,7 +12,8 @@
 // Beyond the paper: collapses keep the link condition (no change of topology)
 // and the features (a vertex leaves a feature curve never; a corner never
 // moves); no operation leaves a triangle inverted against the CAD normal
-// (Definition 3.4) that was not; every flip loop is capped.
+// (Definition 3.4) that was not; every flip loop is capped; an optional cap on
+// the chordal deviation (max_deviation).
 #include <cstddef>
 #include <functional>
 #include <numbers>
@@ -31,6 +32,11 @@ struct RemeshOptions {
   int inner = 4;            ///< J (Algorithm 2)
   double smooth_fraction = 0.3;  ///< vertices smoothed per pass (Algorithm 2, line 3)
   double inversion_angle = std::numbers::pi / 2.0;  ///< alpha (Definition 3.4)
+  /// D: cap on the chordal deviation of every triangle's centroid, estimated
+  /// from its corner normals (chordal_estimate.h); 0: no cap (the paper).
+  /// Triangles above it are split (their most curved edge) in SAMPLING, and no
+  /// collapse, flip or smoothing move may push a triangle above it.
+  double max_deviation = 0.0;
   int max_flip_passes = 50;  ///< cap of each edge-flip loop (waves of link edges after the first pass)
   /// Called at each phase with (round, phase name); may be empty.
   std::function<void(int, const std::string&)> progress;
@@ -49,6 +55,10 @@ RemeshReport remesh(RemeshMesh& mesh, const RemeshGeometry& geometry, const Reme
 /// 6D length of edge (a, b) of `mesh`: the largest over the patches of its
 /// triangles (normals differ across a feature curve).
 double edge_length6d(const RemeshMesh& mesh, int a, int b, double s);
+
+/// The chordal deviation of live triangle t's centroid estimated from its corner
+/// normals (triangle_deviation_estimate).
+double triangle_deviation(const RemeshMesh& mesh, int t);
 
 /// Smallest 6D angle of live triangle t.
 double triangle_min_angle6d(const RemeshMesh& mesh, int t, double s);

@@ -52,6 +52,18 @@ class RemeshGeometry {
   virtual GeometryPoint project_to_patch(int patch, const Eigen::Vector3d& x, const ProjectionHint& hint) const = 0;
   /// The point of feature curve `curve` closest to x.
   virtual GeometryPoint project_to_curve(int curve, const Eigen::Vector3d& x) const = 0;
+  /// The point of feature curve `curve` halfway (by arc length) between its
+  /// points a and b, classified as `ka` and `kb` (curve: param.x() is the curve
+  /// parameter; corner: an end point of the curve), along the shorter of the
+  /// arcs between them: where a feature edge is split. The default projects
+  /// the chord's midpoint, which on a strongly bent curve may land on another
+  /// branch of it.
+  virtual GeometryPoint curve_midpoint(int curve, VertexKind ka, const GeometryPoint& a, VertexKind kb,
+                                       const GeometryPoint& b) const {
+    (void)ka;
+    (void)kb;
+    return project_to_curve(curve, 0.5 * (a.x + b.x));
+  }
   /// The unit normal of patch `patch` at point p of its closure, classified as
   /// `kind` (a face point, or a point of a curve or corner bounding the patch),
   /// oriented like the patch's triangles (counter-clockwise about it).

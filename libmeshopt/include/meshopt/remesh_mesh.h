@@ -23,7 +23,11 @@ struct RemeshVertex {
   /// surface vertex; one per side for a vertex on a feature curve).
   std::vector<std::pair<int, Eigen::Vector3d>> normals;
   /// The normal on `patch` (zero if the vertex has no triangle there).
-  Eigen::Vector3d normal(int patch) const;
+  Eigen::Vector3d normal(int patch) const {
+    for (const auto& [p, n] : normals)
+      if (p == patch) return n;
+    return Eigen::Vector3d::Zero();
+  }
 };
 
 struct RemeshTriangle {
@@ -54,8 +58,18 @@ class RemeshMesh {
   bool has_edge(int a, int b) const;
   bool is_feature(int a, int b) const { return feature_edges.count(key(a, b)) > 0; }
   int feature_curve(int a, int b) const;
+  /// Calls f(t) for each live triangle t that contains both a and b (no allocation).
+  template <class F>
+  void for_each_edge_triangle(int a, int b, F&& f) const {
+    for (int t : incident_[a]) {
+      const auto& v = triangles[t].v;
+      if (v[0] == b || v[1] == b || v[2] == b) f(t);
+    }
+  }
   /// Vertices joined to v by an edge.
   std::vector<int> neighbours(int v) const;
+  /// The same into `out` (cleared first; no allocation once it has grown).
+  void neighbours(int v, std::vector<int>& out) const;
   /// Every edge (a < b) of the live triangles, once.
   std::vector<std::array<int, 2>> edges() const;
   std::size_t live_triangles() const;

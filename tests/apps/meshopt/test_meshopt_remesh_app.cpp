@@ -82,13 +82,18 @@ TEST_CASE("meshopt remesh: a fused cylinder and sphere, outputs readable by Gmsh
                                   dir);
   CAPTURE(smooth.err);
   CHECK(smooth.exit_code == 0);
-  // --json: NDJSON on stdout ending with the result.
+  // --json: NDJSON on stdout ending with the result. --max-deviation D alone
+  // derives L = 160 D and s = 5 L.
   const auto js = run_meshopt("remesh " + model + " --out '" + (dir / "out/j.msh").string() +
-                                  "' --length 0.3 --rounds 1 --json",
+                                  "' --max-deviation 0.002 --rounds 1 --json",
                               dir);
   REQUIRE(js.exit_code == 0);
   const std::string last = js.out.substr(js.out.rfind('\n', js.out.size() - 2) + 1);
-  CHECK(nlohmann::json::parse(last)["event"] == "result");
+  const nlohmann::json result = nlohmann::json::parse(last);
+  CHECK(result["event"] == "result");
+  CHECK(result["report"]["length"].get<double>() == doctest::Approx(0.32));
+  CHECK(result["report"]["anisotropy"].get<double>() == doctest::Approx(1.6));
+  CHECK(result["report"]["max_deviation"].get<double>() == doctest::Approx(0.002));
 }
 
 TEST_CASE("meshopt remesh: bad input gives one clear error and exit 1, unwritable output exit 2") {
@@ -101,6 +106,8 @@ TEST_CASE("meshopt remesh: bad input gives one clear error and exit 1, unwritabl
       {"remesh '" + (dir / "missing.step").string() + "' --length 0.1" + out, "cannot read the model"},
       {"remesh '" + (dir / "garbage.step").string() + "' --length 0.1" + out, "cannot load the model"},
       {"remesh " + model + " --length -1" + out, "--length must be positive"},
+      {"remesh " + model + out, "give --length or --max-deviation"},
+      {"remesh " + model + " --max-deviation -0.1" + out, "--max-deviation must be positive"},
       {"remesh " + model + " --length 0.1 --anisotropy -2" + out, "--anisotropy must be >= 0"},
       {"remesh " + model + " --length 0.1 --feature-angle 200" + out, "--feature-angle must be in [0, 180]"},
       {"remesh " + model + " --length 0.1 --out '" + (dir / "o.txt").string() + "'", "--out must end in .msh"},

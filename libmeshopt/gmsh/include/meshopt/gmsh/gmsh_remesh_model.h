@@ -41,6 +41,8 @@ class GmshRemeshGeometry final : public RemeshGeometry {
   const CadFeatures& features() const { return f_; }
   GeometryPoint project_to_patch(int patch, const Eigen::Vector3d& x, const ProjectionHint& hint) const override;
   GeometryPoint project_to_curve(int curve, const Eigen::Vector3d& x) const override;
+  GeometryPoint curve_midpoint(int curve, VertexKind ka, const GeometryPoint& a, VertexKind kb,
+                               const GeometryPoint& b) const override;
   Eigen::Vector3d patch_normal(int patch, VertexKind kind, const GeometryPoint& p) const override;
   /// (u, v) on `face` of a point p of one of its boundary curves (kind curve,
   /// p.param.x() = t) or points (kind corner).
