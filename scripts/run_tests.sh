@@ -6,7 +6,8 @@
 # CMake package (and imports the installed Python module). The Python tests
 # (pytest, tests/python) run after the Release suites, not under the sanitizers.
 # Before the sanitizer suites, the libFuzzer targets (scripts/run_fuzz.sh: clang,
-# ASan, about 25 s each), so that the run still ends with doctest's summary.
+# ASan, 20 s each), so that the run still ends with doctest's summaries (the sanitized
+# suites run in groups, one per core at a time: scripts/run_test_chunks.sh).
 # Exits non-zero if any test fails.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -35,5 +36,8 @@ echo "== ASan+UBSan build and tests"
 # time of RelWithDebInfo's -O2 -g, as the sanitizers' documentation recommends.
 BUILD_DIR=build-asan BUILD_TYPE=RelWithDebInfo bash scripts/build.sh -DTSPLINE_SANITIZE=ON -DTSPLINE_BUILD_BENCH=OFF \
   -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g1 -DNDEBUG"
+# The sanitized suites run about six times slower than the Release ones: in
+# groups of suites, one per core at a time (scripts/run_test_chunks.sh), each
+# group with its doctest summary and a total at the end.
 ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
-  ./build-asan/tests/unit_tests
+  bash scripts/run_test_chunks.sh ./build-asan/tests/unit_tests
