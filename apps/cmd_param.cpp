@@ -2,6 +2,7 @@
 // holes, one map per four-sided patch) and its output folder.
 #include <CLI/CLI.hpp>
 #include <array>
+#include <chrono>
 #include <iostream>
 #include <memory>
 #include <sstream>
@@ -19,6 +20,7 @@
 #include "tspline/io/param_output.h"
 #include "tspline/io/polygon_reader.h"
 #include "tspline/pipeline/adaptive_parameterization.h"
+#include "tspline/pipeline/domain_parameterization.h"
 #include "tspline/pipeline/parameterization.h"
 
 namespace tspline_app {
@@ -48,33 +50,57 @@ std::array<long long, 4> parse_corners(const std::string& text) {
 int run_param(const std::string& input, const std::string& out_dir, const std::string& corners_text,
               tspline::ParameterizationOptions opt, const tspline::AdaptiveOptions& adaptive, int samples,
               const tspline::io::DomainReadOptions& domain_options, tspline_app::OutputMode mode,
-              const std::string& cuts_file) {
+              const std::string& cuts_file, const std::string& layout_name) {
   if (!corners_text.empty()) opt.corners = parse_corners(corners_text);
   if (samples < 1 || samples > 64) throw tspline::InputError("--samples must be in [1, 64]");
+  tspline::DomainParameterizationOptions choice;
+  choice.layout = tspline::parse_layout_mode(layout_name);
   tspline_app::Progress progress(mode);
   const bool quiet = mode != tspline_app::OutputMode::Human;
   opt.progress = [&progress](const tspline::ProgressEvent& e) { progress.report(e); };
   // Fail on an unwritable output directory before any computation.
   toolkit::io::ensure_writable_directory(out_dir);
+  const auto t0 = std::chrono::steady_clock::now();
   const tspline::io::DomainInput domain = tspline::io::read_domain(input, domain_options);
-  const tspline::Polygon& polygon = domain.outer;
-  if (!domain.holes.empty() || !cuts_file.empty())
-    return tspline_app::run_multipatch_param(domain, input, out_dir, cuts_file, opt, adaptive, samples, progress);
-  tspline::io::AdaptSeriesWriter series(out_dir, samples);
-  const tspline::ParameterizationResult result = tspline::run_parameterization(
-      polygon, opt, adaptive,
+  if (!cuts_file.empty()) {
+    choice.cuts.emplace();
+    for (const tspline::Polygon& p : tspline::io::read_text_rings(cuts_file)) choice.cuts->push_back(p.vertices);
+  }
+  const bool several = !domain.holes.empty() || choice.cuts || choice.layout == tspline::LayoutMode::Quad;
+  if (opt.corners && several)
+    throw tspline::InputError("--corners applies to a single patch; a layout of several patches has its corners "
+                              "at the patch corners (use --layout single on a domain without holes)");
+  // The single-patch iterations, kept until the layout is chosen (auto may drop them).
+  struct Snapshot {
+    int iteration;
+    tspline::TMesh mesh;
+    std::vector<Eigen::Vector2d> x;
+    tspline::TSplineMap map;
+  };
+  std::vector<Snapshot> snapshots;
+  const tspline::DomainParameterization P = tspline::parameterize_domain(
+      {domain.outer, domain.holes}, opt, adaptive, choice,
       [&](int it, const tspline::TMesh& mesh, const std::vector<Eigen::Vector2d>& x, const tspline::TSplineMap& map,
           const std::vector<tspline::CellMapQuality>&) {
-        series.add(it, mesh, x, map);
+        if (it == 0) snapshots.clear();  // a new run (auto's first try was run again, or dropped)
+        snapshots.push_back({it, mesh, x, map});
         progress.event({{"event", "iteration"},
                         {"iteration", it},
                         {"cells", mesh.num_cells()},
                         {"functions", map.basis().size()}});
         progress.progress("adaptive rounds", it + 1, adaptive.max_adapt + 1);
-      });
+      },
+      [&](std::size_t p, int round) { progress.event({{"event", "patch"}, {"patch", p}, {"round", round}}); });
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  if (P.patches)
+    return tspline_app::write_multipatch_param(P, domain, input, out_dir, adaptive, samples, seconds, progress);
+  const tspline::ParameterizationResult& result = *P.single;
+  tspline::io::AdaptSeriesWriter series(out_dir, samples);
+  for (const Snapshot& s : snapshots) series.add(s.iteration, s.mesh, s.x, s.map);
   series.finish();
   nlohmann::json report = tspline::io::param_report(result, input);
   report["input_geometry"] = domain.description;  // format, layer, CRS, projection (gis_reader.h)
+  report["layout"] = {{"chosen", P.layout}, {"reason", P.reason}};
   tspline::io::write_param_outputs(result, out_dir, report, samples);
   progress.settle();
   std::vector<std::string> files;
@@ -131,7 +157,7 @@ int run_param(const std::string& input, const std::string& out_dir, const std::s
 
 /// The options of `tspline param` as parsed (they live as long as the program).
 struct ParamArgs {
-  std::string input, out_dir, corners, cuts_file, layer;
+  std::string input, out_dir, corners, cuts_file, layer, layout = "auto";
   tspline::ParameterizationOptions opt;
   tspline::AdaptiveOptions adaptive;
   tspline::io::DomainReadOptions domain_options;
@@ -154,9 +180,15 @@ void add_param_command(CLI::App& app, CommandAction& action) {
                     "(Shapefile, GeoPackage, KML, GML, GeoJSON, ...; longitude/latitude are projected to metres)")
       ->required();
   param->add_option("--out", A.out_dir, "Output directory (created if missing)")->required();
+  param->add_option("--layout", A.layout,
+                    "auto: one patch where a first try is certified and good over the whole map (scaled Jacobian "
+                    ">= 0.3, J_r >= 0.1), an automatic quad layout otherwise and always for domains with holes; "
+                    "single: one patch (no holes); quad: the automatic quad layout")
+      ->check(CLI::IsMember({"auto", "single", "quad"}))
+      ->capture_default_str();
   param->add_option("--cuts", A.cuts_file,
-                    "Domain with holes: the cuts into four-sided patches as polylines ('x y' per line, cuts "
-                    "separated by blank lines; ends on rings or at ends of other cuts); default: automatic");
+                    "The layout given by hand: cuts into four-sided patches as polylines ('x y' per line, cuts "
+                    "separated by blank lines; ends on rings or at ends of other cuts); default: --layout");
   param->add_option("--corners", A.corners,
                     "Four vertex indices i,j,k,l (0-based, the file's own numbering, in cyclic file order) "
                     "mapped to (0,0),(1,0),(1,1),(0,1); default: automatic choice explained in report.json");
@@ -222,7 +254,7 @@ void add_param_command(CLI::App& app, CommandAction& action) {
       if (layer_opt->count() > 0) A.domain_options.layer = A.layer;
       if (feature_opt->count() > 0) A.domain_options.feature = A.feature;
       return run_param(A.input, A.out_dir, A.corners, A.opt, A.adaptive, A.samples, A.domain_options,
-                       tspline_app::output_mode(A.quiet, A.json_events), A.cuts_file);
+                       tspline_app::output_mode(A.quiet, A.json_events), A.cuts_file, A.layout);
     };
   });
 }

@@ -1,42 +1,43 @@
 #include "param_multipatch.h"
 
-#include <chrono>
 #include <iostream>
 #include <sstream>
 
 #include "tspline/errors.h"
 #include "tspline/io/multipatch_output.h"
-#include "tspline/io/polygon_reader.h"
-#include "tspline/multipatch/multipatch_parameterization.h"
 
 namespace tspline_app {
 
-int run_multipatch_param(const tspline::io::DomainInput& input_domain, const std::string& input,
-                         const std::string& out_dir, const std::string& cuts_file,
-                         const tspline::ParameterizationOptions& options, const tspline::AdaptiveOptions& adaptive,
-                         int samples, Progress& progress) {
-  if (options.corners) throw tspline::InputError("--corners applies to a single patch; a domain with holes is cut "
-                                                 "into patches whose corners are the ends of the cuts");
-  const auto t0 = std::chrono::steady_clock::now();
-  tspline::Domain domain{input_domain.outer, input_domain.holes};
-  std::optional<std::vector<tspline::Cut>> cuts;
-  if (!cuts_file.empty()) {
-    cuts.emplace();
-    for (const tspline::Polygon& p : tspline::io::read_text_rings(cuts_file)) cuts->push_back(p.vertices);
-  }
-  const tspline::MultiPatchResult R = tspline::run_multipatch_parameterization(
-      domain, cuts, options, adaptive, {}, [&](std::size_t p, int round) {
-        progress.event({{"event", "patch"}, {"patch", p}, {"round", round}});
-      });
-  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+int write_multipatch_param(const tspline::DomainParameterization& P, const tspline::io::DomainInput& input_domain,
+                           const std::string& input, const std::string& out_dir,
+                           const tspline::AdaptiveOptions& adaptive, int samples, double seconds, Progress& progress) {
+  const tspline::MultiPatchResult& R = *P.patches;
   nlohmann::json report = tspline::io::multipatch_report(R, input, seconds);
   report["input_geometry"] = input_domain.description;
+  report["layout"] = {{"chosen", P.layout}, {"reason", P.reason}, {"explanation", R.cuts_explanation}};
+  if (P.quad_stats) {
+    const tspline::QuadLayoutStats& s = *P.quad_stats;
+    report["layout"]["quad"] = {{"patches", s.patches},
+                                {"ring_nodes", s.ring_nodes},
+                                {"inner_nodes", s.inner_nodes},
+                                {"inner_valence", s.valence},
+                                {"straight_min_scaled_jacobian", s.min_corner_scaled_jacobian},
+                                {"straight_mean_scaled_jacobian", s.mean_corner_scaled_jacobian},
+                                {"repair_rounds", s.repair_rounds},
+                                {"min_size", s.min_size},
+                                {"max_size", s.max_size},
+                                {"seconds", s.seconds}};
+  }
+  if (P.rejected_single)
+    report["layout"]["single_patch_first_try"] = {{"min_scaled_jacobian_dense", P.rejected_single->min_scaled},
+                                                  {"min_mean_ratio_dense", P.rejected_single->min_mean_ratio}};
   tspline::io::write_multipatch_outputs(R, out_dir, report, samples);
   progress.settle();
   const auto& totals = report["totals"];
   progress.event({{"event", "result"},
                   {"valid", R.valid()},
                   {"certified_valid", R.certified_valid()},
+                  {"layout", P.layout},
                   {"patches", R.patches.size()},
                   {"cells", totals["cells"]},
                   {"min_mean_ratio_jacobian", R.min_mean_ratio_gauss()},
@@ -44,11 +45,13 @@ int run_multipatch_param(const tspline::io::DomainInput& input_domain, const std
                   {"out", out_dir}});
   if (progress.human()) {
     std::ostringstream s;
-    s << R.patches.size() << " patches, " << R.layout.cuts.size() << " cuts, " << totals["cells"] << " cells, "
-      << totals["bezier_elements"] << " elements; certified " << (R.certified_valid() ? "valid" : "NOT valid")
-      << " (det J >= " << R.min_relative_det_bound() << " x element mean), min J_r " << R.min_mean_ratio_dense()
-      << " (whole map); area " << R.map_area << " vs " << R.domain_area << "; largest interface gap " << R.max_gap()
-      << " (" << R.max_gap() / R.diameter << " x diameter); " << seconds << " s";
+    s << "layout " << P.layout << " (" << P.reason << "): " << R.patches.size() << " patches, "
+      << R.layout.cuts.size() << " cuts, " << totals["cells"] << " cells, " << totals["bezier_elements"]
+      << " elements; certified " << (R.certified_valid() ? "valid" : "NOT valid") << " (det J >= "
+      << R.min_relative_det_bound() << " x element mean), min J_r " << R.min_mean_ratio_dense()
+      << " and scaled Jacobian " << R.min_scaled_jacobian_dense() << " (whole map, dense sample); area "
+      << R.map_area << " vs " << R.domain_area << "; largest interface gap " << R.max_gap() << " ("
+      << R.max_gap() / R.diameter << " x diameter); " << seconds << " s";
     std::cout << s.str() << "\nwrote tspline.json (format version 2), surface.vtu, control_net.vtu, "
                             "parametric_tmesh.vtu, physical_tmesh.vtu, boundary.vtu, report.json to "
               << out_dir << std::endl;

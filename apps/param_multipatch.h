@@ -1,17 +1,19 @@
 #pragma once
-// `tspline param` on a domain with holes (or with --cuts): the multi-patch map.
+// `tspline param` on a multi-patch map (a domain with holes, --cuts, or a quad
+// layout chosen by --layout): its outputs and summary.
 #include <string>
 
 #include "progress.h"
-#include "tspline/pipeline/adaptive_parameterization.h"
 #include "tspline/io/gis_reader.h"
+#include "tspline/pipeline/domain_parameterization.h"
 
 namespace tspline_app {
 
-/// Runs the multi-patch parameterization and writes its outputs; returns the
-/// exit code (0, or 3 if some patch is not certified valid).
-int run_multipatch_param(const tspline::io::DomainInput& domain, const std::string& input, const std::string& out_dir,
-                         const std::string& cuts_file, const tspline::ParameterizationOptions& options,
-                         const tspline::AdaptiveOptions& adaptive, int samples, Progress& progress);
+/// Writes the outputs of a multi-patch parameterization (`P.patches`) and
+/// prints its summary; returns the exit code (0, or 3 if the map is not
+/// watertight or some patch is not certified valid).
+int write_multipatch_param(const tspline::DomainParameterization& P, const tspline::io::DomainInput& domain,
+                           const std::string& input, const std::string& out_dir,
+                           const tspline::AdaptiveOptions& adaptive, int samples, double seconds, Progress& progress);
 
 }  // namespace tspline_app

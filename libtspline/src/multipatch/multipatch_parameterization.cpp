@@ -3,8 +3,12 @@
 #include <Eigen/LU>
 
 #include <algorithm>
+#include <atomic>
+#include <exception>
 #include <limits>
+#include <mutex>
 #include <set>
+#include <thread>
 
 #include "tspline/multipatch/automatic_cuts.h"
 #include "tspline/spline/bezier_extraction.h"
@@ -71,6 +75,12 @@ double MultiPatchResult::min_relative_det_bound() const {
 double MultiPatchResult::min_mean_ratio_dense() const {
   double m = std::numeric_limits<double>::infinity();
   for (const auto& r : patches) m = std::min(m, r.dense_quality.min_mean_ratio);
+  return m;
+}
+
+double MultiPatchResult::min_scaled_jacobian_dense() const {
+  double m = std::numeric_limits<double>::infinity();
+  for (const auto& r : patches) m = std::min(m, r.dense_quality.min_scaled);
   return m;
 }
 
@@ -147,18 +157,27 @@ MultiPatchResult run_multipatch_parameterization(const Domain& input, const std:
                                                  const ParameterizationOptions& options,
                                                  const AdaptiveOptions& adaptive, const MultiPatchOptions& multi,
                                                  const PatchCallback& on_patch) {
+  const Domain domain = validate_domain(input);
+  if (cuts) return run_multipatch_parameterization(domain, build_patch_layout(domain, *cuts), "given", options,
+                                                   adaptive, multi, on_patch);
+  AutomaticCuts a = automatic_cuts(domain);
+  PatchLayout layout = build_patch_layout(domain, std::move(a.cuts));
+  return run_multipatch_parameterization(domain, std::move(layout), "automatic: " + a.explanation, options, adaptive,
+                                         multi, on_patch);
+}
+
+MultiPatchResult run_multipatch_parameterization(const Domain& domain, PatchLayout layout,
+                                                 const std::string& explanation,
+                                                 const ParameterizationOptions& options,
+                                                 const AdaptiveOptions& adaptive, const MultiPatchOptions& multi,
+                                                 const PatchCallback& on_patch) {
   if (multi.max_sync_rounds < 0) throw InputError("the number of interface rounds must be >= 0");
+  if (multi.threads < 0) throw InputError("the number of threads must be >= 0");
   auto log = [&](const std::string& s) { report_step(options.progress, "patches", s); };
   MultiPatchResult R;
-  R.domain = validate_domain(input);
-  if (cuts) {
-    R.layout = build_patch_layout(R.domain, *cuts);
-    R.cuts_explanation = "given";
-  } else {
-    AutomaticCuts a = automatic_cuts(R.domain);
-    R.layout = build_patch_layout(R.domain, std::move(a.cuts));
-    R.cuts_explanation = "automatic: " + a.explanation;
-  }
+  R.domain = domain;
+  R.layout = std::move(layout);
+  R.cuts_explanation = explanation;
   {
     Eigen::Vector2d lo = R.domain.outer.vertices.front(), hi = lo;
     for (const auto& v : R.domain.outer.vertices) lo = lo.cwiseMin(v), hi = hi.cwiseMax(v);
@@ -168,30 +187,71 @@ MultiPatchResult run_multipatch_parameterization(const Domain& input, const std:
   const std::size_t P = R.layout.patches.size();
   log("patches: " + std::to_string(P) + " four-sided patches, " + std::to_string(R.layout.cuts.size()) + " cuts (" +
       R.cuts_explanation + ")");
+  // Progress events of concurrent patches go through one lock.
+  std::mutex progress_mutex;
+  ParameterizationOptions shared = options;
+  if (options.progress)
+    shared.progress = [cb = options.progress, &progress_mutex](const ProgressEvent& e) {
+      std::lock_guard<std::mutex> lock(progress_mutex);
+      cb(e);
+    };
+  const unsigned threads =
+      multi.threads > 0 ? static_cast<unsigned>(multi.threads) : std::max(1u, std::thread::hardware_concurrency());
 
   std::vector<BorderParams> required(P);
   std::vector<char> stale(P, 1);
+  R.patches.reserve(P);
   for (int round = 0;; ++round) {
-    for (std::size_t p = 0; p < P; ++p) {
-      if (!stale[p]) continue;
-      if (on_patch) on_patch(p, round);
-      ParameterizationOptions po = options;
-      const Patch& patch = R.layout.patches[p];
-      po.corners = std::array<long long, 4>{};
-      for (int k = 0; k < 4; ++k) (*po.corners)[k] = static_cast<long long>(patch.corners[k]);
-      po.corner_trials = 1;
-      po.border_params = required[p];
-      // The patch's events, its text prefixed with the patch.
-      if (options.progress)
-        po.progress = [cb = options.progress, p](const ProgressEvent& e) {
-          ProgressEvent f = e;
-          f.text = "patch " + std::to_string(p) + ": " + e.text;
-          cb(f);
-        };
-      ParameterizationResult run = run_parameterization(patch.polygon, po, adaptive);
-      if (round == 0) R.patches.push_back(std::move(run));  // round 0 runs every patch, in order
-      else R.patches[p] = std::move(run);
-      if (!R.patches[p].map) throw NumericalError("patch " + std::to_string(p) + ": no map was produced");
+    std::vector<std::size_t> todo;
+    for (std::size_t p = 0; p < P; ++p)
+      if (stale[p]) todo.push_back(p);
+    std::vector<std::optional<ParameterizationResult>> runs(todo.size());
+    std::atomic<std::size_t> next{0};
+    std::atomic<bool> failed{false};
+    std::exception_ptr error;
+    std::mutex error_mutex;
+    auto work = [&]() {
+      for (std::size_t i; !failed && (i = next++) < todo.size();) {
+        const std::size_t p = todo[i];
+        try {
+          if (on_patch) {
+            std::lock_guard<std::mutex> lock(progress_mutex);
+            on_patch(p, round);
+          }
+          ParameterizationOptions po = shared;
+          const Patch& patch = R.layout.patches[p];
+          po.corners = std::array<long long, 4>{};
+          for (int k = 0; k < 4; ++k) (*po.corners)[k] = static_cast<long long>(patch.corners[k]);
+          po.corner_trials = 1;
+          po.border_params = required[p];
+          // The patch's events, its text prefixed with the patch.
+          if (shared.progress)
+            po.progress = [cb = shared.progress, p](const ProgressEvent& e) {
+              ProgressEvent f = e;
+              f.text = "patch " + std::to_string(p) + ": " + e.text;
+              cb(f);
+            };
+          runs[i].emplace(run_parameterization(patch.polygon, po, adaptive));
+          if (!runs[i]->map) throw NumericalError("patch " + std::to_string(p) + ": no map was produced");
+        } catch (...) {
+          std::lock_guard<std::mutex> lock(error_mutex);
+          if (!error) error = std::current_exception();
+          failed = true;
+        }
+      }
+    };
+    const unsigned n = static_cast<unsigned>(std::min<std::size_t>(threads, todo.size()));
+    if (n <= 1) work();
+    else {
+      std::vector<std::thread> pool;
+      for (unsigned t = 0; t < n; ++t) pool.emplace_back(work);
+      for (std::thread& t : pool) t.join();
+    }
+    if (error) std::rethrow_exception(error);
+    for (std::size_t i = 0; i < todo.size(); ++i) {
+      const std::size_t p = todo[i];
+      if (round == 0) R.patches.push_back(std::move(*runs[i]));  // round 0 runs every patch, in order
+      else R.patches[p] = std::move(*runs[i]);
       stale[p] = 0;
     }
     // Interfaces: gaps and knots.

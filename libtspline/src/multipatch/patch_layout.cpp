@@ -80,7 +80,7 @@ struct Graph {
   std::vector<std::vector<int>> outgoing;
 };
 
-Graph build_graph(const Domain& d, const std::vector<Cut>& cuts) {
+Graph build_graph(const Domain& d, const std::vector<Cut>& cuts, const std::vector<Eigen::Vector2d>& ring_corners) {
   Graph g;
   const double tol = snap_tolerance(d);
   // Ring vertices first (ring r, vertex i -> ring_first[r] + i).
@@ -93,15 +93,31 @@ Graph build_graph(const Domain& d, const std::vector<Cut>& cuts) {
   // Cut ends: an end of an earlier cut, a ring vertex, or a new vertex on a ring edge.
   std::map<std::pair<std::size_t, std::size_t>, std::vector<std::pair<double, int>>> inserted;
   std::vector<std::vector<int>> cut_ids(cuts.size());
-  std::vector<int> ends;
+  // Ends found so far, by a grid of cells of size tol (a match lies in one of the 3 x 3 cells around).
+  std::map<std::pair<long long, long long>, std::vector<int>> ends;
+  auto cell_of = [&](const Eigen::Vector2d& p) {
+    return std::pair<long long, long long>(static_cast<long long>(std::floor(p.x() / tol)),
+                                           static_cast<long long>(std::floor(p.y() / tol)));
+  };
   auto end_id = [&](const Eigen::Vector2d& p) {
-    for (int e : ends)
-      if ((g.points[e] - p).norm() <= tol) return e;
+    const auto [ci, cj] = cell_of(p);
+    for (long long i = ci - 1; i <= ci + 1; ++i)
+      for (long long j = cj - 1; j <= cj + 1; ++j) {
+        auto it = ends.find({i, j});
+        if (it == ends.end()) continue;
+        for (int e : it->second)
+          if ((g.points[e] - p).norm() <= tol) return e;
+      }
     const RingHit h = closest_ring_point(d, p);
     const auto& v = ring(d, h.ring).vertices;
     const Eigen::Vector2d a = v[h.edge], b = v[(h.edge + 1) % v.size()];
     int id;
-    if ((a - p).norm() <= tol) id = static_cast<int>(ring_first[h.ring] + h.edge);
+    if (h.distance > tol) {
+      // Inside the domain: a node where cuts meet (the first of them to arrive here).
+      id = static_cast<int>(g.points.size());
+      g.points.push_back(p);
+      g.is_node.push_back(0);
+    } else if ((a - p).norm() <= tol) id = static_cast<int>(ring_first[h.ring] + h.edge);
     else if ((b - p).norm() <= tol) id = static_cast<int>(ring_first[h.ring] + (h.edge + 1) % v.size());
     else {
       id = static_cast<int>(g.points.size());
@@ -110,9 +126,10 @@ Graph build_graph(const Domain& d, const std::vector<Cut>& cuts) {
       inserted[{h.ring, h.edge}].push_back({h.s, id});
     }
     g.is_node[id] = 1;
-    ends.push_back(id);
+    ends[cell_of(p)].push_back(id);
     return id;
   };
+  for (const Eigen::Vector2d& p : ring_corners) end_id(p);
   for (std::size_t c = 0; c < cuts.size(); ++c) {
     cut_ids[c].push_back(end_id(cuts[c].front()));
     for (std::size_t k = 1; k + 1 < cuts[c].size(); ++k) {
@@ -170,8 +187,9 @@ int next_half_edge(const Graph& g, int h) {
 }
 
 // Faces with their vertex ids (for the simplicity check).
-std::vector<std::pair<LayoutFace, std::vector<int>>> faces_with_ids(const Domain& d, const std::vector<Cut>& cuts) {
-  const Graph g = build_graph(d, cuts);
+std::vector<std::pair<LayoutFace, std::vector<int>>> faces_with_ids(const Domain& d, const std::vector<Cut>& cuts,
+                                                                    const std::vector<Eigen::Vector2d>& ring_corners) {
+  const Graph g = build_graph(d, cuts, ring_corners);
   std::vector<char> seen(g.half_edges.size(), 0);
   std::vector<std::pair<LayoutFace, std::vector<int>>> out;
   for (std::size_t h0 = 0; h0 < g.half_edges.size(); ++h0) {
@@ -221,14 +239,26 @@ std::string face_name(const LayoutFace& f) {
 
 std::size_t LayoutFace::nodes() const { return static_cast<std::size_t>(std::count(is_node.begin(), is_node.end(), 1)); }
 
-std::vector<LayoutFace> layout_faces(const Domain& domain, const std::vector<Cut>& cuts) {
+std::vector<LayoutFace> layout_faces(const Domain& domain, const std::vector<Cut>& cuts,
+                                     const std::vector<Eigen::Vector2d>& ring_corners) {
   std::vector<LayoutFace> out;
-  for (auto& [f, ids] : faces_with_ids(domain, cuts)) out.push_back(std::move(f));
+  for (auto& [f, ids] : faces_with_ids(domain, cuts, ring_corners)) out.push_back(std::move(f));
   return out;
 }
 
 void validate_cuts(const Domain& d, const std::vector<Cut>& cuts) {
   const double tol = snap_tolerance(d);
+  // The cuts' ends by cells of size tol (a match lies in one of the 3 x 3 cells around a point).
+  auto end_cell = [&](const Eigen::Vector2d& p) {
+    return std::pair<long long, long long>(static_cast<long long>(std::floor(p.x() / tol)),
+                                           static_cast<long long>(std::floor(p.y() / tol)));
+  };
+  std::map<std::pair<long long, long long>, std::vector<std::pair<std::size_t, Eigen::Vector2d>>> end_cells;
+  for (std::size_t c = 0; c < cuts.size(); ++c)
+    if (!cuts[c].empty() && cuts[c].front().allFinite() && cuts[c].back().allFinite()) {
+      end_cells[end_cell(cuts[c].front())].push_back({c, cuts[c].front()});
+      end_cells[end_cell(cuts[c].back())].push_back({c, cuts[c].back()});
+    }
   for (std::size_t c = 0; c < cuts.size(); ++c) {
     const std::string name = "cut " + std::to_string(c + 1);
     if (cuts[c].size() < 2) throw InputError(name + " has fewer than two points");
@@ -239,8 +269,14 @@ void validate_cuts(const Domain& d, const std::vector<Cut>& cuts) {
         throw InputError(name + " repeats its point " + fmt(cuts[c][k]));
     for (const Eigen::Vector2d& end : {cuts[c].front(), cuts[c].back()}) {
       bool at_cut_end = false;
-      for (std::size_t o = 0; o < cuts.size(); ++o)
-        if (o != c && ((cuts[o].front() - end).norm() <= tol || (cuts[o].back() - end).norm() <= tol)) at_cut_end = true;
+      const auto [ci, cj] = end_cell(end);
+      for (long long i = ci - 1; i <= ci + 1 && !at_cut_end; ++i)
+        for (long long j = cj - 1; j <= cj + 1 && !at_cut_end; ++j) {
+          auto it = end_cells.find({i, j});
+          if (it == end_cells.end()) continue;
+          for (const auto& [o, p] : it->second)
+            if (o != c && (p - end).norm() <= tol) at_cut_end = true;
+        }
       if (!at_cut_end && closest_ring_point(d, end).distance > tol)
         throw InputError(name + ": its end " + fmt(end) + " lies neither on a ring nor at an end of another cut");
     }
@@ -281,37 +317,60 @@ void validate_cuts(const Domain& d, const std::vector<Cut>& cuts) {
     }
   }
   // Cuts against cuts (and a cut against itself): they may share ends only.
+  // Segments swept in order of their smallest x, each tested against the
+  // active ones whose boxes overlap its own.
+  struct Seg {
+    std::size_t c, k;
+    CGAL::Bbox_2 box;
+  };
+  std::vector<Seg> segs;
   for (std::size_t c = 0; c < cuts.size(); ++c)
-    for (std::size_t o = c; o < cuts.size(); ++o)
-      for (std::size_t k = 0; k + 1 < cuts[c].size(); ++k)
-        for (std::size_t l = (o == c ? k + 1 : 0); l + 1 < cuts[o].size(); ++l) {
-          const CSegment s(cpoint(cuts[c][k]), cpoint(cuts[c][k + 1]));
-          const CSegment t(cpoint(cuts[o][l]), cpoint(cuts[o][l + 1]));
-          if (!CGAL::do_intersect(s, t)) continue;
-          // Shared points allowed: consecutive segments of one cut, and common ends of two cuts.
-          std::vector<Eigen::Vector2d> shared;
-          if (o == c && l == k + 1) shared.push_back(cuts[c][k + 1]);
-          if (o != c && k == 0) shared.push_back(cuts[c].front());
-          if (o != c && k + 2 == cuts[c].size()) shared.push_back(cuts[c].back());
-          bool allowed = false;
-          for (const auto& e : shared) {
-            const auto hit = CGAL::intersection(s, t);
-            const CPoint* q = hit ? boost::get<CPoint>(&*hit) : nullptr;
-            if (q && (Eigen::Vector2d(q->x(), q->y()) - e).norm() <= tol) allowed = true;
-          }
-          if (allowed) continue;
-          const Eigen::Vector2d at = 0.5 * (cuts[c][k] + cuts[c][k + 1]);
-          if (o == c) throw InputError("cut " + std::to_string(c + 1) + " crosses itself near " + fmt(at));
-          throw InputError("cuts " + std::to_string(c + 1) + " and " + std::to_string(o + 1) + " cross near " +
-                           fmt(at) + " (cuts may meet only at their ends)");
-        }
+    for (std::size_t k = 0; k + 1 < cuts[c].size(); ++k)
+      segs.push_back({c, k, CSegment(cpoint(cuts[c][k]), cpoint(cuts[c][k + 1])).bbox()});
+  std::sort(segs.begin(), segs.end(), [](const Seg& a, const Seg& b) { return a.box.xmin() < b.box.xmin(); });
+  std::vector<std::size_t> active;
+  for (std::size_t i = 0; i < segs.size(); ++i) {
+    std::erase_if(active, [&](std::size_t j) { return segs[j].box.xmax() < segs[i].box.xmin() - tol; });
+    for (std::size_t j : active) {
+      const Seg &x = segs[i], &y = segs[j];
+      if (!CGAL::do_overlap(x.box + CGAL::Bbox_2(x.box.xmin() - tol, x.box.ymin() - tol, x.box.xmax() + tol,
+                                                  x.box.ymax() + tol), y.box))
+        continue;
+      // Order as the old double loop did: (c, k) before (o, l).
+      const bool first = x.c < y.c || (x.c == y.c && x.k < y.k);
+      const std::size_t c = first ? x.c : y.c, k = first ? x.k : y.k, o = first ? y.c : x.c, l = first ? y.k : x.k;
+      const CSegment s(cpoint(cuts[c][k]), cpoint(cuts[c][k + 1]));
+      const CSegment t(cpoint(cuts[o][l]), cpoint(cuts[o][l + 1]));
+      if (!CGAL::do_intersect(s, t)) continue;
+      // Shared points allowed: consecutive segments of one cut, and common ends of two cuts.
+      std::vector<Eigen::Vector2d> shared;
+      if (o == c && l == k + 1) shared.push_back(cuts[c][k + 1]);
+      if (o != c && k == 0) shared.push_back(cuts[c].front());
+      if (o != c && k + 2 == cuts[c].size()) shared.push_back(cuts[c].back());
+      bool allowed = false;
+      for (const auto& e : shared) {
+        const auto hit = CGAL::intersection(s, t);
+        const CPoint* q = hit ? boost::get<CPoint>(&*hit) : nullptr;
+        if (q && (Eigen::Vector2d(q->x(), q->y()) - e).norm() <= tol) allowed = true;
+      }
+      if (allowed) continue;
+      const Eigen::Vector2d at = 0.5 * (cuts[c][k] + cuts[c][k + 1]);
+      if (o == c) throw InputError("cut " + std::to_string(c + 1) + " crosses itself near " + fmt(at));
+      throw InputError("cuts " + std::to_string(c + 1) + " and " + std::to_string(o + 1) + " cross near " + fmt(at) +
+                       " (cuts may meet only at their ends)");
+    }
+    active.push_back(i);
+  }
 }
 
-PatchLayout build_patch_layout(const Domain& d, std::vector<Cut> cuts) {
+PatchLayout build_patch_layout(const Domain& d, std::vector<Cut> cuts, const std::vector<Eigen::Vector2d>& ring_corners) {
   validate_cuts(d, cuts);
+  for (const Eigen::Vector2d& p : ring_corners)
+    if (!p.allFinite() || closest_ring_point(d, p).distance > snap_tolerance(d))
+      throw InputError("the patch corner " + fmt(p) + " does not lie on a ring");
   PatchLayout L;
   L.cuts = std::move(cuts);
-  for (auto& [f, ids] : faces_with_ids(d, L.cuts)) {
+  for (auto& [f, ids] : faces_with_ids(d, L.cuts, ring_corners)) {
     const std::size_t n = f.points.size();
     double area2 = 0.0;
     for (std::size_t i = 0; i < n; ++i) area2 += cross(f.points[i], f.points[(i + 1) % n]);
@@ -355,11 +414,12 @@ PatchLayout build_patch_layout(const Domain& d, std::vector<Cut> cuts) {
     }
     L.patches.push_back(std::move(p));
   }
+  std::vector<std::vector<std::pair<std::size_t, int>>> sides_of(L.cuts.size());
+  for (std::size_t q = 0; q < L.patches.size(); ++q)
+    for (int k = 0; k < 4; ++k)
+      if (L.patches[q].side_cut[k] >= 0) sides_of[L.patches[q].side_cut[k]].push_back({q, k});
   for (std::size_t c = 0; c < L.cuts.size(); ++c) {
-    std::vector<std::pair<std::size_t, int>> sides;
-    for (std::size_t q = 0; q < L.patches.size(); ++q)
-      for (int k = 0; k < 4; ++k)
-        if (L.patches[q].side_cut[k] == static_cast<int>(c)) sides.push_back({q, k});
+    const auto& sides = sides_of[c];
     if (sides.size() != 2)
       throw InputError("cut " + std::to_string(c + 1) + " is not the side of two patches");
     L.interfaces.push_back({c, sides[0].first, sides[1].first, sides[0].second, sides[1].second});

@@ -28,6 +28,8 @@ struct MultiPatchOptions {
   /// An interface conforms when its two images differ by at most this times
   /// the domain's bounding-box diagonal (sampled at the knots and between).
   double gap_tolerance = 1e-12;
+  /// Patches run concurrently on this many threads (0: one per core).
+  int threads = 0;
 };
 
 struct InterfaceReport {
@@ -53,6 +55,7 @@ struct MultiPatchResult {
   double min_relative_det_bound() const;  ///< min over patches of the certified relative lower bound
   double min_mean_ratio_dense() const;    ///< min over patches of J_r over the dense sample
   double min_mean_ratio_gauss() const;    ///< min over patches of J_r at Gauss points
+  double min_scaled_jacobian_dense() const;  ///< min over patches of the scaled Jacobian over the dense sample
 };
 
 /// Area of the image of the map: the integral of det J over [0,1]^2 (4 x 4
@@ -73,6 +76,15 @@ using PatchCallback = std::function<void(std::size_t patch, int round)>;
 /// \throw InputError for an invalid domain or cuts, or no automatic layout;
 /// NumericalError as run_parameterization.
 MultiPatchResult run_multipatch_parameterization(const Domain& domain, const std::optional<std::vector<Cut>>& cuts,
+                                                 const ParameterizationOptions& options,
+                                                 const AdaptiveOptions& adaptive, const MultiPatchOptions& multi = {},
+                                                 const PatchCallback& on_patch = {});
+
+/// The same on a layout already built (patch_layout.h, quad_layout.h);
+/// `explanation` says how it was made, for the report.
+/// \pre `domain` is validated and `layout` is a layout of it.
+MultiPatchResult run_multipatch_parameterization(const Domain& domain, PatchLayout layout,
+                                                 const std::string& explanation,
                                                  const ParameterizationOptions& options,
                                                  const AdaptiveOptions& adaptive, const MultiPatchOptions& multi = {},
                                                  const PatchCallback& on_patch = {});

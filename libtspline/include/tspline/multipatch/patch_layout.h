@@ -36,7 +36,9 @@ struct LayoutFace {
 
 /// The faces of the graph inside the domain.
 /// \pre `domain` is validated (validate_domain), `cuts` are valid (validate_cuts).
-std::vector<LayoutFace> layout_faces(const Domain& domain, const std::vector<Cut>& cuts);
+/// `ring_corners`: points on rings that are nodes although no cut ends there.
+std::vector<LayoutFace> layout_faces(const Domain& domain, const std::vector<Cut>& cuts,
+                                     const std::vector<Eigen::Vector2d>& ring_corners = {});
 
 /// Checks the cuts against the domain and each other.
 /// \throw InputError naming the cut(s) and ring edges: fewer than two points or
@@ -71,6 +73,9 @@ struct PatchLayout {
 /// \throw InputError as validate_cuts, or naming the face: not simply
 /// connected or pinched (a hole with a single cut), more than four nodes, or
 /// fewer than four corners with no convex ring vertex to complete them.
-PatchLayout build_patch_layout(const Domain& domain, std::vector<Cut> cuts);
+/// `ring_corners`: points on rings that are patch corners although no cut ends
+/// there (a quad layout's corner at a sharp tip); InputError if one is off the rings.
+PatchLayout build_patch_layout(const Domain& domain, std::vector<Cut> cuts,
+                               const std::vector<Eigen::Vector2d>& ring_corners = {});
 
 }  // namespace tspline

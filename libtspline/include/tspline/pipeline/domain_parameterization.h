@@ -1,0 +1,63 @@
+#pragma once
+// The parameterization of any domain, with the choice of its layout:
+//   single: one patch, the whole domain mapped onto the unit square
+//           (run_parameterization; domains without holes only);
+//   quad:   an automatic quad layout (layout/quad_layout.h), every patch a
+//           map of its own, interfaces conforming (run_multipatch_parameterization);
+//   cuts:   the layout given by cuts (patch_layout.h);
+//   auto:   one patch where a first try (at most 3 adaptive rounds) is
+//           certified and good over the whole map (scaled Jacobian >= 0.3
+//           and J_r >= 0.1 over the dense sample), the quad layout otherwise
+//           and always for domains with holes. Without a quad mesher in the
+//           build, domains with holes fall back to the automatic cuts
+//           (automatic_cuts.h) and domains without keep the single patch.
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "tspline/boundary/domain.h"
+#include "tspline/layout/quad_layout.h"
+#include "tspline/multipatch/multipatch_parameterization.h"
+#include "tspline/pipeline/adaptive_parameterization.h"
+
+namespace tspline {
+
+enum class LayoutMode { Auto, Single, Quad };
+
+/// "auto", "single", "quad"; InputError naming the choices otherwise.
+LayoutMode parse_layout_mode(const std::string& name);
+const char* layout_mode_name(LayoutMode mode);
+
+struct DomainParameterizationOptions {
+  LayoutMode layout = LayoutMode::Auto;
+  /// Given cuts (then `layout` must be Auto or Quad; the cuts are the layout).
+  std::optional<std::vector<Cut>> cuts;
+  QuadLayoutOptions quad;
+  MultiPatchOptions multi;
+  /// Auto: a single patch is kept when its whole map reaches both.
+  double good_scaled_jacobian = 0.3;
+  double good_mean_ratio = 0.1;
+  /// Auto: adaptive rounds of the single-patch first try at most.
+  int first_try_rounds = 3;
+};
+
+struct DomainParameterization {
+  std::string layout;  ///< "single", "quad", "cuts" or "automatic cuts"
+  std::string reason;  ///< why this layout, for the report
+  std::optional<ParameterizationResult> single;
+  std::optional<MultiPatchResult> patches;
+  std::optional<QuadLayoutStats> quad_stats;
+  /// The single-patch first try of `auto` that was not kept (whole-map figures), if any.
+  std::optional<DenseMapQuality> rejected_single;
+};
+
+/// \param on_iteration for the single-patch run (as run_parameterization's).
+/// \throw InputError for invalid input or options; NumericalError as the runs.
+DomainParameterization parameterize_domain(const Domain& domain, const ParameterizationOptions& options,
+                                           const AdaptiveOptions& adaptive,
+                                           const DomainParameterizationOptions& choice = {},
+                                           const IterationCallback& on_iteration = {},
+                                           const PatchCallback& on_patch = {});
+
+}  // namespace tspline

@@ -1,0 +1,309 @@
+#include "tspline/layout/quad_layout.h"
+
+#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <map>
+#include <set>
+#include <sstream>
+
+#include "tspline/errors.h"
+#include "tspline/layout/quad_mesher.h"
+
+namespace tspline {
+namespace {
+
+using K = CGAL::Exact_predicates_inexact_constructions_kernel;
+
+double cross(const Eigen::Vector2d& a, const Eigen::Vector2d& b) { return a.x() * b.y() - a.y() * b.x(); }
+
+K::Point_2 cp(const Eigen::Vector2d& p) { return {p.x(), p.y()}; }
+
+bool segments_intersect(const Eigen::Vector2d& a, const Eigen::Vector2d& b, const Eigen::Vector2d& c,
+                        const Eigen::Vector2d& d) {
+  return CGAL::do_intersect(K::Segment_2(cp(a), cp(b)), K::Segment_2(cp(c), cp(d)));
+}
+
+// Ring edges bucketed on a uniform grid, for segment and point queries.
+class EdgeGrid {
+ public:
+  struct Edge {
+    Eigen::Vector2d a, b;
+    int ring;
+    std::size_t index;  // edge index in the ring (from vertex index to index + 1)
+  };
+  EdgeGrid(std::vector<Edge> edges, const Eigen::Vector2d& lo, const Eigen::Vector2d& hi) : edges_(std::move(edges)) {
+    const double n = std::max(8.0, std::sqrt(static_cast<double>(edges_.size())));
+    cell_ = std::max((hi - lo).maxCoeff() / n, 1e-300);
+    lo_ = lo - Eigen::Vector2d::Constant(cell_);
+    nx_ = static_cast<int>((hi.x() - lo_.x()) / cell_) + 2;
+    ny_ = static_cast<int>((hi.y() - lo_.y()) / cell_) + 2;
+    cells_.assign(static_cast<std::size_t>(nx_) * ny_, {});
+    for (std::size_t e = 0; e < edges_.size(); ++e)
+      for_cells(edges_[e].a.cwiseMin(edges_[e].b), edges_[e].a.cwiseMax(edges_[e].b),
+                [&](std::vector<int>& c) { c.push_back(static_cast<int>(e)); });
+  }
+  const Edge& edge(int e) const { return edges_[e]; }
+  /// Edges whose cells meet the box [lo, hi], each once.
+  std::vector<int> near(const Eigen::Vector2d& lo, const Eigen::Vector2d& hi) const {
+    std::vector<int> out;
+    for_cells(lo, hi, [&](const std::vector<int>& c) { out.insert(out.end(), c.begin(), c.end()); });
+    std::sort(out.begin(), out.end());
+    out.erase(std::unique(out.begin(), out.end()), out.end());
+    return out;
+  }
+  /// Crossings of the ray from p in +x with the edges (the parity says inside or not).
+  int ray_crossings(const Eigen::Vector2d& p) const {
+    const int j = std::clamp(static_cast<int>((p.y() - lo_.y()) / cell_), 0, ny_ - 1);
+    const int i0 = std::clamp(static_cast<int>((p.x() - lo_.x()) / cell_), 0, nx_ - 1);
+    std::set<int> seen;
+    int count = 0;
+    for (int i = i0; i < nx_; ++i)
+      for (int e : cells_[static_cast<std::size_t>(j) * nx_ + i]) {
+        if (!seen.insert(e).second) continue;
+        const Eigen::Vector2d &a = edges_[e].a, &b = edges_[e].b;
+        if ((a.y() > p.y()) == (b.y() > p.y())) continue;
+        const double x = a.x() + (p.y() - a.y()) / (b.y() - a.y()) * (b.x() - a.x());
+        if (x > p.x()) ++count;
+      }
+    return count;
+  }
+
+ private:
+  template <class F>
+  void for_cells(const Eigen::Vector2d& lo, const Eigen::Vector2d& hi, F&& f) const {
+    const int i0 = std::clamp(static_cast<int>((lo.x() - lo_.x()) / cell_), 0, nx_ - 1);
+    const int i1 = std::clamp(static_cast<int>((hi.x() - lo_.x()) / cell_), 0, nx_ - 1);
+    const int j0 = std::clamp(static_cast<int>((lo.y() - lo_.y()) / cell_), 0, ny_ - 1);
+    const int j1 = std::clamp(static_cast<int>((hi.y() - lo_.y()) / cell_), 0, ny_ - 1);
+    for (int j = j0; j <= j1; ++j)
+      for (int i = i0; i <= i1; ++i) f(const_cast<std::vector<int>&>(cells_[static_cast<std::size_t>(j) * nx_ + i]));
+  }
+  std::vector<Edge> edges_;
+  std::vector<std::vector<int>> cells_;
+  Eigen::Vector2d lo_;
+  double cell_ = 1.0;
+  int nx_ = 1, ny_ = 1;
+};
+
+// Distance of p from the segment [a, b].
+double segment_distance(const Eigen::Vector2d& p, const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
+  const Eigen::Vector2d ab = b - a;
+  const double l2 = ab.squaredNorm();
+  const double t = l2 > 0.0 ? std::clamp((p - a).dot(ab) / l2, 0.0, 1.0) : 0.0;
+  return (a + t * ab - p).norm();
+}
+
+// The piece (index into nodes) of ring arc length s.
+std::size_t piece_of(const std::vector<double>& nodes, double s) {
+  const auto it = std::upper_bound(nodes.begin(), nodes.end(), s);
+  return it == nodes.begin() ? nodes.size() - 1 : static_cast<std::size_t>(it - nodes.begin()) - 1;
+}
+
+// A node more on piece k of a ring: its vertex farthest from the chord, or its middle.
+void split_piece(const RingCurve& ring, std::vector<double>& nodes, std::size_t k) {
+  const double L = ring.length();
+  const double a = nodes[k], b = k + 1 < nodes.size() ? nodes[k + 1] : nodes.front() + L;
+  const auto [dev, at] = ring.farthest_from_chord(a, b);
+  double s = 0.5 * (a + b);
+  if (at > 0.0 && dev > 1e-3 * (ring.point(b) - ring.point(a)).norm() && at - a > 0.1 * (b - a) && b - at > 0.1 * (b - a))
+    s = at;
+  nodes.push_back(std::fmod(s, L));
+  std::sort(nodes.begin(), nodes.end());
+  nodes.erase(std::unique(nodes.begin(), nodes.end()), nodes.end());
+}
+
+}  // namespace
+
+double quad_corner_scaled_jacobian(const std::array<Eigen::Vector2d, 4>& q) {
+  double m = 1.0;
+  for (int j = 0; j < 4; ++j) {
+    const Eigen::Vector2d e1 = q[(j + 1) % 4] - q[j], e2 = q[(j + 3) % 4] - q[j];
+    const double l = e1.norm() * e2.norm();
+    m = std::min(m, l > 0.0 ? cross(e1, e2) / l : -1.0);
+  }
+  return m;
+}
+
+std::string QuadLayout::explanation() const {
+  std::ostringstream s;
+  s << "quad layout: " << stats.patches << " patches, " << stats.ring_nodes << " nodes on the rings, "
+    << stats.inner_nodes << " inside (valence";
+  for (std::size_t v = 0; v < stats.valence.size(); ++v)
+    if (stats.valence[v]) s << ' ' << v << (v == 7 ? "+" : "") << ": " << stats.valence[v];
+  s << "), straight-sided scaled Jacobian min " << stats.min_corner_scaled_jacobian << " mean "
+    << stats.mean_corner_scaled_jacobian;
+  return s.str();
+}
+
+QuadLayout build_quad_layout(const Domain& d, const QuadLayoutOptions& o) {
+  const auto t0 = std::chrono::steady_clock::now();
+  if (!quad_mesher_available()) quad_mesh({}, {});  // throws the InputError that explains it
+  Eigen::Vector2d lo = d.outer.vertices.front(), hi = lo;
+  for (const auto& v : d.outer.vertices) lo = lo.cwiseMin(v), hi = hi.cwiseMax(v);
+  const double diam = (hi - lo).norm();
+  SizeFieldOptions so = o.size;
+  if (!(so.min_size > 0.0)) so.min_size = o.min_size_fraction * diam;
+  const SizeField h(d, so);
+  // Ring pieces are two quad edges long.
+  auto piece_size = [&h](const Eigen::Vector2d& x) { return 2.0 * h(x); };
+
+  std::vector<RingCurve> rings = {RingCurve(d.outer.vertices)};
+  for (const Polygon& p : d.holes) rings.emplace_back(p.vertices);
+  RingNodeOptions no = o.nodes;
+  if (!(no.min_size > 0.0)) no.min_size = so.min_size;
+  std::vector<std::vector<double>> nodes;
+  for (const RingCurve& r : rings) nodes.push_back(ring_nodes(r, no, piece_size));
+
+  std::vector<EdgeGrid::Edge> edges;
+  for (std::size_t r = 0; r < rings.size(); ++r)
+    for (std::size_t i = 0; i < rings[r].size(); ++i)
+      edges.push_back({rings[r].vertex(i), rings[r].vertex(i + 1), static_cast<int>(r), i});
+  const EdgeGrid grid(std::move(edges), lo, hi);
+  const double tol = 1e-9 * diam;
+
+  QuadLayout out;
+  for (int round = 0;; ++round) {
+    if (round > o.max_repair_rounds)
+      throw NumericalError("no quad layout found: the layout still crosses the boundary after " +
+                           std::to_string(o.max_repair_rounds) + " rounds of adding nodes");
+    std::vector<std::set<std::size_t>> to_split(rings.size());
+    // The straight rings must be simple and disjoint: chords against chords.
+    std::vector<std::vector<Eigen::Vector2d>> straight(rings.size());
+    std::vector<EdgeGrid::Edge> chords;
+    for (std::size_t r = 0; r < rings.size(); ++r) {
+      for (double s : nodes[r]) straight[r].push_back(rings[r].point(s));
+      for (std::size_t k = 0; k < straight[r].size(); ++k)
+        chords.push_back({straight[r][k], straight[r][(k + 1) % straight[r].size()], static_cast<int>(r), k});
+    }
+    {
+      const EdgeGrid cg(chords, lo, hi);
+      for (std::size_t c = 0; c < chords.size(); ++c) {
+        const auto& e = chords[c];
+        for (int o2 : cg.near(e.a.cwiseMin(e.b), e.a.cwiseMax(e.b))) {
+          if (o2 <= static_cast<int>(c)) continue;
+          const auto& f = cg.edge(o2);
+          const std::size_t n = straight[e.ring].size();
+          const bool adjacent = f.ring == e.ring && (f.index == (e.index + 1) % n || e.index == (f.index + 1) % n);
+          if (adjacent && n > 2) continue;
+          if (segments_intersect(e.a, e.b, f.a, f.b)) {
+            to_split[e.ring].insert(e.index);
+            to_split[f.ring].insert(f.index);
+          }
+        }
+      }
+    }
+    // Chords against the true rings (a chord may cut off a piece of another ring).
+    for (const auto& e : chords)
+      for (int g : grid.near(e.a.cwiseMin(e.b), e.a.cwiseMax(e.b))) {
+        const auto& f = grid.edge(g);
+        if (f.ring == e.ring) continue;
+        if (segments_intersect(e.a, e.b, f.a, f.b)) {
+          to_split[e.ring].insert(e.index);
+          to_split[f.ring].insert(piece_of(nodes[f.ring], rings[f.ring].arc(f.index)));
+        }
+      }
+    auto split_marked = [&]() {
+      bool any = false;
+      for (std::size_t r = 0; r < rings.size(); ++r) {
+        // Split from the last piece down: indices of earlier pieces stay valid.
+        for (auto it = to_split[r].rbegin(); it != to_split[r].rend(); ++it) {
+          split_piece(rings[r], nodes[r], *it);
+          any = true;
+        }
+      }
+      return any;
+    };
+    if (split_marked()) {
+      out.stats.repair_rounds = round + 1;
+      continue;
+    }
+
+    const PlanarQuadMesh m = quad_mesh(straight, h);
+    // Boundary nodes onto the true rings.
+    std::vector<Eigen::Vector2d> x = m.nodes;
+    for (std::size_t n = 0; n < x.size(); ++n) {
+      if (m.ring[n] < 0) continue;
+      const auto& nr = nodes[m.ring[n]];
+      const double L = rings[m.ring[n]].length();
+      const std::size_t k = static_cast<std::size_t>(m.segment[n]);
+      const double a = nr[k], b = k + 1 < nr.size() ? nr[k + 1] : nr.front() + L;
+      x[n] = m.t[n] == 0.0 ? rings[m.ring[n]].point(a) : rings[m.ring[n]].point(a + m.t[n] * (b - a));
+    }
+    // Edges: shared by two quads (inner: cuts) or one (on a ring).
+    std::map<std::pair<int, int>, int> edge_quads;
+    for (const auto& q : m.quads)
+      for (int j = 0; j < 4; ++j) ++edge_quads[{std::min(q[j], q[(j + 1) % 4]), std::max(q[j], q[(j + 1) % 4])}];
+    std::vector<int> inner_degree(x.size(), 0), degree(x.size(), 0);
+    for (const auto& [e, count] : edge_quads) {
+      ++degree[e.first], ++degree[e.second];
+      if (count == 2) ++inner_degree[e.first], ++inner_degree[e.second];
+    }
+    // Checks on the true geometry.
+    auto mark_nearest_piece = [&](const Eigen::Vector2d& p) {
+      double best = std::numeric_limits<double>::infinity();
+      int br = 0;
+      std::size_t be = 0;
+      for (std::size_t r = 0; r < rings.size(); ++r)
+        for (std::size_t i = 0; i < rings[r].size(); ++i) {
+          const double dist = segment_distance(p, rings[r].vertex(i), rings[r].vertex(i + 1));
+          if (dist < best) best = dist, br = static_cast<int>(r), be = i;
+        }
+      to_split[br].insert(piece_of(nodes[br], rings[br].arc(be)));
+    };
+    for (std::size_t n = 0; n < x.size(); ++n)
+      if (m.ring[n] < 0 && grid.ray_crossings(x[n]) % 2 == 0) mark_nearest_piece(x[n]);
+    for (const auto& [e, count] : edge_quads) {
+      if (count != 2) continue;
+      const Eigen::Vector2d a = x[e.first], b = x[e.second];
+      for (int g : grid.near(a.cwiseMin(b), a.cwiseMax(b))) {
+        const auto& f = grid.edge(g);
+        if (!segments_intersect(a, b, f.a, f.b)) continue;
+        // Allowed: the cut's end on this ring edge, the rest of the cut off it.
+        const bool a_on = m.ring[e.first] >= 0 && segment_distance(a, f.a, f.b) <= tol;
+        const bool b_on = m.ring[e.second] >= 0 && segment_distance(b, f.a, f.b) <= tol;
+        if (a_on != b_on) {
+          const Eigen::Vector2d from = a_on ? a + 1e-6 * (b - a) : a, to = b_on ? b + 1e-6 * (a - b) : b;
+          if (!segments_intersect(from, to, f.a, f.b)) continue;
+        }
+        to_split[f.ring].insert(piece_of(nodes[f.ring], rings[f.ring].arc(f.index)));
+      }
+    }
+    if (split_marked()) {
+      out.stats.repair_rounds = round + 1;
+      continue;
+    }
+
+    // The layout: inner edges are cuts, quad corners on rings without cuts are ring corners.
+    std::vector<Cut> cuts;
+    for (const auto& [e, count] : edge_quads)
+      if (count == 2) cuts.push_back({x[e.first], x[e.second]});
+    for (std::size_t n = 0; n < x.size(); ++n)
+      if (m.ring[n] >= 0 && inner_degree[n] == 0 && degree[n] > 0) out.ring_corners.push_back(x[n]);
+    out.layout = build_patch_layout(d, std::move(cuts), out.ring_corners);
+    QuadLayoutStats& st = out.stats;
+    st.patches = out.layout.patches.size();
+    st.min_size = so.min_size;
+    st.max_size = so.max_size > 0.0 ? so.max_size : 0.25 * diam;
+    for (std::size_t n = 0; n < x.size(); ++n) {
+      if (degree[n] == 0) continue;
+      if (m.ring[n] >= 0) ++st.ring_nodes;
+      else ++st.inner_nodes, ++st.valence[std::min(degree[n], 7)];
+    }
+    double sum = 0.0;
+    st.min_corner_scaled_jacobian = 1.0;
+    for (const auto& q : m.quads) {
+      const double sj = quad_corner_scaled_jacobian({x[q[0]], x[q[1]], x[q[2]], x[q[3]]});
+      st.min_corner_scaled_jacobian = std::min(st.min_corner_scaled_jacobian, sj);
+      sum += sj;
+    }
+    st.mean_corner_scaled_jacobian = sum / static_cast<double>(m.quads.size());
+    st.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    return out;
+  }
+}
+
+}  // namespace tspline

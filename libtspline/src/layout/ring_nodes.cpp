@@ -1,0 +1,132 @@
+#include "tspline/layout/ring_nodes.h"
+
+#include <algorithm>
+#include <cmath>
+#include <utility>
+
+namespace tspline {
+
+RingCurve::RingCurve(const std::vector<Eigen::Vector2d>& vertices) : v_(vertices) {
+  arc_.assign(v_.size() + 1, 0.0);
+  for (std::size_t i = 0; i < v_.size(); ++i) arc_[i + 1] = arc_[i] + (v_[(i + 1) % v_.size()] - v_[i]).norm();
+}
+
+Eigen::Vector2d RingCurve::point(double s) const {
+  const double L = length();
+  s = std::fmod(s, L);
+  if (s < 0.0) s += L;
+  // The edge [i, i+1] with arc(i) <= s < arc(i+1).
+  const auto it = std::upper_bound(arc_.begin(), arc_.end(), s);
+  std::size_t i = static_cast<std::size_t>(std::max<std::ptrdiff_t>(0, (it - arc_.begin()) - 1));
+  i = std::min(i, v_.size() - 1);
+  const double len = arc_[i + 1] - arc_[i];
+  const double t = len > 0.0 ? (s - arc_[i]) / len : 0.0;
+  return v_[i] + t * (v_[(i + 1) % v_.size()] - v_[i]);
+}
+
+namespace {
+
+// Distance of p from the segment [a, b].
+double segment_distance(const Eigen::Vector2d& p, const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
+  const Eigen::Vector2d ab = b - a;
+  const double l2 = ab.squaredNorm();
+  const double t = l2 > 0.0 ? std::clamp((p - a).dot(ab) / l2, 0.0, 1.0) : 0.0;
+  return (a + t * ab - p).norm();
+}
+
+}  // namespace
+
+std::pair<double, double> RingCurve::farthest_from_chord(double a, double b) const {
+  const double L = length();
+  const Eigen::Vector2d pa = point(a), pb = point(b);
+  double best = -1.0, at = -1.0;
+  // Vertices with arc length in (a, b), b possibly beyond L (wrapping).
+  const std::size_t n = v_.size();
+  std::size_t i = static_cast<std::size_t>(std::upper_bound(arc_.begin(), arc_.end() - 1, std::fmod(a, L)) - arc_.begin());
+  double offset = a >= L ? L : 0.0;
+  for (std::size_t k = 0; k < n; ++k) {
+    if (i >= n) i -= n, offset += L;
+    const double s = arc_[i] + offset;
+    if (s >= b) break;
+    if (s > a) {
+      const double d = segment_distance(v_[i], pa, pb);
+      if (d > best) best = d, at = s;
+    }
+    ++i;
+  }
+  return {best, at};
+}
+
+std::vector<double> split_long_pieces(const RingCurve& ring, std::vector<double> nodes,
+                                      const std::function<double(const Eigen::Vector2d&)>& size, double min_size) {
+  if (!size || nodes.empty()) return nodes;
+  const double L = ring.length();
+  std::vector<double> out;
+  for (std::size_t k = 0; k < nodes.size(); ++k) {
+    const double a = nodes[k], b = k + 1 < nodes.size() ? nodes[k + 1] : nodes.front() + L;
+    out.push_back(a);
+    const double h = std::max(size(ring.point(0.5 * (a + b))), min_size);
+    const double chord = (ring.point(b) - ring.point(a)).norm();
+    if (!(h > 0.0) || chord <= 1.2 * h) continue;
+    const int pieces = static_cast<int>(std::ceil(chord / h - 0.2));
+    for (int j = 1; j < pieces; ++j) out.push_back(std::fmod(a + (b - a) * j / pieces, L));
+  }
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+std::vector<double> ring_nodes(const RingCurve& ring, const RingNodeOptions& o,
+                               const std::function<double(const Eigen::Vector2d&)>& size) {
+  const double L = ring.length();
+  const std::size_t n = ring.size();
+  // Start from the vertex farthest from vertex 0 and the vertex farthest from that one.
+  auto farthest_vertex = [&](const Eigen::Vector2d& from) {
+    std::size_t best = 0;
+    double d = -1.0;
+    for (std::size_t i = 0; i < n; ++i)
+      if ((ring.vertex(i) - from).squaredNorm() > d) d = (ring.vertex(i) - from).squaredNorm(), best = i;
+    return best;
+  };
+  const std::size_t i0 = farthest_vertex(ring.vertex(0));
+  const std::size_t i1 = farthest_vertex(ring.vertex(i0));
+  std::vector<double> nodes = {ring.arc(std::min(i0, i1)), ring.arc(std::max(i0, i1))};
+  if (nodes[0] == nodes[1]) nodes.pop_back();
+  // Relative Douglas-Peucker on each piece (an explicit stack: pieces can nest deeply).
+  std::vector<double> out;
+  for (std::size_t k = 0; k < nodes.size(); ++k) {
+    const double a = nodes[k], b = k + 1 < nodes.size() ? nodes[k + 1] : nodes.front() + L;
+    std::vector<std::pair<double, double>> stack = {{a, b}};
+    std::vector<double> inside;
+    while (!stack.empty()) {
+      const auto [s, t] = stack.back();
+      stack.pop_back();
+      if (t - s <= o.min_size) continue;
+      const auto [dev, at] = ring.farthest_from_chord(s, t);
+      if (at < 0.0) continue;
+      const double chord = (ring.point(t) - ring.point(s)).norm();
+      if (dev <= o.max_deviation * chord) continue;
+      inside.push_back(at);
+      stack.push_back({s, at});
+      stack.push_back({at, t});
+    }
+    out.push_back(a);
+    for (double s : inside) out.push_back(std::fmod(s, L));
+  }
+  std::sort(out.begin(), out.end());
+  out.erase(std::unique(out.begin(), out.end()), out.end());
+  out = split_long_pieces(ring, std::move(out), size, o.min_size);
+  // At least min_nodes_per_ring: split the longest pieces at half their arc length.
+  while (out.size() < static_cast<std::size_t>(std::max(o.min_nodes_per_ring, 1))) {
+    std::size_t longest = 0;
+    double len = -1.0;
+    for (std::size_t k = 0; k < out.size(); ++k) {
+      const double b = k + 1 < out.size() ? out[k + 1] : out.front() + L;
+      if (b - out[k] > len) len = b - out[k], longest = k;
+    }
+    out.push_back(std::fmod(out[longest] + 0.5 * len, L));
+    std::sort(out.begin(), out.end());
+  }
+  return out;
+}
+
+}  // namespace tspline

@@ -1,0 +1,118 @@
+#include "tspline/pipeline/domain_parameterization.h"
+
+#include <algorithm>
+#include <sstream>
+
+#include "tspline/errors.h"
+#include "tspline/layout/quad_mesher.h"
+#include "tspline/multipatch/automatic_cuts.h"
+
+namespace tspline {
+
+LayoutMode parse_layout_mode(const std::string& name) {
+  if (name == "auto") return LayoutMode::Auto;
+  if (name == "single") return LayoutMode::Single;
+  if (name == "quad") return LayoutMode::Quad;
+  throw InputError("layout '" + name + "' is not one of auto, single, quad");
+}
+
+const char* layout_mode_name(LayoutMode mode) {
+  switch (mode) {
+    case LayoutMode::Auto: return "auto";
+    case LayoutMode::Single: return "single";
+    case LayoutMode::Quad: return "quad";
+  }
+  return "auto";
+}
+
+namespace {
+
+std::string figures(const DenseMapQuality& q) {
+  std::ostringstream s;
+  s.precision(3);
+  s << "scaled Jacobian " << q.min_scaled << ", J_r " << q.min_mean_ratio;
+  return s.str();
+}
+
+}  // namespace
+
+DomainParameterization parameterize_domain(const Domain& input, const ParameterizationOptions& options,
+                                           const AdaptiveOptions& adaptive, const DomainParameterizationOptions& c,
+                                           const IterationCallback& on_iteration, const PatchCallback& on_patch) {
+  if (c.first_try_rounds < 0) throw InputError("the first try's adaptive rounds must be >= 0");
+  const Domain domain = validate_domain(input);
+  const bool holes = !domain.holes.empty();
+  DomainParameterization out;
+  if (c.cuts) {
+    if (c.layout == LayoutMode::Single) throw InputError("cuts make a layout of several patches: not with layout single");
+    out.layout = "cuts";
+    out.reason = "the cuts were given";
+    out.patches.emplace(run_multipatch_parameterization(domain, build_patch_layout(domain, *c.cuts), "given", options,
+                                                        adaptive, c.multi, on_patch));
+    return out;
+  }
+  if (c.layout == LayoutMode::Single && holes)
+    throw InputError("a domain with holes cannot be one patch: use layout auto or quad (or give cuts)");
+  if (c.layout == LayoutMode::Single) {
+    out.layout = "single";
+    out.reason = "layout single was asked for";
+    out.single.emplace(run_parameterization(domain.outer, options, adaptive, on_iteration));
+    return out;
+  }
+  auto run_quad = [&](const std::string& reason) {
+    QuadLayout L = build_quad_layout(domain, c.quad);
+    report_step(options.progress, "layout", L.explanation());
+    out.layout = "quad";
+    out.reason = reason;
+    out.quad_stats = L.stats;
+    out.patches.emplace(
+        run_multipatch_parameterization(domain, std::move(L.layout), L.explanation(), options, adaptive, c.multi, on_patch));
+  };
+  if (c.layout == LayoutMode::Quad) {
+    run_quad("layout quad was asked for");
+    return out;
+  }
+  // Auto.
+  if (holes) {
+    if (quad_mesher_available()) {
+      run_quad("the domain has holes");
+      return out;
+    }
+    AutomaticCuts a = automatic_cuts(domain);
+    out.layout = "automatic cuts";
+    out.reason = "the domain has holes, and this build has no quad mesher";
+    out.patches.emplace(run_multipatch_parameterization(domain, build_patch_layout(domain, std::move(a.cuts)),
+                                                        "automatic: " + a.explanation, options, adaptive, c.multi,
+                                                        on_patch));
+    return out;
+  }
+  AdaptiveOptions first = adaptive;
+  first.max_adapt = std::min(adaptive.max_adapt, c.first_try_rounds);
+  ParameterizationResult single = run_parameterization(domain.outer, options, first, on_iteration);
+  const DenseMapQuality& q = single.dense_quality;
+  const bool certified = !adaptive.certify || single.certified_valid();
+  const bool good = certified && single.map && q.min_scaled >= c.good_scaled_jacobian &&
+                    q.min_mean_ratio >= c.good_mean_ratio;
+  // A first try cut short by its round limit is run again in full, so that
+  // auto gives what layout single gives wherever it keeps one patch.
+  const bool cut_short = first.max_adapt < adaptive.max_adapt &&
+                         single.stop_reason.rfind("reached --max-adapt", 0) == 0;
+  if ((good || !quad_mesher_available()) && cut_short)
+    single = run_parameterization(domain.outer, options, adaptive, on_iteration);
+  if (good || !quad_mesher_available()) {
+    out.layout = "single";
+    out.reason = good ? "one patch is certified and good over the whole map (" + figures(q) + ")"
+                      : "this build has no quad mesher";
+    out.single.emplace(std::move(single));
+    return out;
+  }
+  std::string why = !certified ? std::string("one patch is not certified after ") +
+                                     std::to_string(first.max_adapt) + " adaptive rounds"
+                               : "one patch is certified but poor over the whole map (" + figures(q) + ")";
+  out.rejected_single = q;
+  report_step(options.progress, "layout", why + ": building a quad layout");
+  run_quad(why);
+  return out;
+}
+
+}  // namespace tspline
