@@ -2,14 +2,18 @@
 
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 
+#include <Eigen/LU>
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <limits>
 #include <map>
+#include <numbers>
 #include <set>
 #include <sstream>
 
+#include "meshopt/node_smoother.h"
 #include "tspline/errors.h"
 #include "tspline/layout/quad_mesher.h"
 
@@ -114,6 +118,140 @@ void split_piece(const RingCurve& ring, std::vector<double>& nodes, std::size_t 
   nodes.push_back(std::fmod(s, L));
   std::sort(nodes.begin(), nodes.end());
   nodes.erase(std::unique(nodes.begin(), nodes.end()), nodes.end());
+}
+
+// Untangles and smooths the inner nodes of the quad mesh (libmeshopt, the
+// weighted K* objective of Brovka Eqs. 3-5) with the ring nodes fixed. Per
+// quad (x, n1, o, n2) around an inner node x of valence k, the three corner
+// triangles that contain x, each with the ideal shape of the rhombus with
+// angle 2 pi / k at x (a square where k = 4).
+//
+// And where a cut joins an inner node x to a ring node b: the two triangles
+// (b, b+, x) and (b, x, b-), b+- the points of the ring at arc length
+// +- l = |x - b| / 5 from b (the domain's side first), ideal with a right
+// angle at b, so that cuts leave the coast at right angles on the scale of
+// the patch's first cells (a corner angle theta bounds the patch map's
+// scaled Jacobian by sin theta).
+meshopt::SmoothingReport smooth_inner_nodes(std::vector<Eigen::Vector2d>& x, const std::vector<std::array<int, 4>>& quads,
+                                            const std::vector<int>& ring, const std::vector<double>& arc,
+                                            const std::vector<RingCurve>& rings) {
+  const std::size_t n_nodes = x.size();
+  std::vector<std::vector<std::pair<int, int>>> around(x.size());  // (quad, corner)
+  for (std::size_t q = 0; q < quads.size(); ++q)
+    for (int j = 0; j < 4; ++j) around[quads[q][j]].push_back({static_cast<int>(q), j});
+  meshopt::SmoothingProblem problem;
+  std::vector<meshopt::LocalTriangle> tris;
+  for (std::size_t n = 0; n < n_nodes; ++n) {
+    if (ring[n] >= 0 || around[n].empty()) continue;
+    const double theta = 2.0 * std::numbers::pi / static_cast<double>(around[n].size());
+    const Eigen::Vector2d e1(1.0, 0.0), e2(std::cos(theta), std::sin(theta));
+    auto ideal_inv = [](const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
+      Eigen::Matrix2d W;
+      W << a, b;
+      return Eigen::Matrix2d(W.inverse());
+    };
+    tris.clear();
+    for (const auto& [q, j] : around[n]) {
+      const int n1 = quads[q][(j + 1) % 4], o = quads[q][(j + 2) % 4], n2 = quads[q][(j + 3) % 4];
+      tris.push_back({n1, n2, ideal_inv(e1, e2), 1.0});
+      tris.push_back({n1, o, ideal_inv(e1, e1 + e2), 1.0});
+      tris.push_back({o, n2, ideal_inv(e1 + e2, e2), 1.0});
+      // The cut n -> n1 (each cut of n is the edge to n1 of exactly one quad around n).
+      if (ring[n1] < 0) continue;
+      const RingCurve& rc = rings[ring[n1]];
+      const double l = 0.2 * (x[n1] - x[n]).norm();
+      const double dir = ring[n1] == 0 ? 1.0 : -1.0;  // the domain lies left of the outer ring, right of holes
+      const int plus = static_cast<int>(x.size()), minus = plus + 1;
+      x.push_back(rc.point(arc[n1] + dir * l));
+      x.push_back(rc.point(arc[n1] - dir * l));
+      // Ideal: b = (0, 0), b+ = (0.2, 0), x = (0, 1), b- = (-0.2, 0).
+      tris.push_back({n1, plus, ideal_inv({0.0, -1.0}, {0.2, -1.0}), 1.0});
+      tris.push_back({minus, n1, ideal_inv({-0.2, -1.0}, {0.0, -1.0}), 1.0});
+    }
+    problem.add_node(static_cast<int>(n), tris);
+  }
+  meshopt::SmoothingOptions so;
+  so.max_sweeps = 200;
+  const meshopt::SmoothingReport report = meshopt::smooth(x, problem, so);
+  x.resize(n_nodes);  // the ring points b+-
+  return report;
+}
+
+double corner_sj(const Eigen::Vector2d& p, const Eigen::Vector2d& next, const Eigen::Vector2d& prev) {
+  const Eigen::Vector2d e1 = next - p, e2 = prev - p;
+  const double l = e1.norm() * e2.norm();
+  return l > 0.0 ? cross(e1, e2) / l : -1.0;
+}
+
+// Slides each ring node along its ring, between its neighbours on the ring,
+// to the place where the worst corner of its quads is best (straight sides),
+// the ring's sharp turns kept where they are: a node whose ring turns by more
+// than 25 degrees within a fifth of its shorter piece stays (a tip, the head
+// of an inlet: a patch corner belongs there). Golden-section search on the
+// arc length; quads around a node stay valid (their worst corner never drops).
+void slide_ring_nodes(std::vector<Eigen::Vector2d>& x, std::vector<double>& arc,
+                      const std::vector<std::array<int, 4>>& quads, const std::vector<int>& ring,
+                      const std::vector<RingCurve>& rings) {
+  const std::size_t n_nodes = x.size();
+  std::vector<std::vector<int>> quads_of(n_nodes);
+  for (std::size_t q = 0; q < quads.size(); ++q)
+    for (int j = 0; j < 4; ++j) quads_of[quads[q][j]].push_back(static_cast<int>(q));
+  // Ring neighbours: the other ends of the node's edges on the ring (edges of one quad).
+  std::map<std::pair<int, int>, int> count;
+  for (const auto& q : quads)
+    for (int j = 0; j < 4; ++j) ++count[{std::min(q[j], q[(j + 1) % 4]), std::max(q[j], q[(j + 1) % 4])}];
+  std::vector<std::vector<int>> ring_nbr(n_nodes);
+  for (const auto& [e, c] : count)
+    if (c == 1) ring_nbr[e.first].push_back(e.second), ring_nbr[e.second].push_back(e.first);
+  auto worst = [&](int n) {
+    double m = 1.0;
+    for (int q : quads_of[n])
+      for (int j = 0; j < 4; ++j)
+        m = std::min(m, corner_sj(x[quads[q][j]], x[quads[q][(j + 1) % 4]], x[quads[q][(j + 3) % 4]]));
+    return m;
+  };
+  for (std::size_t n = 0; n < n_nodes; ++n) {
+    if (ring[n] < 0 || ring_nbr[n].size() != 2) continue;
+    const RingCurve& rc = rings[ring[n]];
+    const double L = rc.length();
+    // Neighbour arc lengths unwrapped around arc[n].
+    double lo = arc[ring_nbr[n][0]], hi = arc[ring_nbr[n][1]];
+    auto unwrap = [&](double a) {
+      while (a - arc[n] > 0.5 * L) a -= L;
+      while (arc[n] - a > 0.5 * L) a += L;
+      return a;
+    };
+    lo = unwrap(lo), hi = unwrap(hi);
+    if (lo > hi) std::swap(lo, hi);
+    if (!(lo < arc[n] && arc[n] < hi)) continue;
+    const double gap = std::min(arc[n] - lo, hi - arc[n]);
+    const double l = 0.2 * gap;
+    const Eigen::Vector2d t1 = rc.point(arc[n] + l) - x[n], t0 = x[n] - rc.point(arc[n] - l);
+    const double turn = std::abs(std::atan2(cross(t0, t1), t0.dot(t1)));
+    if (turn > 25.0 * std::numbers::pi / 180.0) continue;
+    const double a0 = lo + 0.2 * (arc[n] - lo), b0 = hi - 0.2 * (hi - arc[n]);
+    const double start = arc[n];
+    const double before = worst(static_cast<int>(n));
+    auto f = [&](double sv) {
+      x[n] = rc.point(sv);
+      return worst(static_cast<int>(n));
+    };
+    double a = a0, b = b0;
+    const double g = 0.5 * (std::sqrt(5.0) - 1.0);
+    double c = b - g * (b - a), d = a + g * (b - a);
+    double fc = f(c), fd = f(d);
+    for (int it = 0; it < 20; ++it) {
+      if (fc > fd) b = d, d = c, fd = fc, c = b - g * (b - a), fc = f(c);
+      else a = c, c = d, fc = fd, d = a + g * (b - a), fd = f(d);
+    }
+    const double best = fc > fd ? c : d;
+    if (std::max(fc, fd) > before) {
+      arc[n] = std::fmod(best + L, L);
+      x[n] = rc.point(arc[n]);
+    } else {
+      x[n] = rc.point(start);
+    }
+  }
 }
 
 }  // namespace
@@ -225,13 +363,20 @@ QuadLayout build_quad_layout(const Domain& d, const QuadLayoutOptions& o) {
     const PlanarQuadMesh m = quad_mesh(straight, h);
     // Boundary nodes onto the true rings.
     std::vector<Eigen::Vector2d> x = m.nodes;
+    std::vector<double> arc(x.size(), 0.0);
     for (std::size_t n = 0; n < x.size(); ++n) {
       if (m.ring[n] < 0) continue;
       const auto& nr = nodes[m.ring[n]];
       const double L = rings[m.ring[n]].length();
       const std::size_t k = static_cast<std::size_t>(m.segment[n]);
       const double a = nr[k], b = k + 1 < nr.size() ? nr[k + 1] : nr.front() + L;
-      x[n] = m.t[n] == 0.0 ? rings[m.ring[n]].point(a) : rings[m.ring[n]].point(a + m.t[n] * (b - a));
+      arc[n] = a + m.t[n] * (b - a);
+      x[n] = rings[m.ring[n]].point(arc[n]);
+    }
+    smooth_inner_nodes(x, m.quads, m.ring, arc, rings);
+    for (int pass = 0; pass < 3; ++pass) {
+      slide_ring_nodes(x, arc, m.quads, m.ring, rings);
+      smooth_inner_nodes(x, m.quads, m.ring, arc, rings);
     }
     // Edges: shared by two quads (inner: cuts) or one (on a ring).
     std::map<std::pair<int, int>, int> edge_quads;

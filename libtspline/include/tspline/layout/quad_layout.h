@@ -35,7 +35,7 @@ struct QuadLayoutOptions {
   /// resolved by patches (unless size.min_size is set).
   double min_size_fraction = 2e-3;
   /// Rounds of "add nodes where the true geometry breaks the layout, mesh again".
-  int max_repair_rounds = 8;
+  int max_repair_rounds = 40;
 };
 
 struct QuadLayoutStats {
