@@ -254,6 +254,75 @@ void slide_ring_nodes(std::vector<Eigen::Vector2d>& x, std::vector<double>& arc,
   }
 }
 
+// A ring node that is the corner of one quad only, where the ring is nearly
+// straight (inner angle above 150 degrees, between the chords to the quad's
+// neighbours or between the ring's own edges at the node) or reflex, would be
+// a patch corner of about 180 degrees or more: no map is valid there (det J at
+// a corner of the square is the cross product of the two boundary tangents),
+// and no local edge rotation removes it (it moves to a neighbour). Such a ring
+// is pillowed: every node of it moves inside, a copy takes its place on the
+// ring, and each quad edge along the ring gets a new quad between the two
+// (a conforming layer; every ring node then has two quads). The inner nodes
+// are smoothed afterwards. Returns the rings pillowed.
+std::size_t pillow_flat_rings(std::vector<std::array<int, 4>>& quads, std::vector<Eigen::Vector2d>& x,
+                              std::vector<int>& ring, std::vector<double>& arc, const std::vector<RingCurve>& rings) {
+  std::vector<std::vector<int>> quads_of(x.size());
+  for (std::size_t q = 0; q < quads.size(); ++q)
+    for (int j = 0; j < 4; ++j) quads_of[quads[q][j]].push_back(static_cast<int>(q));
+  auto flat_or_reflex = [](const Eigen::Vector2d& p, const Eigen::Vector2d& next, const Eigen::Vector2d& prev) {
+    const double sv = corner_sj(p, next, prev);
+    return sv < 0.0 || (sv <= 0.5 && (next - p).dot(prev - p) < 0.0);
+  };
+  std::vector<char> pillow(rings.size(), 0);
+  for (std::size_t v = 0; v < x.size(); ++v) {
+    if (ring[v] < 0 || quads_of[v].size() != 1) continue;
+    std::array<int, 4> q = quads[quads_of[v][0]];
+    while (q[0] != static_cast<int>(v)) std::rotate(q.begin(), q.begin() + 1, q.end());
+    const int a = q[1], b = q[3];
+    const RingCurve& rc = rings[ring[v]];
+    const double delta = 1e-6 * std::min((x[a] - x[v]).norm(), (x[b] - x[v]).norm());
+    const double dir = ring[v] == 0 ? 1.0 : -1.0;  // the domain lies left of the outer ring, right of holes
+    if (flat_or_reflex(x[v], x[a], x[b]) ||
+        flat_or_reflex(x[v], rc.point(arc[v] + dir * delta), rc.point(arc[v] - dir * delta)))
+      pillow[ring[v]] = 1;
+  }
+  std::size_t count = 0;
+  for (std::size_t r = 0; r < rings.size(); ++r) count += pillow[r];
+  if (count == 0) return 0;
+  // Edges along the ring, as directed in their quad.
+  std::map<std::pair<int, int>, int> uses;
+  for (const auto& q : quads)
+    for (int j = 0; j < 4; ++j) ++uses[{std::min(q[j], q[(j + 1) % 4]), std::max(q[j], q[(j + 1) % 4])}];
+  std::vector<std::pair<int, int>> along;
+  for (const auto& q : quads)
+    for (int j = 0; j < 4; ++j) {
+      const int v = q[j], w = q[(j + 1) % 4];
+      if (uses[{std::min(v, w), std::max(v, w)}] == 1 && ring[v] >= 0 && pillow[ring[v]]) along.push_back({v, w});
+    }
+  const std::size_t n0 = x.size();
+  std::vector<int> copy(n0, -1);
+  for (std::size_t v = 0; v < n0; ++v) {
+    if (ring[v] < 0 || !pillow[ring[v]]) continue;
+    copy[v] = static_cast<int>(x.size());
+    x.push_back(x[v]);
+    ring.push_back(ring[v]);
+    arc.push_back(arc[v]);
+  }
+  // The old ring nodes move a third of the way towards the mean of their other quad corners.
+  for (std::size_t v = 0; v < n0; ++v) {
+    if (copy[v] < 0) continue;
+    Eigen::Vector2d mean = Eigen::Vector2d::Zero();
+    int k = 0;
+    for (int q : quads_of[v])
+      for (int j = 0; j < 4; ++j)
+        if (quads[q][j] != static_cast<int>(v)) mean += x[quads[q][j]], ++k;
+    if (k > 0) x[v] += (1.0 / 3.0) * (mean / k - x[v]);
+    ring[v] = -1;
+  }
+  for (const auto& [v, w] : along) quads.push_back({w, v, copy[v], copy[w]});
+  return count;
+}
+
 }  // namespace
 
 double quad_corner_scaled_jacobian(const std::array<Eigen::Vector2d, 4>& q) {
@@ -373,14 +442,17 @@ QuadLayout build_quad_layout(const Domain& d, const QuadLayoutOptions& o) {
       arc[n] = a + m.t[n] * (b - a);
       x[n] = rings[m.ring[n]].point(arc[n]);
     }
-    smooth_inner_nodes(x, m.quads, m.ring, arc, rings);
+    std::vector<std::array<int, 4>> quads = m.quads;
+    std::vector<int> node_ring = m.ring;
+    pillow_flat_rings(quads, x, node_ring, arc, rings);
+    smooth_inner_nodes(x, quads, node_ring, arc, rings);
     for (int pass = 0; pass < 3; ++pass) {
-      slide_ring_nodes(x, arc, m.quads, m.ring, rings);
-      smooth_inner_nodes(x, m.quads, m.ring, arc, rings);
+      slide_ring_nodes(x, arc, quads, node_ring, rings);
+      smooth_inner_nodes(x, quads, node_ring, arc, rings);
     }
     // Edges: shared by two quads (inner: cuts) or one (on a ring).
     std::map<std::pair<int, int>, int> edge_quads;
-    for (const auto& q : m.quads)
+    for (const auto& q : quads)
       for (int j = 0; j < 4; ++j) ++edge_quads[{std::min(q[j], q[(j + 1) % 4]), std::max(q[j], q[(j + 1) % 4])}];
     std::vector<int> inner_degree(x.size(), 0), degree(x.size(), 0);
     for (const auto& [e, count] : edge_quads) {
@@ -400,7 +472,7 @@ QuadLayout build_quad_layout(const Domain& d, const QuadLayoutOptions& o) {
       to_split[br].insert(piece_of(nodes[br], rings[br].arc(be)));
     };
     for (std::size_t n = 0; n < x.size(); ++n)
-      if (m.ring[n] < 0 && grid.ray_crossings(x[n]) % 2 == 0) mark_nearest_piece(x[n]);
+      if (node_ring[n] < 0 && grid.ray_crossings(x[n]) % 2 == 0) mark_nearest_piece(x[n]);
     for (const auto& [e, count] : edge_quads) {
       if (count != 2) continue;
       const Eigen::Vector2d a = x[e.first], b = x[e.second];
@@ -408,8 +480,8 @@ QuadLayout build_quad_layout(const Domain& d, const QuadLayoutOptions& o) {
         const auto& f = grid.edge(g);
         if (!segments_intersect(a, b, f.a, f.b)) continue;
         // Allowed: the cut's end on this ring edge, the rest of the cut off it.
-        const bool a_on = m.ring[e.first] >= 0 && segment_distance(a, f.a, f.b) <= tol;
-        const bool b_on = m.ring[e.second] >= 0 && segment_distance(b, f.a, f.b) <= tol;
+        const bool a_on = node_ring[e.first] >= 0 && segment_distance(a, f.a, f.b) <= tol;
+        const bool b_on = node_ring[e.second] >= 0 && segment_distance(b, f.a, f.b) <= tol;
         if (a_on != b_on) {
           const Eigen::Vector2d from = a_on ? a + 1e-6 * (b - a) : a, to = b_on ? b + 1e-6 * (a - b) : b;
           if (!segments_intersect(from, to, f.a, f.b)) continue;
@@ -427,7 +499,7 @@ QuadLayout build_quad_layout(const Domain& d, const QuadLayoutOptions& o) {
     for (const auto& [e, count] : edge_quads)
       if (count == 2) cuts.push_back({x[e.first], x[e.second]});
     for (std::size_t n = 0; n < x.size(); ++n)
-      if (m.ring[n] >= 0 && inner_degree[n] == 0 && degree[n] > 0) out.ring_corners.push_back(x[n]);
+      if (node_ring[n] >= 0 && inner_degree[n] == 0 && degree[n] > 0) out.ring_corners.push_back(x[n]);
     out.layout = build_patch_layout(d, std::move(cuts), out.ring_corners);
     QuadLayoutStats& st = out.stats;
     st.patches = out.layout.patches.size();
@@ -435,17 +507,17 @@ QuadLayout build_quad_layout(const Domain& d, const QuadLayoutOptions& o) {
     st.max_size = so.max_size > 0.0 ? so.max_size : 0.25 * diam;
     for (std::size_t n = 0; n < x.size(); ++n) {
       if (degree[n] == 0) continue;
-      if (m.ring[n] >= 0) ++st.ring_nodes;
+      if (node_ring[n] >= 0) ++st.ring_nodes;
       else ++st.inner_nodes, ++st.valence[std::min(degree[n], 7)];
     }
     double sum = 0.0;
     st.min_corner_scaled_jacobian = 1.0;
-    for (const auto& q : m.quads) {
+    for (const auto& q : quads) {
       const double sj = quad_corner_scaled_jacobian({x[q[0]], x[q[1]], x[q[2]], x[q[3]]});
       st.min_corner_scaled_jacobian = std::min(st.min_corner_scaled_jacobian, sj);
       sum += sj;
     }
-    st.mean_corner_scaled_jacobian = sum / static_cast<double>(m.quads.size());
+    st.mean_corner_scaled_jacobian = sum / static_cast<double>(quads.size());
     st.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     return out;
   }
