@@ -114,6 +114,7 @@ class NewtonStage {
     double mean_diag = 0.0;
     bool ok = false;
     for (int attempt = 0; attempt < 12; ++attempt) {
+      if (attempt > 0) ++rep.shifted_factorizations;
       llt_.setShift(shift);
       llt_.factorize(H_);
       if (llt_.info() == Eigen::Success) {

@@ -7,7 +7,7 @@
 // the map's own degrees of freedom, with the boundary curve fixed:
 //
 //  1. Minimize the regularized energy E_eps of map_energy.h for a fixed eps
-//     (projected Newton by default, or L-BFGS: MapOptimizer), then lower eps by the
+//     (L-BFGS by default, or projected Newton: MapOptimizer), then lower eps by the
 //     rule of Garanzha et al. 2021 (Sect. 4 there): with sigma = max(1 -
 //     E/E_prev, 1/10) the relative progress of the stage and D_min the smallest
 //     sampled det J, mu = (1 - sigma) chi(D_min, eps), and eps = 2 sqrt(mu (mu -
@@ -48,8 +48,8 @@ namespace tspline {
 
 /// The minimizer of each eps stage.
 enum class MapOptimizer {
-  Newton,  ///< projected Newton, CHOLMOD (the default: faster on every benchmark, bench/README.md)
-  LBFGS    ///< Ceres' L-BFGS (the method before issue 23)
+  Newton,  ///< projected Newton, CHOLMOD: fewer iterations, but each costs a sparse Cholesky
+  LBFGS    ///< Ceres' L-BFGS (the default: faster on every benchmark here, bench/README.md)
 };
 
 struct UntanglingProgress {
@@ -68,7 +68,11 @@ struct MapUntanglingOptions {
   /// more stages (measured on Newfoundland: 80 stages of 20 iterations and two
   /// sample refinements without a certificate on 3,247 cells).
   int max_stages = 60;
-  MapOptimizer optimizer = MapOptimizer::Newton;
+  /// L-BFGS by default: on this project's 2-core machine (ATLAS BLAS) the
+  /// Cholesky of the bicubic 2-component Hessian costs 60 ms at 2.7e3 and
+  /// 1.6 s at 3.3e4 unknowns, more than the L-BFGS iterations it saves
+  /// (bench/README.md, issue 23).
+  MapOptimizer optimizer = MapOptimizer::LBFGS;
   int max_iterations_per_stage = 20;  ///< L-BFGS iterations per stage
   /// Newton iterations per stage at most; a stage also ends when an
   /// iteration lowers the energy by less than newton_stage_tolerance (relative).
@@ -107,6 +111,7 @@ struct MapUntanglingReport {
   int iterations = 0;   ///< optimizer (Newton or L-BFGS) iterations
   int evaluations = 0;  ///< energy (+ gradient) evaluations
   int factorizations = 0;  ///< Newton: Hessian assemblies and Cholesky factorizations
+  int shifted_factorizations = 0;  ///< Newton: repeated with a diagonal shift (the first attempt failed)
   int line_search_certifications = 0;  ///< Newton: trial steps checked by the certificate
   double hessian_seconds = 0.0;  ///< Newton: assembly of the Hessians
   double solve_seconds = 0.0;    ///< Newton: CHOLMOD analysis, factorizations and solves
