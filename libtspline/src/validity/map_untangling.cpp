@@ -167,6 +167,8 @@ MapUntanglingReport untangle_map(TSplineMap& map, const MapUntanglingOptions& op
     throw std::invalid_argument("untangle_map: stage and iteration limits must be >= 1");
   if (!(opt.eps_floor > 0.0) || !(opt.energy_tolerance > 0.0))
     throw std::invalid_argument("untangle_map: eps_floor and energy_tolerance must be > 0");
+  if (opt.max_newton_iterations_per_stage < 1 || !(opt.newton_stage_tolerance >= 0.0))
+    throw std::invalid_argument("untangle_map: max_newton_iterations_per_stage must be >= 1 and newton_stage_tolerance >= 0");
   const auto t0 = std::chrono::steady_clock::now();
   MapEnergy energy(map, opt.energy);
   MapUntanglingReport rep;
