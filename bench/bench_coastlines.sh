@@ -3,9 +3,13 @@
 # polygon (Release build): one row per domain with what the final map is
 # (from report.json), the wall time and the peak memory of the run.
 # Usage: bash bench/bench_coastlines.sh [DOMAIN ...]   (default: tests/data/coastlines/*.txt tests/data/polygons/*.txt)
+# OPTIMIZER=lbfgs|newton passes --optimizer to tspline param (default: its default);
+# NO_BUILD=1 skips the build.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-BUILD_DIR=build BUILD_TYPE=Release bash scripts/build.sh > /dev/null
+[ "${NO_BUILD:-0}" = 1 ] || BUILD_DIR=build BUILD_TYPE=Release bash scripts/build.sh > /dev/null
+extra=()
+[ -z "${OPTIMIZER:-}" ] || extra=(--optimizer "$OPTIMIZER")
 domains=("$@")
 [ ${#domains[@]} -gt 0 ] || domains=(tests/data/coastlines/*.txt tests/data/polygons/*.txt)
 tmp=$(mktemp -d)
@@ -14,7 +18,7 @@ printf "%-18s %8s %7s %8s %5s %10s %9s %9s %8s %8s %4s\n" domain vertices cells 
 for f in "${domains[@]}"; do
   n=$(basename "$f" .txt)
   set +e
-  /usr/bin/time -f "%e %M" -o "$tmp/time" build/apps/tspline param "$f" --out "$tmp/$n" --quiet > /dev/null 2> "$tmp/err"
+  /usr/bin/time -f "%e %M" -o "$tmp/time" build/apps/tspline param "$f" --out "$tmp/$n" --quiet "${extra[@]}" > /dev/null 2> "$tmp/err"
   rc=$?
   set -e
   read -r secs kb < <(tail -n 1 "$tmp/time")

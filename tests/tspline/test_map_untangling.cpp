@@ -149,18 +149,23 @@ TEST_SUITE("map_untangling") {
     // Both ways out: the local problem around the failing elements (default),
     // and finer samples on the whole map's continuation. Few iterations per
     // stage, so that the first stage does not already remove the fold.
+    // (Newton, with its default iterations per stage, removes this fold in
+    // the first stage: both ways must certify, the local problem need not be used.)
     uo.max_iterations_per_stage = 2;
+    for (auto optimizer : {tspline::MapOptimizer::LBFGS, tspline::MapOptimizer::Newton})
     for (bool local : {true, false}) {
       CAPTURE(local);
+      CAPTURE(optimizer == tspline::MapOptimizer::Newton);
       TSplineMap map = *found;
+      uo.optimizer = optimizer;
       uo.local_repair = local;
       const tspline::MapUntanglingReport r = tspline::untangle_map(map, uo);
       CHECK(r.before.nonpositive == 0);
       CHECK(r.certified);
       CHECK(tspline::certify_map(map).certified_valid());
-      if (local)
+      if (local && optimizer == tspline::MapOptimizer::LBFGS)
         CHECK(r.local_repairs_certified >= 1);
-      else
+      else if (!local)
         CHECK(r.local_repairs == 0);
     }
   }

@@ -212,7 +212,7 @@ class AdaptiveRun {
       rec.control_points_optimized = u.free_points > 0;
       std::ostringstream s;
       s << "untangling: " << u.free_points << " free control points, " << u.elements << " elements, " << u.stages
-        << " stages, " << u.iterations << " L-BFGS iterations, samples with det J <= 0 " << u.before.nonpositive
+        << " stages, " << u.iterations << " optimizer iterations, samples with det J <= 0 " << u.before.nonpositive
         << " -> " << u.after.nonpositive;
       if (u.local_repairs > 0)
         s << ", " << u.local_repairs << " local repairs of folds between samples (" << u.local_repairs_certified
@@ -293,7 +293,7 @@ class AdaptiveRun {
         e.defects = p.samples.nonpositive;
         std::ostringstream s;
         s << "untangling stage " << p.stage + 1 << ": eps " << p.eps << ", samples with det J <= 0 "
-          << p.samples.nonpositive << ", " << p.iterations << " L-BFGS iterations"
+          << p.samples.nonpositive << ", " << p.iterations << " optimizer iterations"
           << (p.certified ? ", certified" : "");
         e.text = s.str();
         opt_.progress(e);

@@ -66,6 +66,8 @@ void validate_options(const AdaptiveOptions& ad) {
   if (!(u.min_decrease > 0.0 && u.min_decrease < 1.0))
     fail("untangling.min_decrease must be in (0, 1), got " + str(u.min_decrease));
   if (u.max_quality_stages < 1) fail("untangling.max_quality_stages must be >= 1");
+  if (u.max_newton_iterations_per_stage < 1 || !(u.newton_stage_tolerance >= 0.0))
+    fail("untangling: max_newton_iterations_per_stage must be >= 1 and newton_stage_tolerance >= 0");
 }
 
 }  // namespace tspline

@@ -1,12 +1,15 @@
 // The regularized distortion energy of a T-spline map; see map_energy.h.
 #include "tspline/validity/map_energy.h"
 #include "tspline/detail/quadrature.h"
+#include "tspline/detail/thread_pool.h"
 
 #include <algorithm>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
 #include <thread>
+
+#include <Eigen/Dense>
 
 #include "tspline/validity/map_quality.h"
 
@@ -44,23 +47,6 @@ void lobatto_points_01(int n, std::vector<double>& p, std::vector<double>& w) {
 std::array<double, 4> bernstein3_derivative(double s) {
   const double r = 1.0 - s;
   return {-3.0 * r * r, 3.0 * r * r - 6.0 * s * r, 6.0 * s * r - 3.0 * s * s, 3.0 * s * s};
-}
-
-// Runs body(begin, end, slot) on `threads` contiguous ranges of [0, n).
-template <class Body>
-void parallel_ranges(std::size_t n, int threads, Body&& body) {
-  if (threads <= 1 || n < 256) {
-    body(std::size_t{0}, n, 0);
-    return;
-  }
-  std::vector<std::thread> pool;
-  const std::size_t chunk = (n + threads - 1) / threads;
-  for (int t = 1; t < threads; ++t) {
-    const std::size_t b = std::min(n, t * chunk), e = std::min(n, (t + 1) * chunk);
-    pool.emplace_back([&body, b, e, t] { body(b, e, t); });
-  }
-  body(0, std::min(n, chunk), 0);
-  for (std::thread& th : pool) th.join();
 }
 
 }  // namespace
@@ -249,7 +235,7 @@ double MapEnergy::evaluate(const double* xv, double eps, double* gradient, std::
   std::vector<std::vector<double>> grads(gradient ? threads - 1 : 0, std::vector<double>(num_variables(), 0.0));
   if (gradient) std::fill(gradient, gradient + num_variables(), 0.0);
   const double theta = options_.theta;
-  parallel_ranges(es.size(), threads, [&](std::size_t b, std::size_t e_end, int slot) {
+  detail::parallel_ranges(es.size(), threads, [&](std::size_t b, std::size_t e_end, int slot) {
     double* g = gradient ? (slot == 0 ? gradient : grads[slot - 1].data()) : nullptr;
     double F = 0.0;
     std::size_t nonpos = 0;
@@ -347,6 +333,301 @@ SampleStats MapEnergy::stats(const double* xv) const {
   }
   st.mean_mean_ratio = wsum > 0.0 ? jsum / wsum : 0.0;
   return st;
+}
+
+
+SampleTerm sample_term(const Eigen::Matrix2d& J, double eps, double theta, double power, bool project) {
+  constexpr double s2 = 0.70710678118654752440;  // 1 / sqrt(2)
+  // Conformal (z) and anticonformal (w) coordinates of J in the orthonormal
+  // basis e1..e4 of map_energy.h: vec J = E (z1, z2, w1, w2).
+  const Eigen::Vector2d z(s2 * (J(0, 0) + J(1, 1)), s2 * (J(1, 0) - J(0, 1)));
+  const Eigen::Vector2d w(s2 * (J(0, 0) - J(1, 1)), s2 * (J(0, 1) + J(1, 0)));
+  const double P = z.squaredNorm(), Q = w.squaredNorm();
+  const double D = J.determinant();  // = (P - Q) / 2, without the cancellation
+  const double I = J.squaredNorm();  // = P + Q
+  // t(I, D) = N / chi, N = (1 - theta) I + theta (D^2 + 1) (Garanzha et al. 2021, Eqs. 2-4);
+  // chi' = chi / r, chi'' = eps^2 / (2 r^3), r = sqrt(eps^2 + D^2).
+  const double r = std::sqrt(eps * eps + D * D);
+  const double chi = regularized_det(D, eps);
+  const double c1 = chi / r, c2 = eps * eps / (2.0 * r * r * r);
+  const double N = (1.0 - theta) * I + theta * (D * D + 1.0);
+  const double t = N / chi;
+  const double tI = (1.0 - theta) / chi;
+  const double tD = (2.0 * theta * D - t * c1) / chi;
+  const double tID = -(1.0 - theta) * c1 / (chi * chi);
+  const double tDD = (2.0 * theta - 4.0 * theta * D * c1 / chi - t * c2 + 2.0 * t * c1 * c1 / chi) / chi;
+  // phi = t^p: phi_a = p t^(p-1) t_a, phi_ab = p t^(p-1) t_ab + p (p-1) t^(p-2) t_a t_b.
+  const double tp1 = power == 1.0 ? 1.0 : std::pow(t, power - 1.0);
+  const double d1 = power * tp1, d2 = power == 1.0 ? 0.0 : power * (power - 1.0) * tp1 / t;
+  const double fI = d1 * tI, fD = d1 * tD;
+  const double fII = d2 * tI * tI, fID = d1 * tID + d2 * tI * tD, fDD = d1 * tDD + d2 * tD * tD;
+  // To (P, Q): I = P + Q, D = (P - Q) / 2.
+  const double fP = fI + 0.5 * fD, fQ = fI - 0.5 * fD;
+  const double fPP = fII + fID + 0.25 * fDD, fQQ = fII - fID + 0.25 * fDD, fPQ = fII - 0.25 * fDD;
+
+  SampleTerm out;
+  out.value = power == 1.0 ? t : tp1 * t;
+  // Gradient: d phi / dz = 2 phi_P z, d phi / dw = 2 phi_Q w, then vec J = E (z, w).
+  const Eigen::Vector2d gz = 2.0 * fP * z, gw = 2.0 * fQ * w;
+  out.gradient << s2 * (gz[0] + gw[0]), s2 * (-gz[1] + gw[1]), s2 * (gz[1] + gw[1]), s2 * (gz[0] - gw[0]);
+
+  // Eigensystem of H_zw: unit directions (any, where z or w vanishes).
+  const double nz = std::sqrt(P), nw = std::sqrt(Q);
+  const Eigen::Vector2d zh = nz > 0.0 ? Eigen::Vector2d(z / nz) : Eigen::Vector2d(1.0, 0.0);
+  const Eigen::Vector2d wh = nw > 0.0 ? Eigen::Vector2d(w / nw) : Eigen::Vector2d(1.0, 0.0);
+  const Eigen::Vector2d zp(-zh[1], zh[0]), wp(-wh[1], wh[0]);
+  double lz = 2.0 * fP, lw = 2.0 * fQ;                      // twist (z-perp), flip (w-perp)
+  double a = 2.0 * fP + 4.0 * fPP * P, c = 2.0 * fQ + 4.0 * fQQ * Q;  // scalings: [[a, b], [b, c]]
+  double b = 4.0 * fPQ * nz * nw;                            //   on (zh, 0), (0, wh)
+  if (project) {
+    lz = std::max(lz, 0.0), lw = std::max(lw, 0.0);
+    const double m = 0.5 * (a + c), h = std::hypot(0.5 * (a - c), b);
+    const double lp = m + h, lm = m - h;
+    if (lp <= 0.0) {
+      a = b = c = 0.0;
+    } else if (lm < 0.0) {
+      // Keep the positive eigenpair only: v v^T lp, v the better conditioned
+      // of the two (equivalent) eigenvector formulas.
+      Eigen::Vector2d v1(b, lp - a), v2(lp - c, b);
+      Eigen::Vector2d v = v1.squaredNorm() >= v2.squaredNorm() ? v1 : v2;
+      const double n2 = v.squaredNorm();
+      if (n2 > 0.0) {
+        v /= std::sqrt(n2);
+      } else {
+        v = a >= c ? Eigen::Vector2d(1.0, 0.0) : Eigen::Vector2d(0.0, 1.0);
+      }
+      a = lp * v[0] * v[0], b = lp * v[0] * v[1], c = lp * v[1] * v[1];
+    }
+  }
+  // H_zw in the (z1, z2, w1, w2) coordinates.
+  Eigen::Matrix4d Hzw = Eigen::Matrix4d::Zero();
+  Hzw.topLeftCorner<2, 2>() = lz * zp * zp.transpose() + a * zh * zh.transpose();
+  Hzw.bottomRightCorner<2, 2>() = lw * wp * wp.transpose() + c * wh * wh.transpose();
+  Hzw.topRightCorner<2, 2>() = b * zh * wh.transpose();
+  Hzw.bottomLeftCorner<2, 2>() = Hzw.topRightCorner<2, 2>().transpose();
+  Eigen::Matrix4d E;  // columns e1..e4 in vec J = (J00, J01, J10, J11)
+  E << s2, 0, s2, 0,  //
+      0, -s2, 0, s2,  //
+      0, s2, 0, s2,   //
+      s2, 0, -s2, 0;
+  out.hessian = E * Hzw * E.transpose();
+  return out;
+}
+
+void MapEnergy::build_hessian_pattern() const {
+  HessianPattern& hp = hpattern_;
+  const auto& es = extraction_.elements();
+  const std::size_t nodes = free_functions_.size();
+  // Node adjacency, lower part (rows i >= column j).
+  std::vector<std::vector<int>> col(nodes);
+  std::vector<int> fn;
+  for (std::size_t k = 0; k < es.size(); ++k) {
+    if (!elements_[k].active) continue;
+    fn.clear();
+    for (int a : es[k].functions)
+      if (variable_of_[a] >= 0) fn.push_back(variable_of_[a] / 2);
+    for (int j : fn)
+      for (int i : fn)
+        if (i >= j) col[j].push_back(i);
+  }
+  for (std::vector<int>& c : col) {
+    std::sort(c.begin(), c.end());
+    c.erase(std::unique(c.begin(), c.end()), c.end());
+  }
+  // Scalar structure: columns 2j and 2j+1 both hold rows 2i, 2i+1, i in col[j].
+  const Eigen::Index n = static_cast<Eigen::Index>(2 * nodes);
+  std::size_t nnz = 0;
+  for (const std::vector<int>& c : col) nnz += 4 * c.size();
+  hp.H = Eigen::SparseMatrix<double>(n, n);
+  hp.H.resizeNonZeros(static_cast<Eigen::Index>(nnz));
+  int* outer = hp.H.outerIndexPtr();
+  int* inner = hp.H.innerIndexPtr();
+  double* val = hp.H.valuePtr();
+  std::size_t pos = 0;
+  for (std::size_t j = 0; j < nodes; ++j)
+    for (int d = 0; d < 2; ++d) {
+      outer[2 * j + d] = static_cast<int>(pos);
+      for (int i : col[j]) {
+        inner[pos] = 2 * i, val[pos++] = 0.0;
+        inner[pos] = 2 * i + 1, val[pos++] = 0.0;
+      }
+    }
+  outer[n] = static_cast<int>(pos);
+  // Slots per element.
+  hp.slot_offset.assign(es.size() + 1, 0);
+  for (std::size_t k = 0; k < es.size(); ++k) {
+    const std::size_t m = es[k].functions.size();
+    hp.slot_offset[k + 1] = hp.slot_offset[k] + (elements_[k].active ? m * m : 0);
+  }
+  hp.slots.assign(hp.slot_offset.back(), -1);
+  for (std::size_t k = 0; k < es.size(); ++k) {
+    if (!elements_[k].active) continue;
+    const std::vector<int>& f = es[k].functions;
+    const std::size_t m = f.size();
+    for (std::size_t c = 0; c < m; ++c) {
+      if (variable_of_[f[c]] < 0) continue;
+      const int j = variable_of_[f[c]] / 2;
+      for (std::size_t r = 0; r < m; ++r) {
+        if (variable_of_[f[r]] < 0) continue;
+        const int i = variable_of_[f[r]] / 2;
+        if (i < j) continue;
+        const auto it = std::lower_bound(col[j].begin(), col[j].end(), i);
+        hp.slots[hp.slot_offset[k] + r * m + c] = static_cast<int>(it - col[j].begin());
+      }
+    }
+  }
+  // Greedy colouring: elements of one colour share no free function, so that
+  // they can be assembled in parallel without conflicts.
+  std::vector<std::vector<int>> support(nodes);
+  for (std::size_t k = 0; k < es.size(); ++k)
+    if (elements_[k].active)
+      for (int a : es[k].functions)
+        if (variable_of_[a] >= 0) support[variable_of_[a] / 2].push_back(static_cast<int>(k));
+  std::vector<int> color(es.size(), -1);
+  std::vector<char> used;
+  hp.colors.clear();
+  for (std::size_t k = 0; k < es.size(); ++k) {
+    if (!elements_[k].active) continue;
+    used.assign(hp.colors.size() + 1, 0);
+    for (int a : es[k].functions)
+      if (variable_of_[a] >= 0)
+        for (int o : support[variable_of_[a] / 2])
+          if (color[o] >= 0) used[color[o]] = 1;
+    int cc = 0;
+    while (used[cc]) ++cc;
+    color[k] = cc;
+    if (cc == static_cast<int>(hp.colors.size())) hp.colors.emplace_back();
+    hp.colors[cc].push_back(static_cast<int>(k));
+  }
+  hp.built = true;
+}
+
+void MapEnergy::hessian(const double* xv, double eps, Eigen::SparseMatrix<double>& H, double power,
+                        bool project) const {
+  if (!hpattern_.built) build_hessian_pattern();
+  const HessianPattern& hp = hpattern_;
+  if (H.rows() != hp.H.rows() || H.nonZeros() != hp.H.nonZeros() || !H.isCompressed())
+    H = hp.H;
+  else
+    std::fill(H.valuePtr(), H.valuePtr() + H.nonZeros(), 0.0);
+  const auto& es = extraction_.elements();
+  const double theta = options_.theta;
+  const int* outer = H.outerIndexPtr();
+  double* val = H.valuePtr();
+  using Mat16 = Eigen::Matrix<double, 16, 16>;
+  using MatA = Eigen::Matrix<double, 16, Eigen::Dynamic>;
+  for (const std::vector<int>& group : hp.colors) {
+    detail::parallel_ranges(group.size(), options_.threads, [&](std::size_t b, std::size_t e_end, int) {
+      MatA A, Mxx, Mxy, Myy;
+      Eigen::MatrixXd Cf, Kxx, Kxy, Kyy;
+      std::vector<int> rows;
+      for (std::size_t gi = b; gi < e_end; ++gi) {
+        const std::size_t k = static_cast<std::size_t>(group[gi]);
+        const BezierElement& e = es[k];
+        const Element& d = elements_[k];
+        const Pattern& pat = patterns_[d.level];
+        const Eigen::Index nq = static_cast<Eigen::Index>(pat.weight.size());
+        std::array<double, 16> X, Y;
+        element_coefficients(k, xv, X, Y);
+        A.resize(16, 2 * nq), Mxx.resize(16, 2 * nq), Mxy.resize(16, 2 * nq), Myy.resize(16, 2 * nq);
+        for (Eigen::Index q = 0; q < nq; ++q) {
+          const SampleJacobian s = sample_jacobian(X, Y, d.W, pat.B[q], pat.Bs[q], pat.Bt[q], d.hx, d.hy);
+          Eigen::Matrix2d J;
+          J << s.J00, s.J01, s.J10, s.J11;
+          const SampleTerm st = sample_term(J, eps, theta, power, project);
+          const Eigen::Matrix4d Hq = (pat.weight[q] * d.weight) * st.hessian;
+          // J00 = as . X, J01 = at . X, J10 = as . Y, J11 = at . Y (sample_jacobian).
+          const double iw = 1.0 / s.w;
+          const auto& Bq = pat.B[q];
+          const auto& Bs = pat.Bs[q];
+          const auto& Bt = pat.Bt[q];
+          for (int i = 0; i < 16; ++i) {
+            A(i, 2 * q) = (Bs[i] - Bq[i] * s.ws * iw) * iw / d.hx;
+            A(i, 2 * q + 1) = (Bt[i] - Bq[i] * s.wt * iw) * iw / d.hy;
+          }
+          Mxx.middleCols<2>(2 * q) = A.middleCols<2>(2 * q) * Hq.topLeftCorner<2, 2>();
+          Mxy.middleCols<2>(2 * q) = A.middleCols<2>(2 * q) * Hq.topRightCorner<2, 2>();
+          Myy.middleCols<2>(2 * q) = A.middleCols<2>(2 * q) * Hq.bottomRightCorner<2, 2>();
+        }
+        // Bernstein-coefficient blocks (sum over samples of A_q H_q A_q^T).
+        const Mat16 Bxx = Mxx * A.transpose(), Bxy = Mxy * A.transpose(), Byy = Myy * A.transpose();
+        // To the element's free control points: K = C_f B C_f^T.
+        rows.clear();
+        for (Eigen::Index r = 0; r < e.C.rows(); ++r)
+          if (variable_of_[e.functions[r]] >= 0) rows.push_back(static_cast<int>(r));
+        const Eigen::Index nf = static_cast<Eigen::Index>(rows.size());
+        Cf.resize(nf, 16);
+        for (Eigen::Index r = 0; r < nf; ++r) Cf.row(r) = e.C.row(rows[r]);
+        Kxx.noalias() = Cf * Bxx * Cf.transpose();
+        Kxy.noalias() = Cf * Bxy * Cf.transpose();
+        Kyy.noalias() = Cf * Byy * Cf.transpose();
+        const std::size_t m = e.functions.size();
+        const int* slot = &hp.slots[hp.slot_offset[k]];
+        for (Eigen::Index c = 0; c < nf; ++c) {
+          const int j = variable_of_[e.functions[rows[c]]] / 2;
+          for (Eigen::Index r = 0; r < nf; ++r) {
+            const int sl = slot[rows[r] * m + rows[c]];
+            if (sl < 0) continue;
+            double* c0 = val + outer[2 * j] + 2 * sl;
+            double* c1 = val + outer[2 * j + 1] + 2 * sl;
+            c0[0] += Kxx(r, c);  // (x_i, x_j)
+            c0[1] += Kxy(c, r);  // (y_i, x_j) = (x_j, y_i)
+            c1[0] += Kxy(r, c);  // (x_i, y_j)
+            c1[1] += Kyy(r, c);  // (y_i, y_j)
+          }
+        }
+      }
+    }, 8);
+  }
+}
+
+double MapEnergy::max_positive_step(const double* xv, const double* dv, double a_max, double safety) const {
+  const auto& es = extraction_.elements();
+  // The direction's own coefficients: element_coefficients is linear, so the
+  // coefficients of x + t d are X + t (X(d) - X(0)) with the fixed points in X(0).
+  const std::vector<double> zero(num_variables(), 0.0);
+  std::vector<double> result(static_cast<std::size_t>(std::max(1, options_.threads)), a_max);
+  detail::parallel_ranges(es.size(), options_.threads, [&](std::size_t b, std::size_t e_end, int slot) {
+    double best = a_max;
+    for (std::size_t k = b; k < e_end; ++k) {
+      const Element& d = elements_[k];
+      if (!d.active) continue;
+      const Pattern& pat = patterns_[d.level];
+      std::array<double, 16> X, Y, DX, DY, X0, Y0;
+      element_coefficients(k, xv, X, Y);
+      element_coefficients(k, dv, DX, DY);
+      element_coefficients(k, zero.data(), X0, Y0);
+      for (int i = 0; i < 16; ++i) DX[i] -= X0[i], DY[i] -= Y0[i];
+      for (std::size_t q = 0; q < pat.weight.size(); ++q) {
+        const SampleJacobian s = sample_jacobian(X, Y, d.W, pat.B[q], pat.Bs[q], pat.Bt[q], d.hx, d.hy);
+        const double D0 = s.J00 * s.J11 - s.J01 * s.J10;
+        if (!(D0 > 0.0)) continue;
+        const SampleJacobian g = sample_jacobian(DX, DY, d.W, pat.B[q], pat.Bs[q], pat.Bt[q], d.hx, d.hy);
+        // det(J + t G) = D0 + t D1 + t^2 D2.
+        const double D1 = s.J00 * g.J11 + g.J00 * s.J11 - s.J01 * g.J10 - g.J01 * s.J10;
+        const double D2 = g.J00 * g.J11 - g.J01 * g.J10;
+        // Smallest positive root, if any, by the stable quadratic formula.
+        double root = std::numeric_limits<double>::infinity();
+        if (D2 == 0.0) {
+          if (D1 < 0.0) root = -D0 / D1;
+        } else {
+          const double disc = D1 * D1 - 4.0 * D2 * D0;
+          if (disc >= 0.0) {
+            const double sq = std::sqrt(disc);
+            const double qq = -0.5 * (D1 + (D1 >= 0.0 ? sq : -sq));
+            const double r1 = qq / D2, r2 = qq != 0.0 ? D0 / qq : std::numeric_limits<double>::infinity();
+            for (double rt : {r1, r2})
+              if (rt > 0.0) root = std::min(root, rt);
+          }
+        }
+        best = std::min(best, safety * root);
+      }
+    }
+    result[slot] = best;
+  });
+  double a = a_max;
+  for (double v : result) a = std::min(a, v);
+  return a;
 }
 
 }  // namespace tspline

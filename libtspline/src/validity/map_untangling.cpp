@@ -4,6 +4,8 @@
 #include <ceres/gradient_problem.h>
 #include <ceres/gradient_problem_solver.h>
 
+#include <Eigen/CholmodSupport>
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -39,6 +41,104 @@ class EnergyFunction final : public ceres::FirstOrderFunction {
   int* evaluations_;
 };
 
+// Projected Newton on one eps stage (map_untangling.h). The Hessian's
+// pattern and CHOLMOD's symbolic analysis are kept across stages (same
+// MapEnergy, same T-mesh): only the numeric factorization is redone.
+class NewtonStage {
+ public:
+  explicit NewtonStage(const MapEnergy& energy) : energy_(energy) {
+    llt_.cholmod().print = 0;  // a failed (shifted) attempt is not an error
+  }
+
+  // Up to max_iter iterations at (eps, power) from x. certify(v) is asked
+  // before accepting a step from a certified x (certified: in and out).
+  template <class Certify>
+  void run(Eigen::VectorXd& x, double eps, double power, int max_iter, double tol, bool barrier,
+           bool& certified, const Certify& certify, MapUntanglingReport& rep) {
+    const Eigen::Index n = x.size();
+    Eigen::VectorXd g(n), d(n), xt(n);
+    for (int it = 0; it < max_iter; ++it) {
+      std::size_t nonpos = 0;
+      const double E0 = energy_.evaluate(x.data(), eps, g.data(), &nonpos, power);
+      ++rep.evaluations;
+      if (!std::isfinite(E0) || (barrier && nonpos > 0)) return;
+      if (!direction(x, eps, power, g, d, rep)) return;
+      double slope = g.dot(d);
+      if (!(slope < 0.0)) {  // cannot happen with a positive definite system; round-off
+        d = -g;
+        slope = -g.squaredNorm();
+      }
+      if (!(slope < 0.0)) return;  // stationary
+      ++rep.iterations;
+      const bool keep_positive = nonpos == 0;
+      double a = keep_positive ? energy_.max_positive_step(x.data(), d.data(), 1.0, 0.9) : 1.0;
+      bool accepted = false;
+      double Et = E0;
+      for (int ls = 0; ls < 40 && a > 0.0; ++ls, a *= 0.5) {
+        xt = x + a * d;
+        std::size_t np = 0;
+        Et = energy_.evaluate(xt.data(), eps, nullptr, &np, power);
+        ++rep.evaluations;
+        if (!std::isfinite(Et) || Et > E0 + 1e-4 * a * slope) continue;
+        if (keep_positive && np > 0) continue;
+        if (certified) {
+          ++rep.line_search_certifications;
+          if (np > 0 || !certify(xt)) continue;
+        }
+        accepted = true;
+        break;
+      }
+      if (!accepted) return;
+      x.swap(xt);
+      if (rep.iterations >= max_total_) return;
+      if (E0 - Et <= tol * std::abs(E0)) return;
+    }
+  }
+  void set_max_total(int m) { max_total_ = m; }
+
+ private:
+  bool direction(const Eigen::VectorXd& x, double eps, double power, const Eigen::VectorXd& g, Eigen::VectorXd& d,
+                 MapUntanglingReport& rep) {
+    auto t = std::chrono::steady_clock::now();
+    energy_.hessian(x.data(), eps, H_, power, true);
+    ++rep.factorizations;
+    auto t2 = std::chrono::steady_clock::now();
+    rep.hessian_seconds += std::chrono::duration<double>(t2 - t).count();
+    if (!analyzed_) {
+      llt_.analyzePattern(H_);
+      analyzed_ = true;
+    }
+    // A projected Hessian is positive semi-definite; with the boundary fixed
+    // it is almost always definite. If not, shift the diagonal (Levenberg).
+    double shift = 0.0;
+    double mean_diag = 0.0;
+    bool ok = false;
+    for (int attempt = 0; attempt < 12; ++attempt) {
+      if (attempt > 0) ++rep.shifted_factorizations;
+      llt_.setShift(shift);
+      llt_.factorize(H_);
+      if (llt_.info() == Eigen::Success) {
+        d = llt_.solve(-g);
+        ok = d.allFinite();
+        if (ok) break;
+      }
+      if (mean_diag == 0.0) {
+        for (Eigen::Index j = 0; j < H_.outerSize(); ++j) mean_diag += H_.coeff(j, j);
+        mean_diag = std::max(mean_diag / std::max<Eigen::Index>(1, H_.outerSize()), 1e-300);
+      }
+      shift = shift == 0.0 ? 1e-8 * mean_diag : 10.0 * shift;
+    }
+    rep.solve_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t2).count();
+    return ok;
+  }
+
+  const MapEnergy& energy_;
+  Eigen::SparseMatrix<double> H_;
+  Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<double>, Eigen::Lower> llt_;
+  bool analyzed_ = false;
+  int max_total_ = 1 << 30;
+};
+
 // The local problem for hidden folds: the functions of the failing elements
 // and of the elements sharing a function with them move, nothing else.
 MapUntanglingOptions local_repair_options(const TSplineMap& map, const MapEnergy& energy,
@@ -67,6 +167,8 @@ MapUntanglingReport untangle_map(TSplineMap& map, const MapUntanglingOptions& op
     throw std::invalid_argument("untangle_map: stage and iteration limits must be >= 1");
   if (!(opt.eps_floor > 0.0) || !(opt.energy_tolerance > 0.0))
     throw std::invalid_argument("untangle_map: eps_floor and energy_tolerance must be > 0");
+  if (opt.max_newton_iterations_per_stage < 1 || !(opt.newton_stage_tolerance >= 0.0))
+    throw std::invalid_argument("untangle_map: max_newton_iterations_per_stage must be >= 1 and newton_stage_tolerance >= 0");
   const auto t0 = std::chrono::steady_clock::now();
   MapEnergy energy(map, opt.energy);
   MapUntanglingReport rep;
@@ -108,6 +210,10 @@ MapUntanglingReport untangle_map(TSplineMap& map, const MapUntanglingOptions& op
 
   bool resampled = false;
   int quality_stages = 0;  // certified stages at the floor eps
+  bool x_certified = false;  // x is the last certified iterate (Newton keeps it certified)
+  NewtonStage newton(energy);
+  newton.set_max_total(opt.max_iterations);
+  auto certified_valid = [&](const Eigen::VectorXd& v) { return certify(v).certified_valid(); };
   for (int stage = 0; stage < opt.max_stages; ++stage) {
     if (resampled) {
       // Finer samples can show det J <= 0 where the coarser ones had none:
@@ -123,8 +229,11 @@ MapUntanglingReport untangle_map(TSplineMap& map, const MapUntanglingOptions& op
     // The quality phase (barrier) raises each term to quality_power.
     const double power = barrier ? opt.quality_power : 1.0;
     const double E_prev = energy.evaluate(x.data(), eps, nullptr, nullptr, power);
-    so.max_num_iterations = std::min(opt.max_iterations_per_stage, opt.max_iterations - rep.iterations);
-    {
+    if (opt.optimizer == MapOptimizer::Newton) {
+      newton.run(x, eps, power, opt.max_newton_iterations_per_stage, opt.newton_stage_tolerance, barrier, x_certified,
+                 certified_valid, rep);
+    } else {
+      so.max_num_iterations = std::min(opt.max_iterations_per_stage, opt.max_iterations - rep.iterations);
       ceres::GradientProblem problem(new EnergyFunction(energy, eps, barrier, power, &rep.evaluations));
       ceres::GradientProblemSolver::Summary summary;
       Eigen::VectorXd trial = x;
@@ -132,15 +241,18 @@ MapUntanglingReport untangle_map(TSplineMap& map, const MapUntanglingOptions& op
       rep.iterations += static_cast<int>(summary.iterations.size() > 0 ? summary.iterations.size() - 1 : 0);
       // Ceres returns the best point it evaluated successfully.
       if (trial.allFinite()) x = trial;
+      x_certified = false;
     }
     ++rep.stages;
     const double E = energy.evaluate(x.data(), eps, nullptr, nullptr, power);
     const SampleStats st = energy.stats(x.data());
     bool certified_now = false;
+    x_certified = false;
     if (st.nonpositive == 0) {
       MapCertification cert = certify(x);
       if (cert.certified_valid()) {
         certified_now = true;
+        x_certified = true;
         best = x;
         best_cert = std::move(cert);
       } else {
@@ -163,6 +275,7 @@ MapUntanglingReport untangle_map(TSplineMap& map, const MapUntanglingOptions& op
             ++rep.local_repairs_certified;
             x = energy.variables(local);
             certified_now = true;
+            x_certified = true;
             best = x;
             best_cert = lr.certification;
             resampled = false;  // the finer samples of the failing elements stay; they are positive now
@@ -182,7 +295,7 @@ MapUntanglingReport untangle_map(TSplineMap& map, const MapUntanglingOptions& op
       break;
     }
     if (rep.iterations >= opt.max_iterations) {
-      rep.stop_reason = "reached the L-BFGS iteration limit";
+      rep.stop_reason = "reached the iteration limit";
       break;
     }
     if (stage + 1 == opt.max_stages) {

@@ -37,7 +37,27 @@
 // in Bernstein form (X_k = sum_r P_r C(r, k)), so the energy and its exact
 // gradient cost O(samples x 16 + functions x 16) per element, without storing
 // basis values per sample.
+//
+// Hessian (projected Newton, issue 23). On a sample J is linear in the control
+// points (J = dS/d(xi, eta), S = X / w, w independent of them), so the
+// sample's Hessian over the element's control points is A^T H_J A with A the
+// 4 x (2 n) map from control points to vec J and H_J the 4 x 4 Hessian of the
+// sample's term with respect to J (sample_term below). The term is isotropic:
+// with J = z1 e1 + z2 e2 + w1 e3 + w2 e4 in the orthonormal basis
+// e1 = I/sqrt2, e2 = [[0,-1],[1,0]]/sqrt2 (conformal part z), e3 = [[1,0],[0,-1]]/sqrt2,
+// e4 = [[0,1],[1,0]]/sqrt2 (anticonformal part w), |J|^2 = P + Q and
+// det J = (P - Q) / 2 with P = |z|^2, Q = |w|^2, so the term is phi(P, Q) and
+//   H_zw = 2 phi_P I_z (+) 2 phi_Q I_w + 4 [phi_PP z z^T, phi_PQ z w^T; phi_PQ w z^T, phi_QQ w w^T],
+// whose eigenvectors are known in closed form: z-perp (eigenvalue 2 phi_P),
+// w-perp (2 phi_Q), and two in the plane of (z/|z|, 0), (0, w/|w|) from a 2 x 2
+// matrix. These are the analytic eigensystems of Smith, De Goes & Kim,
+// "Analytic eigensystems for isotropic distortion energies", ACM TOG 38(1),
+// 2019 (twist = z-perp, flip = w-perp, two scalings), written in the
+// conformal/anticonformal split; clamping the eigenvalues at 0 (Teran,
+// Sifakis, Irving & Fedkiw, SCA 2005) gives the projected H_J, positive
+// semi-definite, and equal to the exact one where that already is.
 #include <Eigen/Core>
+#include <Eigen/SparseCore>
 #include <cstddef>
 #include <vector>
 
@@ -110,6 +130,24 @@ class MapEnergy {
                   double power = 1.0) const;
   SampleStats stats(const double* x) const;
 
+  /// The Hessian of evaluate(x, eps, ..., power) with respect to x, each
+  /// sample's 4 x 4 Hessian in J projected to positive semi-definite if
+  /// `project` (map_energy.h, top). H gets the sparsity pattern of the
+  /// Bezier extraction (computed once per MapEnergy, i.e. per T-mesh: H's
+  /// structure is the same on every call) and holds the LOWER triangle: per
+  /// column pair (2j, 2j+1) of a control point the rows 2i, 2i+1 of the
+  /// points i >= j that share an element with it; the one entry (2j, 2j+1)
+  /// above the diagonal is stored too, with its value. Read H as
+  /// H.selfadjointView<Eigen::Lower>() (CHOLMOD with stype -1 does).
+  /// Not thread-safe on its first call (the pattern is built then).
+  void hessian(const double* x, double eps, Eigen::SparseMatrix<double>& H, double power = 1.0,
+               bool project = true) const;
+  /// Largest a in (0, a_max] such that every sample with det J > 0 at x has
+  /// det J > 0 at x + t d for all t in [0, a] (det J along the line is a
+  /// quadratic in t: J is linear in x), times `safety`; a_max if none ever
+  /// turns non-positive.
+  double max_positive_step(const double* x, const double* d, double a_max, double safety = 0.9) const;
+
   int sample_level(std::size_t element) const { return elements_[element].level; }
   /// \pre 0 <= level <= max_sample_level.
   void set_sample_level(std::size_t element, int level);
@@ -130,6 +168,14 @@ class MapEnergy {
     int level = 0;
     bool active = true;  // touches a variable (else constant: left out)
   };
+  struct HessianPattern {
+    Eigen::SparseMatrix<double> H;          // the structure, values 0
+    std::vector<std::size_t> slot_offset;   // per element: start of its n x n slots
+    std::vector<int> slots;                 // (r, c): position of node(r) in node column node(c), -1 if above
+    std::vector<std::vector<int>> colors;   // elements in groups sharing no free function
+    bool built = false;
+  };
+  void build_hessian_pattern() const;
   // X and Y Bernstein coefficients of element k at the variables x.
   void element_coefficients(std::size_t k, const double* x, std::array<double, 16>& X,
                             std::array<double, 16>& Y) const;
@@ -144,9 +190,20 @@ class MapEnergy {
   std::vector<Eigen::Vector2d> original_;    // as given (the fixed ones are returned exactly)
   Eigen::Vector2d centre_ = Eigen::Vector2d::Zero();
   double L_ = 1.0;
+  mutable HessianPattern hpattern_;
 };
 
 /// chi(D, eps) of the header, evaluated without cancellation for D < 0.
 double regularized_det(double D, double eps);
+
+/// One sample's term phi(J) = t(J)^p with t = [(1 - theta) |J|^2 + theta (det J^2 + 1)] / chi(det J, eps),
+/// its gradient and its Hessian with respect to vec J = (J00, J01, J10, J11) (row-major),
+/// the Hessian projected to positive semi-definite if `project` (header, top).
+struct SampleTerm {
+  double value = 0.0;
+  Eigen::Vector4d gradient = Eigen::Vector4d::Zero();
+  Eigen::Matrix4d hessian = Eigen::Matrix4d::Zero();
+};
+SampleTerm sample_term(const Eigen::Matrix2d& J, double eps, double theta, double power, bool project);
 
 }  // namespace tspline

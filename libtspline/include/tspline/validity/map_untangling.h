@@ -6,8 +6,8 @@
 // its vertices; on real coastlines the cubic map folds there. This step moves
 // the map's own degrees of freedom, with the boundary curve fixed:
 //
-//  1. Minimize the regularized energy E_eps of map_energy.h with L-BFGS
-//     (Ceres' GradientProblemSolver) for a fixed eps, then lower eps by the
+//  1. Minimize the regularized energy E_eps of map_energy.h for a fixed eps
+//     (L-BFGS by default, or projected Newton: MapOptimizer), then lower eps by the
 //     rule of Garanzha et al. 2021 (Sect. 4 there): with sigma = max(1 -
 //     E/E_prev, 1/10) the relative progress of the stage and D_min the smallest
 //     sampled det J, mu = (1 - sigma) chi(D_min, eps), and eps = 2 sqrt(mu (mu -
@@ -24,6 +24,18 @@
 //
 // The map returned is the last certified one if there was one, else the last
 // iterate (then report.certified is false).
+//
+// Projected Newton (issue 23; Teran et al. 2005, Smith et al. 2019): each
+// iteration assembles the energy's Hessian over the free control points with
+// every sample's 4 x 4 Hessian in J projected to positive semi-definite
+// (MapEnergy::hessian), factors it by CHOLMOD's supernodal Cholesky (the
+// symbolic analysis done once per T-mesh and reused; a diagonal shift only if
+// the factorization fails), and searches along the Newton direction by
+// backtracking (Armijo) from the largest step that keeps every positive
+// sample's det J positive (MapEnergy::max_positive_step: det J is quadratic
+// along the line). Once every sample is positive no step makes one
+// non-positive, and once the map is certified no step is accepted that the
+// certificate does not prove valid: a certified map stays certified.
 #include <cstddef>
 #include <functional>
 #include <string>
@@ -34,11 +46,17 @@
 
 namespace tspline {
 
+/// The minimizer of each eps stage.
+enum class MapOptimizer {
+  Newton,  ///< projected Newton, CHOLMOD: fewer iterations, but each costs a sparse Cholesky
+  LBFGS    ///< Ceres' L-BFGS (the default: faster on every benchmark here, bench/README.md)
+};
+
 struct UntanglingProgress {
   int stage = 0;
   double eps = 0.0;
   double energy = 0.0;
-  int iterations = 0;  ///< L-BFGS iterations so far (all stages)
+  int iterations = 0;  ///< optimizer (Newton or L-BFGS) iterations so far (all stages)
   SampleStats samples;
   bool certified = false;  ///< certified at the end of this stage
 };
@@ -50,8 +68,17 @@ struct MapUntanglingOptions {
   /// more stages (measured on Newfoundland: 80 stages of 20 iterations and two
   /// sample refinements without a certificate on 3,247 cells).
   int max_stages = 60;
+  /// L-BFGS by default: on this project's 2-core machine (ATLAS BLAS) the
+  /// Cholesky of the bicubic 2-component Hessian costs 60 ms at 2.7e3 and
+  /// 1.6 s at 3.3e4 unknowns, more than the L-BFGS iterations it saves
+  /// (bench/README.md, issue 23).
+  MapOptimizer optimizer = MapOptimizer::LBFGS;
   int max_iterations_per_stage = 20;  ///< L-BFGS iterations per stage
-  int max_iterations = 20000;         ///< L-BFGS iterations in total
+  /// Newton iterations per stage at most; a stage also ends when an
+  /// iteration lowers the energy by less than newton_stage_tolerance (relative).
+  int max_newton_iterations_per_stage = 8;
+  double newton_stage_tolerance = 1e-4;
+  int max_iterations = 20000;         ///< optimizer iterations in total
   /// Stop once certified and a stage at the floor eps lowered the energy by
   /// less than this fraction.
   double energy_tolerance = 1e-3;
@@ -81,8 +108,13 @@ struct MapUntanglingReport {
   std::size_t elements = 0;
   std::size_t samples = 0;  ///< at the end (after sample refinement)
   int stages = 0;
-  int iterations = 0;   ///< L-BFGS iterations
-  int evaluations = 0;  ///< energy + gradient evaluations
+  int iterations = 0;   ///< optimizer (Newton or L-BFGS) iterations
+  int evaluations = 0;  ///< energy (+ gradient) evaluations
+  int factorizations = 0;  ///< Newton: Hessian assemblies and Cholesky factorizations
+  int shifted_factorizations = 0;  ///< Newton: repeated with a diagonal shift (the first attempt failed)
+  int line_search_certifications = 0;  ///< Newton: trial steps checked by the certificate
+  double hessian_seconds = 0.0;  ///< Newton: assembly of the Hessians
+  double solve_seconds = 0.0;    ///< Newton: CHOLMOD analysis, factorizations and solves
   int sample_refinements = 0;  ///< elements whose sample level was raised
   int local_repairs = 0;        ///< local problems solved for hidden folds (see local_repair)
   int local_repairs_certified = 0;  ///< of which certified the map

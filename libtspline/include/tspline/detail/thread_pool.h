@@ -1,0 +1,26 @@
+#pragma once
+// One pool of worker threads for the whole process (issue 23: the map's
+// energy, gradient and Hessian ran on threads created for every evaluation).
+// The workers are started on first use and live until exit; a parallel call
+// hands each worker one contiguous range and waits for all of them.
+//
+// A call made while the pool is busy (another thread's call in flight, or a
+// call from inside a range body) runs serially in the calling thread instead
+// of waiting or oversubscribing the cores: callers that are themselves
+// parallel (corner trials) keep their own parallelism.
+#include <cstddef>
+#include <functional>
+
+namespace tspline::detail {
+
+/// Threads the pool can use (std::thread::hardware_concurrency, at least 1, at most 16).
+int pool_threads();
+
+/// Runs body(begin, end, slot) on min(threads, pool_threads()) contiguous
+/// ranges of [0, n), slot in [0, ranges); returns when all are done. Serial
+/// (one range, slot 0) if threads <= 1, n < min_parallel, or the pool is busy.
+/// Exceptions from a body are rethrown in the caller (the first one).
+void parallel_ranges(std::size_t n, int threads, const std::function<void(std::size_t, std::size_t, int)>& body,
+                     std::size_t min_parallel = 256);
+
+}  // namespace tspline::detail
