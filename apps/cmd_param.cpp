@@ -50,11 +50,12 @@ std::array<long long, 4> parse_corners(const std::string& text) {
 int run_param(const std::string& input, const std::string& out_dir, const std::string& corners_text,
               tspline::ParameterizationOptions opt, const tspline::AdaptiveOptions& adaptive, int samples,
               const tspline::io::DomainReadOptions& domain_options, tspline_app::OutputMode mode,
-              const std::string& cuts_file, const std::string& layout_name) {
+              const std::string& cuts_file, const std::string& layout_name, bool init_level_given) {
   if (!corners_text.empty()) opt.corners = parse_corners(corners_text);
   if (samples < 1 || samples > 64) throw tspline::InputError("--samples must be in [1, 64]");
   tspline::DomainParameterizationOptions choice;
   choice.layout = tspline::parse_layout_mode(layout_name);
+  if (init_level_given) choice.patch_initial_level = opt.initial_level;  // else the layout's own default
   tspline_app::Progress progress(mode);
   const bool quiet = mode != tspline_app::OutputMode::Human;
   opt.progress = [&progress](const tspline::ProgressEvent& e) { progress.report(e); };
@@ -205,7 +206,9 @@ void add_param_command(CLI::App& app, CommandAction& action) {
                     "Boundary tolerance relative to the squared bounding-box diagonal, used when --tol is "
                     "not given")
       ->capture_default_str();
-  param->add_option("--init-level", A.opt.initial_level, "Initial uniform level L in [0, 10]: 2^L x 2^L cells")
+  auto* init_opt = param->add_option("--init-level", A.opt.initial_level,
+                                     "Initial uniform level L in [0, 10]: 2^L x 2^L cells (patches of a quad "
+                                     "layout: 2 unless given)")
       ->capture_default_str();
   param->add_option("--max-level", A.opt.max_level, "Maximum refinement level of any cell")->capture_default_str();
   param->add_option("--max-sweeps", A.opt.smoothing.max_sweeps, "Maximum Gauss-Seidel sweeps of the optimization")
@@ -250,8 +253,8 @@ void add_param_command(CLI::App& app, CommandAction& action) {
   param->add_flag("--json", A.json_events,
                   "Print progress and the result as JSON lines (one object per line: events log, progress, "
                   "iteration, result) instead of text");
-  param->callback([&action, tol_opt, gj_opt, layer_opt, feature_opt, args] {
-    action = [tol_opt, gj_opt, layer_opt, feature_opt, args] {
+  param->callback([&action, tol_opt, gj_opt, layer_opt, feature_opt, init_opt, args] {
+    action = [tol_opt, gj_opt, layer_opt, feature_opt, init_opt, args] {
       ParamArgs& A = *args;
       if (tol_opt->count() > 0) A.opt.tolerance_absolute = A.tol;
       A.adaptive.optimize_control_points = !A.no_cpo;
@@ -262,7 +265,8 @@ void add_param_command(CLI::App& app, CommandAction& action) {
       if (layer_opt->count() > 0) A.domain_options.layer = A.layer;
       if (feature_opt->count() > 0) A.domain_options.feature = A.feature;
       return run_param(A.input, A.out_dir, A.corners, A.opt, A.adaptive, A.samples, A.domain_options,
-                       tspline_app::output_mode(A.quiet, A.json_events), A.cuts_file, A.layout);
+                       tspline_app::output_mode(A.quiet, A.json_events), A.cuts_file, A.layout,
+                       init_opt->count() > 0);
     };
   });
 }

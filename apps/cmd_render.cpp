@@ -37,6 +37,7 @@ const char* view_name(tspline::io::RenderView v) {
     case tspline::io::RenderView::Jacobian: return "jacobian";
     case tspline::io::RenderView::ControlNet: return "control-net";
     case tspline::io::RenderView::Solution: return "solution";
+    case tspline::io::RenderView::Layout: return "layout";
     case tspline::io::RenderView::Auto: break;
   }
   return "auto";
@@ -54,7 +55,8 @@ void add_render_command(CLI::App& app, CommandAction& action) {
   cmd->add_option("DIR", a->dir, "Output directory of `tspline param` or `tspline poisson`")->required();
   cmd->add_option("--png,--image", a->png, "Picture to write: PNG, SVG or PDF by the extension")->required();
   cmd->add_option("--view", a->view,
-                  "auto (solution if DIR has solution/, else jacobian), tmesh, jacobian, control-net, solution")
+                  "auto (solution if DIR has solution/, else jacobian), tmesh, jacobian, control-net, solution, "
+                  "layout (the patches of a multi-patch map, one colour each)")
       ->capture_default_str();
   cmd->add_option("--size", a->size, "Image size WIDTHxHEIGHT in pixels")->capture_default_str();
   cmd->add_option("--step", a->step, "solution: the Poisson step to draw (default: the last)");
@@ -69,7 +71,8 @@ void add_render_command(CLI::App& app, CommandAction& action) {
       if (!a->quiet) {
         std::cout << "wrote " << a->png << " (" << o.width << "x" << o.height << ", " << view_name(s.view)
                   << " from " << s.source;
-        if (s.max > s.min) std::cout << ", range " << s.min << " .. " << s.max;
+        if (s.view == tspline::io::RenderView::Layout) std::cout << ", " << s.max << " patches";
+        else if (s.max > s.min) std::cout << ", range " << s.min << " .. " << s.max;
         std::cout << ")" << std::endl;
       }
       return 0;

@@ -32,7 +32,7 @@ int main(int argc, char** argv) {
           double t = std::atan2(a.x() * b.y() - a.y() * b.x(), a.dot(b));
           if (t < 0) t += 2 * M_PI;
           t = 2 * M_PI - t;
-          if (t * 180 / M_PI > 170)
+          if (t * 180 / M_PI > 170 || t * 180 / M_PI < 15)
             std::cout << "  patch " << p << " corner " << k << " at (" << v[c].x() << ", " << v[c].y() << ") angle "
                       << t * 180 / M_PI << ", side cuts " << P.side_cut[k] << " " << P.side_cut[(k + 3) % 4]
                       << std::endl;

@@ -5,6 +5,8 @@
 #include <cstdio>
 #include <filesystem>
 #include <limits>
+#include <map>
+#include <set>
 
 #include "tspline/errors.h"
 #include "toolkit/io/atomic_file.h"
@@ -154,6 +156,61 @@ fs::path solution_step(const fs::path& dir, int step) {
   return file;
 }
 
+/// The layout of a multi-patch surface.vtu (cell data "patch"): each patch
+/// filled with its own colour, the patch outlines (interfaces and boundary)
+/// drawn, and the layout nodes where three or more patches meet, or two on the
+/// domain's boundary, marked. Returns the number of patches.
+std::size_t draw_layout(Canvas& img, const toolkit::io::VtuMesh& m) {
+  // A single-patch map has no "patch" array: one patch.
+  const auto it = m.cell_scalars.find("patch");
+  const std::vector<double> patch = it != m.cell_scalars.end() ? it->second : std::vector<double>(m.cells.size(), 0.0);
+  Box box;
+  box.add(m);
+  const double eps = 1e-9 * std::max(box.hi.x() - box.lo.x(), box.hi.y() - box.lo.y());
+  using Key = std::pair<long long, long long>;
+  auto key = [&](const Eigen::Vector2d& p) {
+    return Key(std::llround(p.x() / eps), std::llround(p.y() / eps));
+  };
+  // A muted palette, patch p gets colour p mod 10 (neighbours mostly differ).
+  static const Rgb palette[10] = {{253, 205, 158}, {179, 214, 237}, {204, 235, 197}, {247, 181, 189},
+                                  {217, 201, 235}, {253, 237, 166}, {191, 230, 227}, {237, 209, 199},
+                                  {224, 224, 224}, {214, 232, 153}};
+  std::map<std::pair<Key, Key>, std::map<int, int>> edges;  // edge -> patch -> count
+  std::size_t patches = 0;
+  for (std::size_t c = 0; c < m.cells.size(); ++c) {
+    const auto& cell = m.cells[c];
+    if (cell.size() < 3) continue;
+    const int p = static_cast<int>(patch[c]);
+    patches = std::max<std::size_t>(patches, static_cast<std::size_t>(p) + 1);
+    std::vector<Eigen::Vector2d> poly;
+    for (const auto v : cell) poly.push_back(m.points[v]);
+    img.fill_polygon(poly, palette[p % 10]);
+    for (std::size_t k = 0; k < cell.size(); ++k) {
+      Key a = key(m.points[cell[k]]), b = key(m.points[cell[(k + 1) % cell.size()]]);
+      if (b < a) std::swap(a, b);
+      ++edges[{a, b}][p];
+    }
+  }
+  std::map<Key, std::set<int>> node_patches;
+  std::set<Key> on_boundary;
+  for (const auto& [e, per_patch] : edges) {
+    int outlines = 0;
+    for (const auto& [p, count] : per_patch)
+      if (count == 1) {
+        ++outlines;
+        node_patches[e.first].insert(p), node_patches[e.second].insert(p);
+      }
+    if (outlines == 0) continue;
+    const Eigen::Vector2d a(e.first.first * eps, e.first.second * eps), b(e.second.first * eps, e.second.second * eps);
+    img.draw_line(a, b, kBlack, outlines == 1 ? 1.5 : 1.0);
+    if (outlines == 1) on_boundary.insert(e.first), on_boundary.insert(e.second);
+  }
+  for (const auto& [k, ps] : node_patches)
+    if (ps.size() >= 3 || (ps.size() == 2 && on_boundary.count(k)))
+      img.draw_dot(Eigen::Vector2d(k.first * eps, k.second * eps), 2.5, kRed);
+  return patches;
+}
+
 }  // namespace
 
 RenderView parse_render_view(const std::string& name) {
@@ -162,7 +219,8 @@ RenderView parse_render_view(const std::string& name) {
   if (name == "jacobian") return RenderView::Jacobian;
   if (name == "control-net") return RenderView::ControlNet;
   if (name == "solution") return RenderView::Solution;
-  throw InputError("--view: '" + name + "' is not one of auto, tmesh, jacobian, control-net, solution");
+  if (name == "layout") return RenderView::Layout;
+  throw InputError("--view: '" + name + "' is not one of auto, tmesh, jacobian, control-net, solution, layout");
 }
 
 RenderSummary render_png(const std::string& dir_name, const std::string& png_path, const RenderOptions& options) {
@@ -245,6 +303,16 @@ RenderSummary render_png(const std::string& dir_name, const std::string& png_pat
         summary.source = file.string();
         summary.min = lo;
         summary.max = hi;
+        break;
+      }
+      case RenderView::Layout: {
+        const fs::path file = dir / output_files::kSurface;
+        const toolkit::io::VtuMesh m = read_output(file, param);
+        Box box;
+        box.add(m);
+        set_view(img, box, false);
+        summary.max = static_cast<double>(draw_layout(img, m));
+        summary.source = file.string();
         break;
       }
       case RenderView::Auto: break;

@@ -229,6 +229,20 @@ void slide_ring_nodes(std::vector<Eigen::Vector2d>& x, std::vector<double>& arc,
     const Eigen::Vector2d t1 = rc.point(arc[n] + l) - x[n], t0 = x[n] - rc.point(arc[n] - l);
     const double turn = std::abs(std::atan2(cross(t0, t1), t0.dot(t1)));
     if (turn > 25.0 * std::numbers::pi / 180.0) continue;
+    // Never across a corner of the ring (a turn of more than 45 degrees on the scale l):
+    // the side would have a kink inside it.
+    auto turn_at = [&](double sv) {
+      const Eigen::Vector2d p = rc.point(sv), u = rc.point(sv + l) - p, w = p - rc.point(sv - l);
+      return std::abs(std::atan2(cross(w, u), w.dot(u)));
+    };
+    for (std::size_t i = 0; i < rc.size(); ++i) {
+      double si = rc.arc(i);
+      while (si - arc[n] > 0.5 * L) si -= L;
+      while (arc[n] - si > 0.5 * L) si += L;
+      if (!(lo < si && si < hi) || si == arc[n] || turn_at(si) <= 0.25 * std::numbers::pi) continue;
+      if (si < arc[n]) lo = std::max(lo, si);
+      else hi = std::min(hi, si);
+    }
     const double a0 = lo + 0.2 * (arc[n] - lo), b0 = hi - 0.2 * (hi - arc[n]);
     const double start = arc[n];
     const double before = worst(static_cast<int>(n));
@@ -504,7 +518,7 @@ QuadLayout build_quad_layout(const Domain& d, const QuadLayoutOptions& o) {
     QuadLayoutStats& st = out.stats;
     st.patches = out.layout.patches.size();
     st.min_size = so.min_size;
-    st.max_size = so.max_size > 0.0 ? so.max_size : 0.25 * diam;
+    st.max_size = so.max_size > 0.0 ? so.max_size : 0.125 * diam;
     for (std::size_t n = 0; n < x.size(); ++n) {
       if (degree[n] == 0) continue;
       if (node_ring[n] >= 0) ++st.ring_nodes;

@@ -38,6 +38,9 @@ struct GmshSession {
     gmsh::initialize();
     gmsh::option::setNumber("General.Terminal", 0);
     gmsh::option::setNumber("General.Verbosity", 1);
+    // One thread: Gmsh reports errors by throwing, which cannot leave its OpenMP regions.
+    gmsh::option::setNumber("General.NumThreads", 1);
+    gmsh::option::setNumber("Mesh.MaxNumThreads2D", 1);
   }
   ~GmshSession() { gmsh::finalize(); }
   GmshSession(const GmshSession&) = delete;

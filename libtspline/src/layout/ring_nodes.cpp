@@ -112,8 +112,44 @@ std::vector<double> ring_nodes(const RingCurve& ring, const RingNodeOptions& o,
     out.push_back(a);
     for (double s : inside) out.push_back(std::fmod(s, L));
   }
+  // Corners of the ring: vertices where it turns by more than corner_turn on the
+  // scale of a quarter of the local piece size (the domain's corners, the tips
+  // of peninsulas, the heads of inlets), the sharpest first, none within half a
+  // piece of a sharper one. Patch corners belong there, not inside a side.
+  {
+    std::vector<std::pair<double, double>> turns;  // (turn, arc)
+    for (std::size_t i = 0; i < n; ++i) {
+      const Eigen::Vector2d p = ring.vertex(i);
+      const double h = size ? std::max(size(p), o.min_size) : 0.1 * L;
+      const double l = std::min(0.25 * h, 0.1 * L);
+      const Eigen::Vector2d u = ring.point(ring.arc(i) + l) - p, w = p - ring.point(ring.arc(i) - l);
+      const double turn = std::abs(std::atan2(w.x() * u.y() - w.y() * u.x(), w.dot(u)));
+      if (turn > o.corner_turn) turns.push_back({turn, ring.arc(i)});
+    }
+    std::sort(turns.begin(), turns.end(), std::greater<>());
+    std::vector<double> kept;
+    for (const auto& [turn, s] : turns) {
+      const double h = size ? std::max(size(ring.point(s)), o.min_size) : 0.1 * L;
+      bool near = false;
+      for (double k : kept) {
+        const double d = std::abs(k - s);
+        near = near || std::min(d, L - d) < 0.5 * h;
+      }
+      if (!near) kept.push_back(s);
+    }
+    // A corner replaces the Douglas-Peucker nodes within a quarter piece of it.
+    for (double k : kept) {
+      const double h = size ? std::max(size(ring.point(k)), o.min_size) : 0.1 * L;
+      std::erase_if(out, [&](double s) {
+        const double d = std::abs(k - s);
+        return std::min(d, L - d) < 0.25 * h;
+      });
+    }
+    out.insert(out.end(), kept.begin(), kept.end());
+  }
   std::sort(out.begin(), out.end());
   out.erase(std::unique(out.begin(), out.end()), out.end());
+  if (out.empty()) out.push_back(0.0);
   out = split_long_pieces(ring, std::move(out), size, o.min_size);
   // At least min_nodes_per_ring: split the longest pieces at half their arc length.
   while (out.size() < static_cast<std::size_t>(std::max(o.min_nodes_per_ring, 1))) {

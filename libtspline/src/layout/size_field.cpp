@@ -61,7 +61,7 @@ SizeField::SizeField(const Domain& d, const SizeFieldOptions& o) {
   Eigen::Vector2d lo = d.outer.vertices.front(), hi = lo;
   for (const auto& v : d.outer.vertices) lo = lo.cwiseMin(v), hi = hi.cwiseMax(v);
   const double diag = (hi - lo).norm();
-  max_size_ = o.max_size > 0.0 ? o.max_size : 0.25 * diag;
+  max_size_ = o.max_size > 0.0 ? o.max_size : 0.125 * diag;
   min_size_ = std::min(o.min_size, max_size_);
 
   // Ring samples: the vertices, and points on long edges so that no gap exceeds spacing.

@@ -122,7 +122,9 @@ InterfaceReport measure_interface(const MultiPatchResult& R, const Interface& f)
 // (transfer_map reproduces the boundary curve exactly; inside it is the
 // interpolant of the old map), then checked again: the new map replaces the
 // old one only if it is still certified (or the old one was not either).
-void equalize_interface_knots(MultiPatchResult& R, const AdaptiveOptions& ad, int max_level) {
+// Returns the number of patches refined (0: every interface has one set of knots).
+std::size_t equalize_interface_knots(MultiPatchResult& R, const AdaptiveOptions& ad, int max_level) {
+  std::size_t refined = 0;
   std::vector<BorderParams> want(R.patches.size());
   for (const Interface& f : R.layout.interfaces) {
     const std::set<double> u = interface_knots(R, f);
@@ -138,6 +140,7 @@ void equalize_interface_knots(MultiPatchResult& R, const AdaptiveOptions& ad, in
     TSplineMap map = transfer_map(*r.map, std::move(mesh));
     MapCertification cert = ad.certify ? certify_map(map, ad.certification) : MapCertification{};
     if (ad.certify && r.certified_valid() && !cert.certified_valid()) continue;
+    ++refined;
     std::vector<CellMapQuality> cells;
     r.quality = map_quality(map, ad.gauss, &cells);
     r.cell_quality = std::move(cells);
@@ -149,6 +152,7 @@ void equalize_interface_knots(MultiPatchResult& R, const AdaptiveOptions& ad, in
       r.front.optimized[v] = map.point(r.front.mesh.vertex_param(v));
     r.map.emplace(std::move(map));
   }
+  return refined;
 }
 
 }  // namespace
@@ -279,7 +283,10 @@ MultiPatchResult run_multipatch_parameterization(const Domain& domain, PatchLayo
     log("interfaces: re-running " + std::to_string(std::count(stale.begin(), stale.end(), 1)) +
         " patches with the union of the knots of their interfaces");
   }
-  equalize_interface_knots(R, adaptive, options.max_level);
+  // Refining a patch to the knots of one interface can refine its others (the
+  // T-mesh stays balanced): repeat until every interface has one set of knots.
+  for (int round = 0; round < 16 && equalize_interface_knots(R, adaptive, options.max_level) > 0; ++round) {
+  }
   for (std::size_t i = 0; i < R.layout.interfaces.size(); ++i)
     R.interfaces[i] = measure_interface(R, R.layout.interfaces[i]);
   R.map_area = 0.0;

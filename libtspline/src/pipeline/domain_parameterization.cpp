@@ -65,8 +65,14 @@ DomainParameterization parameterize_domain(const Domain& input, const Parameteri
     out.layout = "quad";
     out.reason = reason;
     out.quad_stats = L.stats;
+    ParameterizationOptions po = options;
+    if (c.patch_initial_level) po.initial_level = *c.patch_initial_level;
     out.patches.emplace(
-        run_multipatch_parameterization(domain, std::move(L.layout), L.explanation(), options, adaptive, c.multi, on_patch));
+        run_multipatch_parameterization(domain, std::move(L.layout), L.explanation(), po, adaptive, c.multi, on_patch));
+  };
+  auto good_patches = [&](const MultiPatchResult& R) {
+    return (!adaptive.certify || R.certified_valid()) && R.min_scaled_jacobian_dense() >= c.good_scaled_jacobian &&
+           R.min_mean_ratio_dense() >= c.good_mean_ratio;
   };
   if (c.layout == LayoutMode::Quad) {
     run_quad("layout quad was asked for");
@@ -74,8 +80,31 @@ DomainParameterization parameterize_domain(const Domain& input, const Parameteri
   }
   // Auto.
   if (holes) {
+    // A few holes: the automatic cuts first (few, large patches), kept where good.
+    std::string why = "the domain has holes";
+    if (domain.holes.size() <= static_cast<std::size_t>(c.first_try_max_holes) && quad_mesher_available()) {
+      try {
+        AutomaticCuts a = automatic_cuts(domain);
+        MultiPatchResult R = run_multipatch_parameterization(domain, build_patch_layout(domain, std::move(a.cuts)),
+                                                             "automatic: " + a.explanation, options, adaptive,
+                                                             c.multi, on_patch);
+        std::ostringstream q;
+        q.precision(3);
+        q << "scaled Jacobian " << R.min_scaled_jacobian_dense() << ", J_r " << R.min_mean_ratio_dense();
+        if (good_patches(R)) {
+          out.layout = "automatic cuts";
+          out.reason = "the automatic cuts between the holes are certified and good over the whole map (" + q.str() + ")";
+          out.patches.emplace(std::move(R));
+          return out;
+        }
+        why = "the automatic cuts between the holes are certified but poor, or not certified (" + q.str() + ")";
+      } catch (const InputError& e) {
+        why = std::string("the domain has holes, and no automatic cuts were found (") + e.what() + ")";
+      }
+      report_step(options.progress, "layout", why + ": building a quad layout");
+    }
     if (quad_mesher_available()) {
-      run_quad("the domain has holes");
+      run_quad(why);
       return out;
     }
     AutomaticCuts a = automatic_cuts(domain);

@@ -8,8 +8,9 @@
 // split at its vertex farthest from its chord while that distance exceeds
 // `max_deviation` times the chord (a deep inlet, a sharp tip or a peninsula
 // inside one side would cost the patch its quality; wiggles small against the
-// side do not), and then at equal arc length while the chord is longer than
-// the local patch size (size_field.h). Features smaller than `min_size` are
+// side do not), at the ring's corners (a turn of more than 40 degrees on the
+// scale of a quarter piece), and then at equal arc length while the chord is
+// longer than the local patch size (size_field.h). Features smaller than `min_size` are
 // not resolved: they stay inside one side and the patch's T-mesh follows them.
 #include <Eigen/Core>
 #include <cstddef>
@@ -45,6 +46,9 @@ struct RingNodeOptions {
   double max_deviation = 0.2;  ///< split a piece while a vertex is farther than this x chord from it
   double min_size = 0.0;       ///< never split a piece shorter (by arc length) than this
   int min_nodes_per_ring = 4;  ///< a ring gets at least this many nodes
+  /// Vertices where the ring turns by more than this (radians) on the scale of
+  /// a quarter of the local piece size are nodes (corners of the domain).
+  double corner_turn = 40.0 * 3.14159265358979323846 / 180.0;
 };
 
 /// Nodes of one ring as arc lengths in [0, length), increasing, at ring vertices

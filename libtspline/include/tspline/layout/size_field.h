@@ -23,10 +23,13 @@
 namespace tspline {
 
 struct SizeFieldOptions {
-  double factor = 1.0;        ///< patch size per unit of local width
+  /// Patch size per unit of local width: 1/2, two patches across every neck
+  /// (the quad mesher meshes at twice the size and splits, so that its coarse
+  /// elements are as wide as the neck).
+  double factor = 0.5;
   double grading = 0.35;      ///< growth of the size per unit distance from the boundary
   double min_size = 0.0;      ///< absolute; widths below are not resolved
-  double max_size = 0.0;      ///< absolute; 0: a quarter of the bounding-box diagonal
+  double max_size = 0.0;      ///< absolute; 0: an eighth of the bounding-box diagonal
   double across_ratio = 2.5;  ///< arc length / distance above which two samples of a ring face each other
   int grid_cells = 768;       ///< grid cells along the longer side of the bounding box
 };

@@ -7,8 +7,10 @@
 //   cuts:   the layout given by cuts (patch_layout.h);
 //   auto:   one patch where a first try (at most 3 adaptive rounds) is
 //           certified and good over the whole map (scaled Jacobian >= 0.3
-//           and J_r >= 0.1 over the dense sample), the quad layout otherwise
-//           and always for domains with holes. Without a quad mesher in the
+//           and J_r >= 0.1 over the dense sample), the quad layout otherwise;
+//           for domains with holes the quad layout, unless they have at most
+//           4 holes and the automatic cuts are certified and good by the same
+//           measure. Without a quad mesher in the
 //           build, domains with holes fall back to the automatic cuts
 //           (automatic_cuts.h) and domains without keep the single patch.
 #include <functional>
@@ -40,6 +42,12 @@ struct DomainParameterizationOptions {
   double good_mean_ratio = 0.1;
   /// Auto: adaptive rounds of the single-patch first try at most.
   int first_try_rounds = 3;
+  /// Auto: domains with at most this many holes try the automatic cuts
+  /// (automatic_cuts.h: few, large patches) first and keep them where good.
+  int first_try_max_holes = 4;
+  /// Initial T-mesh level of the patches of a quad layout (they are small and
+  /// nearly square; refinement adds what they need); unset: the options' own.
+  std::optional<int> patch_initial_level = 2;
 };
 
 struct DomainParameterization {

@@ -12,10 +12,11 @@ enum class RenderView {
   TMesh,       ///< image of the T-mesh cells under the map (curved edges), boundary polygon
   Jacobian,    ///< mean ratio Jacobian J_r on [0, 1] (viridis; J_r < 0 red), T-mesh edges
   ControlNet,  ///< control net (lines and points) over the boundary polygon
-  Solution     ///< u_h of the last (or a given) Poisson step, analysis cell edges
+  Solution,    ///< u_h of the last (or a given) Poisson step, analysis cell edges
+  Layout       ///< the patches of a multi-patch map, one colour each; interfaces, layout nodes
 };
 
-/// Parses "auto", "tmesh", "jacobian", "control-net", "solution". \throw InputError.
+/// Parses "auto", "tmesh", "jacobian", "control-net", "solution", "layout". \throw InputError.
 RenderView parse_render_view(const std::string& name);
 
 struct RenderOptions {
@@ -28,7 +29,7 @@ struct RenderOptions {
 struct RenderSummary {
   RenderView view = RenderView::Auto;  ///< the view drawn (Auto resolved)
   std::string source;                  ///< the main .vtu file read
-  double min = 0.0, max = 0.0;         ///< range of the colour-mapped field (0, 0 if none)
+  double min = 0.0, max = 0.0;         ///< range of the colour-mapped field (0, 0 if none; Layout: max = patches)
 };
 
 /// Draws `dir`'s outputs into `png_path` (written atomically), a PNG, SVG or

@@ -1,0 +1,231 @@
+// Automatic quad layouts (layout/): ring nodes, the size field, the layout of
+// a domain with a narrow neck and of one with many holes, the conforming
+// multi-patch map on a layout, and the layout choice of parameterize_domain.
+#include <doctest/doctest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
+#include "test_support.h"
+#include "tspline/boundary/domain.h"
+#include "tspline/errors.h"
+#include "tspline/layout/quad_layout.h"
+#include "tspline/layout/quad_mesher.h"
+#include "tspline/layout/ring_nodes.h"
+#include "tspline/layout/size_field.h"
+#include "tspline/multipatch/multipatch_parameterization.h"
+#include "tspline/pipeline/domain_parameterization.h"
+
+namespace {
+
+using test_support::contains;
+using test_support::make_polygon;
+using test_support::message_of;
+
+tspline::Polygon rectangle(double x0, double y0, double x1, double y1) {
+  return make_polygon({{x0, y0}, {x1, y0}, {x1, y1}, {x0, y1}});
+}
+
+// Two 4 x 4 squares joined by a neck of width w and length 2 (counter-clockwise).
+tspline::Polygon dumbbell(double w) {
+  return make_polygon({{0, 0}, {4, 0}, {4, 2 - w / 2}, {6, 2 - w / 2}, {6, 0}, {10, 0}, {10, 4}, {6, 4},
+                       {6, 2 + w / 2}, {4, 2 + w / 2}, {4, 4}, {0, 4}});
+}
+
+double polygon_area(const std::vector<Eigen::Vector2d>& v) {
+  double a = 0.0;
+  for (std::size_t i = 0; i < v.size(); ++i) {
+    const Eigen::Vector2d &p = v[i], &q = v[(i + 1) % v.size()];
+    a += p.x() * q.y() - p.y() * q.x();
+  }
+  return 0.5 * a;
+}
+
+// Inner angle (degrees) of a counter-clockwise polygon at vertex i.
+double inner_angle(const std::vector<Eigen::Vector2d>& v, std::size_t i) {
+  const std::size_t n = v.size();
+  const Eigen::Vector2d a = v[(i + n - 1) % n] - v[i], b = v[(i + 1) % n] - v[i];
+  double t = std::atan2(a.x() * b.y() - a.y() * b.x(), a.dot(b));
+  if (t < 0) t += 2 * std::numbers::pi;
+  return 360.0 - t * 180.0 / std::numbers::pi;
+}
+
+// Every patch: four corners, each of inner angle below 180 degrees; the patch
+// polygons tile the domain (their areas add up to the domain's).
+void check_layout_tiles(const tspline::Domain& d, const tspline::PatchLayout& L) {
+  double area = 0.0;
+  for (const tspline::Patch& p : L.patches) {
+    const double a = polygon_area(p.polygon.vertices);
+    CHECK(a > 0.0);
+    area += a;
+    for (int k = 0; k < 4; ++k) CHECK(inner_angle(p.polygon.vertices, p.corners[k]) < 180.0);
+  }
+  CHECK(area == doctest::Approx(tspline::domain_area(d)).epsilon(1e-12));
+  // Every cut is the side of exactly two patches.
+  CHECK(L.interfaces.size() == L.cuts.size());
+}
+
+}  // namespace
+
+TEST_SUITE("quad_layout") {
+  TEST_CASE("ring curve: arc length, points, the vertex farthest from a chord") {
+    const tspline::RingCurve r(rectangle(0, 0, 4, 2).vertices);
+    CHECK(r.length() == doctest::Approx(12.0));
+    CHECK((r.point(5.0) - Eigen::Vector2d(4, 1)).norm() < 1e-14);
+    CHECK((r.point(13.0) - Eigen::Vector2d(1, 0)).norm() < 1e-14);  // modulo the length
+    // From (2, 0) to (4, 1): the vertex (4, 0) in between, at distance 2/sqrt(5) from the chord.
+    const auto [dev, at] = r.farthest_from_chord(2.0, 5.0);
+    CHECK(dev == doctest::Approx(2.0 / std::sqrt(5.0)));
+    CHECK(at == doctest::Approx(4.0));
+    // Wrapping past vertex 0: from (0, 1) (arc 11) to (1, 0) (arc 13): the vertex (0, 0) at arc 12.
+    CHECK(r.farthest_from_chord(11.0, 13.0).second == doctest::Approx(12.0));
+  }
+
+  TEST_CASE("ring nodes: the corners of a rectangle, and long sides split by the size") {
+    const tspline::RingCurve r(rectangle(0, 0, 4, 2).vertices);
+    const std::vector<double> corners = tspline::ring_nodes(r, {});
+    CHECK(corners == std::vector<double>{0.0, 4.0, 6.0, 10.0});
+    // With size 1 every side is split into pieces of at most 1.2.
+    const std::vector<double> fine = tspline::ring_nodes(r, {}, [](const Eigen::Vector2d&) { return 1.0; });
+    CHECK(fine.size() == 12);
+    for (std::size_t k = 0; k < fine.size(); ++k) {
+      const double next = k + 1 < fine.size() ? fine[k + 1] : fine[0] + r.length();
+      CHECK(next - fine[k] == doctest::Approx(1.0));
+    }
+    // A ring of three vertices still gets four nodes.
+    const tspline::RingCurve tri(make_polygon({{0, 0}, {1, 0}, {0, 1}}).vertices);
+    CHECK(tspline::ring_nodes(tri, {}).size() == 4);
+  }
+
+  TEST_CASE("size field: the local width in a neck, growing away from it at the grading rate") {
+    const tspline::Domain d = tspline::validate_domain({dumbbell(0.5), {}});
+    tspline::SizeFieldOptions o;
+    o.factor = 0.5;
+    o.grading = 0.35;
+    const tspline::SizeField h(d, o);
+    // Across the neck: factor x width 0.5 at the ring, plus the grading times the 0.25 to
+    // the centre (up to the grid's resolution, 10 / 768, and the chamfer's 8 %).
+    CHECK(h({5.0, 2.0}) == doctest::Approx(0.5 * 0.5 + 0.35 * 0.25).epsilon(0.1));
+    CHECK(h.min_width() == doctest::Approx(0.5).epsilon(1e-6));
+    // One unit from the neck's mouth into a bulb: at most factor x width + grading.
+    CHECK(h({3.0, 2.0}) <= 0.5 * 0.5 + 0.35 * 1.0 + 0.05);
+    // Far from any narrow place the size is capped by an eighth of the diagonal.
+    CHECK(h({1.0, 1.0}) <= 0.125 * std::hypot(10.0, 4.0) + 1e-12);
+  }
+
+  TEST_CASE("quad corner scaled Jacobian: 1 for a square, sin 60 for a rhombus, negative when reflex") {
+    using V = Eigen::Vector2d;
+    CHECK(tspline::quad_corner_scaled_jacobian({V(0, 0), V(1, 0), V(1, 1), V(0, 1)}) == doctest::Approx(1.0));
+    const double c = std::cos(std::numbers::pi / 3), s = std::sin(std::numbers::pi / 3);
+    CHECK(tspline::quad_corner_scaled_jacobian({V(0, 0), V(1, 0), V(1 + c, s), V(c, s)}) == doctest::Approx(s));
+    CHECK(tspline::quad_corner_scaled_jacobian({V(0, 0), V(2, 0), V(0.5, 0.5), V(0, 2)}) < 0.0);
+  }
+
+  TEST_CASE("layout of a domain with a narrow neck: patches of their own in the neck, near square") {
+    if (!tspline::quad_mesher_available()) {
+      const std::string msg = message_of<tspline::InputError>(
+          [] { (void)tspline::build_quad_layout(tspline::validate_domain({dumbbell(0.5), {}})); });
+      CHECK(contains(msg, "Gmsh"));
+      return;
+    }
+    const tspline::Domain d = tspline::validate_domain({dumbbell(0.5), {}});
+    const tspline::QuadLayout L = tspline::build_quad_layout(d);
+    check_layout_tiles(d, L.layout);
+    // Patches whose centroid lies in the neck (4 < x < 6): shorter than four times
+    // the neck's width along it, and with sides of ratio at most 4.
+    int in_neck = 0;
+    for (const tspline::Patch& p : L.layout.patches) {
+      Eigen::Vector2d c = Eigen::Vector2d::Zero();
+      for (std::size_t k = 0; k < 4; ++k) c += p.polygon.vertices[p.corners[k]] / 4.0;
+      if (!(c.x() > 4.2 && c.x() < 5.8)) continue;
+      ++in_neck;
+      double lo = 1e300, hi = 0.0;
+      for (int k = 0; k < 4; ++k) {
+        const double l = (p.polygon.vertices[p.corners[(k + 1) % 4]] - p.polygon.vertices[p.corners[k]]).norm();
+        lo = std::min(lo, l), hi = std::max(hi, l);
+      }
+      CHECK(hi <= 4.0 * lo);
+      CHECK(hi <= 4.0 * 0.5);
+    }
+    CHECK(in_neck >= 2);  // the neck is 2 long and 0.5 wide: several patches along it
+    CHECK(L.stats.min_corner_scaled_jacobian > 0.2);
+    for (std::size_t v = 0; v <= 2; ++v) CHECK(L.stats.valence[v] == 0);  // no inner node of valence 2 or less
+  }
+
+  TEST_CASE("layout of a square with 16 holes: every ring joined, patches tiling the domain") {
+    if (!tspline::quad_mesher_available()) return;  // the no-Gmsh message is checked above
+    tspline::Domain d{rectangle(0, 0, 8, 8), {}};
+    for (int i = 0; i < 4; ++i)
+      for (int j = 0; j < 4; ++j) d.holes.push_back(rectangle(1 + 2 * i, 1 + 2 * j, 1.6 + 2 * i, 1.5 + 2 * j));
+    d = tspline::validate_domain(d);
+    const tspline::QuadLayout L = tspline::build_quad_layout(d);
+    check_layout_tiles(d, L.layout);
+    CHECK(L.stats.patches == L.layout.patches.size());
+    CHECK(L.stats.min_corner_scaled_jacobian > 0.2);
+    // Every hole is a side of some patch.
+    for (std::size_t h = 0; h < d.holes.size(); ++h) {
+      const Eigen::Vector2d corner = d.holes[h].vertices[0];
+      bool touched = false;
+      for (const tspline::Patch& p : L.layout.patches)
+        for (const Eigen::Vector2d& v : p.polygon.vertices)
+          if ((v - corner).norm() < 1e-12) touched = true;
+      CHECK(touched);
+    }
+  }
+
+  TEST_CASE("multi-patch map on a quad layout: certified, conforming after adaptive refinement, area") {
+    if (!tspline::quad_mesher_available()) return;
+    // A rectangular and a round hole (a 48-gon: its patches refine to the boundary tolerance,
+    // the cuts' other patches do not, so the knots must be carried across the interfaces).
+    std::vector<Eigen::Vector2d> circle;
+    for (int k = 0; k < 48; ++k)
+      circle.push_back(Eigen::Vector2d(2.8, 1.6) + 0.45 * Eigen::Vector2d(std::cos(k * std::numbers::pi / 24),
+                                                                          std::sin(k * std::numbers::pi / 24)));
+    tspline::Domain d{rectangle(0, 0, 4, 3), {rectangle(1, 1, 1.8, 1.6), make_polygon(circle)}};
+    d = tspline::validate_domain(d);
+    const double circle_area = 0.5 * 48 * 0.45 * 0.45 * std::sin(std::numbers::pi / 24);
+    tspline::DomainParameterizationOptions choice;
+    choice.layout = tspline::LayoutMode::Quad;
+    tspline::ParameterizationOptions po;
+    po.tolerance_relative = 1e-7;  // the round hole's sides need more than the initial cells
+    tspline::AdaptiveOptions ad;
+    ad.max_adapt = 3;
+    const tspline::DomainParameterization P = tspline::parameterize_domain(d, po, ad, choice);
+    REQUIRE(P.patches);
+    CHECK(P.layout == "quad");
+    const tspline::MultiPatchResult& R = *P.patches;
+    CHECK(R.certified_valid());
+    CHECK(std::abs(R.map_area - R.domain_area) < 1e-3 * R.domain_area);
+    CHECK(R.domain_area == doctest::Approx(12.0 - 0.48 - circle_area));
+    CHECK(R.max_gap() <= 1e-12 * R.diameter);
+    bool refined = false;
+    for (const auto& r : R.patches) refined = refined || r.map->mesh().num_cells() > 16;
+    CHECK(refined);
+    for (const auto& i : R.interfaces) CHECK(i.same_knots);
+  }
+
+  TEST_CASE("layout choice: single keeps the one-patch run, auto keeps one patch where it is good") {
+    const tspline::Domain square{rectangle(0, 0, 1, 1), {}};
+    tspline::ParameterizationOptions po;
+    po.initial_level = 2;
+    const tspline::AdaptiveOptions ad;
+    tspline::DomainParameterizationOptions single;
+    single.layout = tspline::LayoutMode::Single;
+    const tspline::DomainParameterization S = tspline::parameterize_domain(square, po, ad, single);
+    REQUIRE(S.single);
+    const tspline::ParameterizationResult direct = tspline::run_parameterization(square.outer, po, ad);
+    CHECK(S.single->map->mesh().num_cells() == direct.map->mesh().num_cells());
+    CHECK(S.single->dense_quality.min_mean_ratio == direct.dense_quality.min_mean_ratio);
+    // The unit square is mapped onto itself: certified and good, so auto keeps one patch.
+    const tspline::DomainParameterization A = tspline::parameterize_domain(square, po, ad, {});
+    CHECK(A.layout == "single");
+    CHECK(contains(A.reason, "good over the whole map"));
+    // A domain with holes is never one patch.
+    const tspline::Domain holed{rectangle(0, 0, 3, 3), {rectangle(1, 1, 2, 2)}};
+    CHECK(contains(message_of<tspline::InputError>([&] { (void)tspline::parameterize_domain(holed, po, ad, single); }),
+                   "cannot be one patch"));
+    CHECK(contains(message_of<tspline::InputError>([] { (void)tspline::parse_layout_mode("quads"); }),
+                   "auto, single, quad"));
+  }
+}
