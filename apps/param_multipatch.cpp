@@ -3,7 +3,11 @@
 #include <chrono>
 #include <iostream>
 #include <sstream>
+#include <string>
+#include <vector>
 
+#include "tspline/boundary/domain.h"
+#include "tspline/boundary/polygon_validation.h"
 #include "tspline/errors.h"
 #include "tspline/io/multipatch_output.h"
 #include "tspline/io/polygon_reader.h"
@@ -18,7 +22,20 @@ int run_multipatch_param(const tspline::io::DomainInput& input_domain, const std
   if (options.corners) throw tspline::InputError("--corners applies to a single patch; a domain with holes is cut "
                                                  "into patches whose corners are the ends of the cuts");
   const auto t0 = std::chrono::steady_clock::now();
-  tspline::Domain domain{input_domain.outer, input_domain.holes};
+  // Every ring is cleaned here with the run's boundary tolerance (needles
+  // narrower than epsilon / diagonal go, one note per cleaned ring); the
+  // pipeline's own validate_domain then finds nothing more to remove.
+  std::vector<std::string> cleaning_notes;
+  tspline::Domain domain;
+  {
+    tspline::DomainCleaningOptions how;
+    how.needle_width =
+        tspline::needle_width_for_ring(input_domain.outer, options.tolerance_absolute, options.tolerance_relative);
+    how.notes = &cleaning_notes;
+    domain = tspline::validate_domain(tspline::Domain{input_domain.outer, input_domain.holes}, how);
+  }
+  for (const std::string& note : cleaning_notes)
+    tspline::report_step(options.progress, "cleaning", "note: " + note, -1, tspline::ProgressEvent::Kind::Note);
   std::optional<std::vector<tspline::Cut>> cuts;
   if (!cuts_file.empty()) {
     cuts.emplace();
@@ -31,6 +48,7 @@ int run_multipatch_param(const tspline::io::DomainInput& input_domain, const std
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   nlohmann::json report = tspline::io::multipatch_report(R, input, seconds);
   report["input_geometry"] = input_domain.description;
+  report["input_cleaning"] = {{"notes", cleaning_notes}};
   tspline::io::write_multipatch_outputs(R, out_dir, report, samples);
   progress.settle();
   const auto& totals = report["totals"];
