@@ -63,9 +63,9 @@ int run_param(const std::string& input, const std::string& out_dir, const std::s
   tspline::io::AdaptSeriesWriter series(out_dir, samples);
   const tspline::ParameterizationResult result = tspline::run_parameterization(
       polygon, opt, adaptive,
-      [&](int it, const tspline::TMesh& mesh, const std::vector<Eigen::Vector2d>& x, const tspline::TSplineMap& map,
-          const std::vector<tspline::CellMapQuality>&) {
-        series.add(it, mesh, x, map);
+      [&](int it, const tspline::TMesh& mesh, const std::vector<Eigen::Vector2d>&, const tspline::TSplineMap& map,
+          const std::vector<tspline::CellMapQuality>& cells) {
+        series.add(it, map, &cells);
         progress.event({{"event", "iteration"},
                         {"iteration", it},
                         {"cells", mesh.num_cells()},

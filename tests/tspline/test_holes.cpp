@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "test_support.h"
+#include "toolkit/io/vtu_reader.h"
 #include "tspline/multipatch/automatic_cuts.h"
 #include "tspline/boundary/border_knots.h"
 #include "tspline/boundary/domain.h"
@@ -321,6 +322,21 @@ TEST_SUITE("holes") {
       for (const char* f : {"surface.vtu", "boundary.vtu", "parametric_tmesh.vtu", "physical_tmesh.vtu",
                             "control_net.vtu", "report.json"})
         CHECK(std::filesystem::exists(dir / f));
+      // physical_tmesh.vtu (read back with VTK): every patch's cells drawn
+      // through its map, none flagged invalid on this certified map.
+      const toolkit::io::VtuMesh phys = toolkit::io::read_vtu((dir / "physical_tmesh.vtu").string());
+      std::size_t cells = 0;
+      for (const auto& r : R.patches) cells += r.map->mesh().num_cells();
+      REQUIRE(phys.cells.size() == cells);
+      std::size_t flagged = 0, uncertified = 0;
+      for (std::size_t c = 0; c < cells; ++c) {
+        flagged += phys.cell_scalars.at("valid")[c] != 1.0;
+        uncertified += phys.cell_scalars.at("certified")[c] != 1.0;
+        CHECK(phys.cell_scalars.at("det_lower_bound")[c] > 0.0);
+      }
+      CHECK(flagged == 0);
+      CHECK(uncertified == 0);
+      CHECK(phys.cell_scalars.at("patch").back() == static_cast<double>(R.patches.size() - 1));
     }
   }
 
