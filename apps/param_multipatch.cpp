@@ -32,10 +32,18 @@ int run_multipatch_param(const tspline::io::DomainInput& input_domain, const std
     how.needle_width =
         tspline::needle_width_for_ring(input_domain.outer, options.tolerance_absolute, options.tolerance_relative);
     how.notes = &cleaning_notes;
-    domain = tspline::validate_domain(tspline::Domain{input_domain.outer, input_domain.holes}, how);
+    auto report_notes = [&] {
+      for (const std::string& note : cleaning_notes)
+        tspline::report_step(options.progress, "cleaning", "note: " + note, -1, tspline::ProgressEvent::Kind::Note);
+    };
+    try {
+      domain = tspline::validate_domain(tspline::Domain{input_domain.outer, input_domain.holes}, how);
+    } catch (const tspline::InputError&) {
+      report_notes();  // what was cleaned before the ring that stopped the run
+      throw;
+    }
+    report_notes();
   }
-  for (const std::string& note : cleaning_notes)
-    tspline::report_step(options.progress, "cleaning", "note: " + note, -1, tspline::ProgressEvent::Kind::Note);
   std::optional<std::vector<tspline::Cut>> cuts;
   if (!cuts_file.empty()) {
     cuts.emplace();
