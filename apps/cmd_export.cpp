@@ -3,6 +3,7 @@
 // Gmsh (msh_export.h).
 #include <iostream>
 #include <memory>
+#include <vector>
 
 #include "commands.h"
 #include "tspline/errors.h"
@@ -22,9 +23,24 @@ struct ExportArgs {
 };
 
 // Version 2: one Bezier document per patch (docs/bezier_format.md, "Multi-patch maps").
+void export_multipatch_bezier(const tspline::io::LoadedMaps& maps, const ExportArgs& a);
+
+// --msh: one surface entity per patch, nodes shared along the interfaces (msh_export.h).
 int export_multipatch(const tspline::io::LoadedMaps& maps, const ExportArgs& a) {
-  if (!a.msh.empty())
-    throw tspline::InputError("--msh: " + a.file + " is a multi-patch map; the Gmsh export takes one patch (use --bezier)");
+  if (!a.bezier.empty()) export_multipatch_bezier(maps, a);
+  if (!a.msh.empty()) {
+    std::vector<const tspline::TSplineMap*> ptrs;
+    for (const tspline::io::LoadedTSpline& t : maps.patches) ptrs.push_back(&t.map);
+    const tspline::io::MshExportStats s = tspline::io::write_msh_file(a.msh, ptrs, maps.interfaces);
+    if (!a.quiet)
+      std::cout << "wrote " << a.msh << ": " << s.elements << " bicubic quadrilaterals (Gmsh type 36) on "
+                << maps.patches.size() << " patches, " << s.nodes << " nodes (shared along the "
+                << maps.interfaces.size() << " interfaces)" << std::endl;
+  }
+  return 0;
+}
+
+void export_multipatch_bezier(const tspline::io::LoadedMaps& maps, const ExportArgs& a) {
   nlohmann::json doc = {{"format", "tspline-bezier-multipatch"}, {"version", 1}, {"source", a.file}};
   std::size_t elements = 0;
   for (std::size_t p = 0; p < maps.patches.size(); ++p) {
@@ -42,7 +58,6 @@ int export_multipatch(const tspline::io::LoadedMaps& maps, const ExportArgs& a) 
   if (!a.quiet)
     std::cout << "wrote " << a.bezier << ": " << elements << " Bezier elements on " << maps.patches.size()
               << " patches" << std::endl;
-  return 0;
 }
 
 }  // namespace

@@ -14,6 +14,8 @@
 #include "param_multipatch.h"
 #include "progress.h"
 #include "toolkit/io/atomic_file.h"
+#include "tspline/boundary/domain.h"
+#include "tspline/boundary/polygon_validation.h"
 #include "tspline/errors.h"
 #include "tspline/io/gis_reader.h"
 #include "tspline/io/output_files.h"
@@ -71,20 +73,41 @@ int run_param(const std::string& input, const std::string& out_dir, const std::s
   if (opt.corners && several)
     throw tspline::InputError("--corners applies to a single patch; a layout of several patches has its corners "
                               "at the patch corners (use --layout single on a domain without holes)");
+  // A domain with holes: every ring is cleaned here with the run's boundary
+  // tolerance (needles narrower than epsilon / diagonal go, one note per
+  // cleaned ring); the pipeline's own validate_domain then finds nothing more.
+  // (One ring is cleaned by the single-patch pipeline itself.)
+  std::vector<std::string> cleaning_notes;
+  tspline::Domain input_rings{domain.outer, domain.holes};
+  if (!domain.holes.empty()) {
+    tspline::DomainCleaningOptions how;
+    how.needle_width = tspline::needle_width_for_ring(domain.outer, opt.tolerance_absolute, opt.tolerance_relative);
+    how.notes = &cleaning_notes;
+    auto report_notes = [&] {
+      for (const std::string& note : cleaning_notes)
+        tspline::report_step(opt.progress, "cleaning", "note: " + note, -1, tspline::ProgressEvent::Kind::Note);
+    };
+    try {
+      input_rings = tspline::validate_domain(input_rings, how);
+    } catch (const tspline::InputError&) {
+      report_notes();  // what was cleaned before the ring that stopped the run
+      throw;
+    }
+    report_notes();
+  }
   // The single-patch iterations, kept until the layout is chosen (auto may drop them).
   struct Snapshot {
     int iteration;
-    tspline::TMesh mesh;
-    std::vector<Eigen::Vector2d> x;
     tspline::TSplineMap map;
+    std::vector<tspline::CellMapQuality> cells;
   };
   std::vector<Snapshot> snapshots;
   const tspline::DomainParameterization P = tspline::parameterize_domain(
-      {domain.outer, domain.holes}, opt, adaptive, choice,
-      [&](int it, const tspline::TMesh& mesh, const std::vector<Eigen::Vector2d>& x, const tspline::TSplineMap& map,
-          const std::vector<tspline::CellMapQuality>&) {
+      input_rings, opt, adaptive, choice,
+      [&](int it, const tspline::TMesh& mesh, const std::vector<Eigen::Vector2d>&, const tspline::TSplineMap& map,
+          const std::vector<tspline::CellMapQuality>& cells) {
         if (it == 0) snapshots.clear();  // a new run (auto's first try was run again, or dropped)
-        snapshots.push_back({it, mesh, x, map});
+        snapshots.push_back({it, map, cells});
         progress.event({{"event", "iteration"},
                         {"iteration", it},
                         {"cells", mesh.num_cells()},
@@ -94,10 +117,11 @@ int run_param(const std::string& input, const std::string& out_dir, const std::s
       [&](std::size_t p, int round) { progress.event({{"event", "patch"}, {"patch", p}, {"round", round}}); });
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   if (P.patches)
-    return tspline_app::write_multipatch_param(P, domain, input, out_dir, adaptive, samples, seconds, progress);
+    return tspline_app::write_multipatch_param(P, domain, input, out_dir, adaptive, samples, seconds, progress,
+                                               cleaning_notes);
   const tspline::ParameterizationResult& result = *P.single;
   tspline::io::AdaptSeriesWriter series(out_dir, samples);
-  for (const Snapshot& s : snapshots) series.add(s.iteration, s.mesh, s.x, s.map);
+  for (const Snapshot& s : snapshots) series.add(s.iteration, s.map, &s.cells);
   series.finish();
   nlohmann::json report = tspline::io::param_report(result, input);
   report["input_geometry"] = domain.description;  // format, layer, CRS, projection (gis_reader.h)

@@ -273,7 +273,7 @@ int run_poisson_process(const PoissonArgs& args, const PetscSession& session,
   if (maps.version == 2) {  // multi-patch map: C0 coupling across the interfaces (poisson_multipatch.h)
     const ProblemSetup mp = make_problem(args, maps.patches.front().map);
     return root ? tspline_app::run_multipatch_poisson(
-                      maps, {args.refine, args.steps, args.gamma, args.max_dofs, args.out_dir, args.quiet || args.json},
+                      maps, {args.refine, args.steps, args.gamma, args.max_dofs, args.out_dir, args.quiet || args.json, args.samples},
                       mp.problem, mp.description)
                 : 0;
   }

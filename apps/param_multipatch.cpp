@@ -10,10 +10,12 @@ namespace tspline_app {
 
 int write_multipatch_param(const tspline::DomainParameterization& P, const tspline::io::DomainInput& input_domain,
                            const std::string& input, const std::string& out_dir,
-                           const tspline::AdaptiveOptions& adaptive, int samples, double seconds, Progress& progress) {
+                           const tspline::AdaptiveOptions& adaptive, int samples, double seconds, Progress& progress,
+                           const std::vector<std::string>& cleaning_notes) {
   const tspline::MultiPatchResult& R = *P.patches;
   nlohmann::json report = tspline::io::multipatch_report(R, input, seconds);
   report["input_geometry"] = input_domain.description;
+  report["input_cleaning"] = {{"notes", cleaning_notes}};
   report["layout"] = {{"chosen", P.layout}, {"reason", P.reason}, {"explanation", R.cuts_explanation}};
   if (P.quad_stats) {
     const tspline::QuadLayoutStats& s = *P.quad_stats;

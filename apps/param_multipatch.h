@@ -2,6 +2,7 @@
 // `tspline param` on a multi-patch map (a domain with holes, --cuts, or a quad
 // layout chosen by --layout): its outputs and summary.
 #include <string>
+#include <vector>
 
 #include "progress.h"
 #include "tspline/io/gis_reader.h"
@@ -14,6 +15,7 @@ namespace tspline_app {
 /// watertight or some patch is not certified valid).
 int write_multipatch_param(const tspline::DomainParameterization& P, const tspline::io::DomainInput& domain,
                            const std::string& input, const std::string& out_dir,
-                           const tspline::AdaptiveOptions& adaptive, int samples, double seconds, Progress& progress);
+                           const tspline::AdaptiveOptions& adaptive, int samples, double seconds, Progress& progress,
+                           const std::vector<std::string>& cleaning_notes = {});
 
 }  // namespace tspline_app

@@ -17,10 +17,13 @@ struct MultiPatchPoissonArgs {
   std::size_t max_dofs = 200000;
   std::string out_dir;
   bool quiet = false;
+  int samples = 2;  ///< solution/step_NNN.vtu: k x k sub-quads per analysis cell
 };
 
-/// Solves, prints the errors and the estimator per step and writes
-/// report.json into out_dir. Returns the exit code.
+/// Solves, prints the errors and the estimator per step and writes into
+/// out_dir, after every step (each file atomically): solution/step_NNN.vtu (every
+/// patch's u_h sampled as for a single map, poisson_output.h solution_vtu, merged
+/// with cell data `patch`), solution.pvd and report.json. Returns the exit code.
 int run_multipatch_poisson(const tspline::io::LoadedMaps& maps, const MultiPatchPoissonArgs& args,
                            const tspline::PoissonProblem& problem, const nlohmann::json& problem_description);
 

@@ -128,9 +128,9 @@ TEST_SUITE("app") {
     const RunResult r = run("param '" + in.string() + "' --corners 0,1,7,8 --out '" + (d / "out").string() + "'", d);
     CAPTURE(r.err);
     REQUIRE(r.exit_code == 0);
-    CHECK(r.out.find("note: removed vertex 2 (repeats vertex 1)") != std::string::npos);
-    CHECK(r.out.find("note: removed vertex 6 (tip of a zero-area spike: edges 5-6 and 6-7 overlap)") !=
-          std::string::npos);
+    // One note for the ring, naming each removed vertex.
+    CHECK(r.out.find("note: the boundary: removed vertex 2 (repeats vertex 1); removed vertex 6 (tip of a zero-area "
+                     "spike: edges 5-6 and 6-7 overlap)") != std::string::npos);
     const auto rep = nlohmann::json::parse(slurp(d / "out" / "report.json"));
     CHECK(rep["input_cleaning"]["removed_vertices"] == nlohmann::json::array({2, 6}));
     CHECK(rep["counts"]["polygon_vertices"] == 7);

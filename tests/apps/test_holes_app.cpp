@@ -2,11 +2,14 @@
 // with holes, and every bad-input case of holes and cuts.
 #include <doctest/doctest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
 
 #include "test_support.h"
+#include "toolkit/io/vtu_reader.h"
 
 namespace fs = std::filesystem;
 
@@ -98,6 +101,34 @@ TEST_SUITE("holes_app") {
     REQUIRE(prep["steps"].size() == 2);
     CHECK(prep["steps"][1]["max_interface_jump"].get<double>() < 1e-12);
     CHECK(prep["steps"][1]["l2_error"].get<double>() < prep["steps"][0]["l2_error"].get<double>() / 8);
+    // The solution of every patch per step (solution/step_NNN.vtu, solution.pvd), so
+    // that `render --view solution` draws it: u_h - u there is within the step's error.
+    const toolkit::io::VtuMesh sol = toolkit::io::read_vtu((d / "poisson" / "solution" / "step_001.vtu").string());
+    CHECK(fs::exists(d / "poisson" / "solution.pvd"));
+    double worst = 0.0, max_patch = 0.0;
+    for (double e : sol.point_scalars.at("error")) worst = std::max(worst, std::abs(e));
+    for (double q : sol.cell_scalars.at("patch")) max_patch = std::max(max_patch, q);
+    CHECK(max_patch == static_cast<double>(patches - 1));
+    CHECK(worst > 0.0);
+    CHECK(worst < 0.05);
+    const auto pic = test_support::run_app(
+        "render " + quoted(d / "poisson") + " --view solution -q --png " + quoted(d / "solution.png"), d);
+    CAPTURE(pic.err);
+    CHECK(pic.exit_code == 0);
+    CHECK(fs::file_size(d / "solution.png") > 1000);
+    for (const char* view : {"tmesh", "jacobian", "control-net"}) {
+      const auto v = test_support::run_app("render " + quoted(out) + " --view " + view + " -q --png " +
+                                               quoted(d / (std::string(view) + ".png")),
+                                           d);
+      CHECK(v.exit_code == 0);
+    }
+    // Gmsh export of every patch (conforming across the cuts: msh_export tests).
+    const auto msh = test_support::run_app(
+        "export " + quoted(out / "tspline.json") + " --msh " + quoted(d / "plate.msh"), d);
+    CAPTURE(msh.err);
+    REQUIRE(msh.exit_code == 0);
+    CHECK(contains(msh.out, "on " + std::to_string(patches) + " patches"));
+    CHECK(contains(test_support::slurp(d / "plate.msh"), "\"patch " + std::to_string(patches - 1) + "\""));
     const auto adaptive = test_support::run_app(
         "poisson " + quoted(out / "tspline.json") + " --problem gaussian --steps 3 -q --out " + quoted(d / "p2"), d);
     CAPTURE(adaptive.err);

@@ -8,6 +8,9 @@
 #include <algorithm>
 #include <filesystem>
 #include <map>
+#include <set>
+#include <string>
+#include <utility>
 #include <vector>
 
 #include "meshopt/gmsh/gmsh_mesh.h"
@@ -16,6 +19,7 @@
 #include "tspline/spline/bezier_extraction.h"
 #include "tspline/io/msh_export.h"
 #include "tspline/io/polygon_reader.h"
+#include "tspline/multipatch/multipatch_parameterization.h"
 
 namespace fs = std::filesystem;
 
@@ -103,6 +107,88 @@ TEST_SUITE("msh_export") {
     CHECK(min_det > 0.0);
     CHECK(worst_interior < 1e-3);
     CHECK(worst_interior > 1e-12);  // the elements only interpolate the rational map
+  }
+
+  TEST_CASE("multi-patch map: one surface per patch, nodes shared along every cut, no duplicates") {
+    const fs::path d = test_support::scratch_dir("msh_export", "plate");
+    const auto rings = tspline::io::read_text_rings(std::string(TSPLINE_TEST_DATA_DIR) + "/holes/plate_with_hole.txt");
+    const tspline::Domain dom{rings.front(), {rings.begin() + 1, rings.end()}};
+    const tspline::MultiPatchResult R = tspline::run_multipatch_parameterization(dom, std::nullopt, {}, {});
+    REQUIRE(R.certified_valid());
+    std::vector<const tspline::TSplineMap*> maps;
+    std::size_t elements = 0;
+    for (const auto& r : R.patches) {
+      maps.push_back(&*r.map);
+      elements += tspline::BezierExtraction(r.map->basis()).elements().size();
+    }
+    std::size_t alone = 0;  // nodes of the patches exported one by one
+    for (const tspline::TSplineMap* m : maps) {
+      tspline::io::MshExportStats s;
+      (void)tspline::io::msh_document(*m, &s);
+      alone += s.nodes;
+    }
+    const fs::path file = d / "plate.msh";
+    const tspline::io::MshExportStats stats = tspline::io::write_msh_file(file.string(), maps, R.layout.interfaces);
+    CHECK(stats.elements == elements);
+    // Shared interface nodes: every cut's nodes once (the shared knots make
+    // the positions correspond), so fewer nodes than the patches alone have.
+    std::size_t cut_nodes = 0;
+    for (const tspline::Interface& f : R.layout.interfaces) {
+      const tspline::BezierExtraction ex(maps[f.patch_a]->basis());
+      std::set<double> ends;
+      for (const tspline::BezierElement& e : ex.elements()) {
+        const Eigen::Vector2d lo = e.lo, hi = e.hi;
+        switch (f.side_a) {
+          case 0: if (lo.y() == 0) ends.insert(lo.x()), ends.insert(hi.x()); break;
+          case 1: if (hi.x() == 1) ends.insert(lo.y()), ends.insert(hi.y()); break;
+          case 2: if (hi.y() == 1) ends.insert(lo.x()), ends.insert(hi.x()); break;
+          default: if (lo.x() == 0) ends.insert(lo.y()), ends.insert(hi.y()); break;
+        }
+      }
+      cut_nodes += 3 * (ends.size() - 1) + 1;
+    }
+    CHECK(stats.nodes == alone - cut_nodes);
+    meshopt::gmsh_io::Session session;
+    gmsh::open(file.string());
+    std::vector<std::pair<int, int>> surfaces;
+    gmsh::model::getEntities(surfaces, 2);
+    CHECK(surfaces.size() == R.patches.size());
+    std::vector<std::pair<int, int>> groups;
+    gmsh::model::getPhysicalGroups(groups, 2);
+    CHECK(groups.size() == R.patches.size() + 1);
+    std::vector<std::size_t> node_tags;
+    std::vector<double> coord, param;
+    gmsh::model::mesh::getNodes(node_tags, coord, param);
+    CHECK(node_tags.size() == stats.nodes);
+    std::vector<std::size_t> tags, conn;
+    gmsh::model::mesh::getElementsByType(36, tags, conn);
+    CHECK(tags.size() == elements);
+    // Conforming across the cuts: Gmsh finds no two nodes at one point.
+    gmsh::model::mesh::removeDuplicateNodes();
+    std::vector<std::size_t> after;
+    gmsh::model::mesh::getNodes(after, coord, param);
+    CHECK(after.size() == node_tags.size());
+    // Patch 0's elements: its nodes lie on its map.
+    std::map<std::size_t, Eigen::Vector2d> node;
+    gmsh::model::mesh::getNodes(node_tags, coord, param);
+    for (std::size_t i = 0; i < node_tags.size(); ++i) node[node_tags[i]] = {coord[3 * i], coord[3 * i + 1]};
+    std::vector<int> types;
+    std::vector<std::vector<std::size_t>> etags, enodes;
+    gmsh::model::mesh::getElements(types, etags, enodes, 2, 1);
+    REQUIRE(types.size() == 1);
+    const tspline::BezierExtraction ex0(maps[0]->basis());
+    REQUIRE(etags[0].size() == ex0.elements().size());
+    double worst = 0.0;
+    for (std::size_t i = 0; i < etags[0].size(); ++i)
+      for (int k = 0; k < 16; ++k) {
+        const tspline::BezierElement& e = ex0.elements()[i];
+        const Eigen::Vector2d st(tspline::io::kQua16Local[k][0], tspline::io::kQua16Local[k][1]);
+        worst = std::max(worst, (node.at(enodes[0][16 * i + k]) - maps[0]->point(e.lo + st.cwiseProduct(e.hi - e.lo))).norm());
+      }
+    CHECK(worst <= 1e-12 * R.diameter);
+    gmsh::clear();
+    MESSAGE("plate: " << R.patches.size() << " patches, " << elements << " elements, " << stats.nodes
+                      << " nodes (" << alone << " for the patches alone)");
   }
 
   TEST_CASE("tspline export --msh: file and bad input") {

@@ -2,10 +2,14 @@
 // real polygon data (clean_polygon in polygon_validation.h).
 #include <doctest/doctest.h>
 
+#include <cmath>
+#include <optional>
+
 #include "separable_maps.h"
 #include "test_support.h"
 #include "tspline/validity/boundary_curve.h"
 #include "tspline/boundary/polygon_validation.h"
+#include "tspline/errors.h"
 
 TEST_SUITE("boundary_curve") {
   TEST_CASE("the square's boundary is proven simple; a boundary pulled across itself is not") {
@@ -61,5 +65,63 @@ TEST_SUITE("boundary_curve") {
     // A true crossing is not "cleaned".
     const tspline::Polygon bow = test_support::make_polygon({{0, 0}, {1, 1}, {1, 0}, {0, 1}});
     CHECK(tspline::clean_polygon(bow).removed_file_indices.empty());
+    CHECK(tspline::clean_polygon(bow, 0.1).removed_file_indices.empty());
+  }
+
+  TEST_CASE("clean_polygon: needles narrower than the width, at vertex 0 and drawn with several vertices") {
+    // The square [0,4]^2 whose vertex 0 is the tip of an exactly collinear
+    // spike: 0 = (0,6) between 5 = (0,4) and 1 = (0,3.5), across the seam.
+    const tspline::Polygon seam = test_support::make_polygon({{0, 6}, {0, 3.5}, {0, 0}, {4, 0}, {4, 4}, {0, 4}});
+    const tspline::PolygonCleaning s = tspline::clean_polygon(seam);
+    CHECK(s.removed_file_indices == std::vector<std::size_t>{0});
+    CHECK(s.needles == 1);
+    CHECK(s.max_needle_width == 0.0);
+    CHECK(tspline::cleaning_summary("hole 3", s) ==
+          "hole 3: removed vertex 0 (tip of a zero-area spike: edges 5-0 and 0-1 overlap)");
+    CHECK(tspline::signed_area(tspline::validate_polygon(s.polygon)) == doctest::Approx(16).epsilon(1e-15));
+    // A needle out of the bottom edge, 1e-6 wide, drawn with two vertices out
+    // and two back: 1 = (2,0), 2 = (2,-1), 3 = (2,-2) its tip, 4 = (2.000001,-1),
+    // 5 = (2.000001,0). Tip 3 goes, then 4 lies within the width of 2, then 2
+    // is a tip, then 5 lies within the width of 1: the bottom edge is straight.
+    const tspline::Polygon fan = test_support::make_polygon(
+        {{0, 0}, {2, 0}, {2, -1}, {2, -2}, {2.000001, -1}, {2.000001, 0}, {4, 0}, {4, 4}, {0, 4}});
+    const tspline::PolygonCleaning f = tspline::clean_polygon(fan, 1e-5);
+    CHECK(f.removed_file_indices == std::vector<std::size_t>{2, 3, 4, 5});
+    CHECK(f.needles == 2);
+    CHECK(f.max_needle_width == doctest::Approx(1e-6).epsilon(1e-6));
+    CHECK(test_support::contains(tspline::cleaning_summary("r", f), "removed vertex 4 (lies 1e-06 from vertex 2"));
+    const tspline::Polygon clean = tspline::validate_polygon(f.polygon);
+    CHECK(clean.vertices.size() == 5);
+    CHECK(tspline::signed_area(clean) == doctest::Approx(16).epsilon(1e-15));
+    // The raw polygon's area exceeds it by the needle's 1e-6 x 1 + 1e-6 x 1 / 2.
+    CHECK(tspline::signed_area(tspline::validate_polygon(fan)) == doctest::Approx(16 + 1.5e-6).epsilon(1e-13));
+    // Narrower width: the needle is a legitimate (simple) feature and stays.
+    CHECK(tspline::clean_polygon(fan, 1e-7).removed_file_indices.empty());
+    CHECK(tspline::clean_polygon(fan).removed_file_indices.empty());
+    // A sharp but wide tip is no needle: the angle at (2,-2) is small, its base 0.1 wide.
+    const tspline::Polygon tip = test_support::make_polygon({{0, 0}, {2, 0}, {2.05, -2}, {2.1, 0}, {4, 0}, {4, 4}, {0, 4}});
+    CHECK(tspline::clean_polygon(tip, 1e-3).removed_file_indices.empty());
+    CHECK_THROWS_AS(tspline::clean_polygon(tip, -1.0), std::invalid_argument);
+  }
+
+  TEST_CASE("needle width: epsilon / diagonal, from the diagonal the needles do not span") {
+    const tspline::Polygon sq = test_support::make_polygon({{0, 0}, {4, 0}, {4, 4}, {0, 4}});
+    CHECK(tspline::needle_width_for_ring(sq, std::nullopt, 1e-5) == doctest::Approx(1e-5 * std::sqrt(32.0)));
+    CHECK(tspline::needle_width_for_ring(sq, 1e-3, 1e-5) == doctest::Approx(1e-3 / std::sqrt(32.0)));
+    // A typo spike 1e6 long and 2 wide spans the bounding box: at its own
+    // diagonal (width 10) it would be a needle; the square's diagonal gives the
+    // width, and at that width the spike is kept (validation then judges it).
+    const tspline::Polygon typo = test_support::make_polygon({{0, 0}, {4, 0}, {4, 4}, {3, 4}, {2, 1e6}, {1, 4}, {0, 4}});
+    const double w = tspline::needle_width_for_ring(typo, std::nullopt, 1e-5);
+    CHECK(w == doctest::Approx(1e-5 * std::sqrt(32.0)));
+    CHECK(tspline::clean_polygon(typo, w).removed_file_indices.empty());
+    // Collinear points only: nothing but a needle, named as such.
+    const tspline::Polygon line = test_support::make_polygon({{0, 0}, {1, 0}, {2, 0}, {3, 0}});
+    const double wl = tspline::needle_width_for_ring(line, std::nullopt, 1e-5);
+    CHECK(wl == 0.0);
+    CHECK(test_support::message_of<tspline::InputError>([&] {
+            (void)tspline::validate_cleaned_polygon(tspline::clean_polygon(line, wl), wl);
+          }) == "the ring encloses no area: it is nothing but zero-area spikes (2 of its 4 vertices are left once "
+                "they are removed)");
   }
 }

@@ -6,8 +6,11 @@
 #include <cmath>
 #include <filesystem>
 #include <numbers>
+#include <string>
+#include <vector>
 
 #include "test_support.h"
+#include "toolkit/io/vtu_reader.h"
 #include "tspline/multipatch/automatic_cuts.h"
 #include "tspline/boundary/border_knots.h"
 #include "tspline/boundary/domain.h"
@@ -99,6 +102,105 @@ TEST_SUITE("holes") {
     CHECK(contains(m, "hole 2 lies inside hole 1"));
     m = validation_error(Domain{square(0, 0, 10, 10), {make_polygon({{1, 1}, {3, 3}, {3, 1}, {1, 3}})}});
     CHECK(contains(m, "Hole 1: "));
+  }
+
+  TEST_CASE("domain validation removes needles in every ring, at vertex 0 and mid-ring, one note per ring") {
+    const Domain raw = read_text_domain(holes_file("needles.txt"));
+    auto raw_area = [](const Domain& d) {
+      double a = std::abs(tspline::signed_area(d.outer));
+      for (const tspline::Polygon& h : d.holes) a -= std::abs(tspline::signed_area(h));
+      return a;
+    };
+    // The default needle width: 1e-5 x the outer diagonal (about 1.4e-4 here).
+    std::vector<std::string> notes;
+    tspline::DomainCleaningOptions how;
+    how.notes = &notes;
+    const Domain v = tspline::validate_domain(raw, how);
+    REQUIRE(notes.size() == 3);
+    CAPTURE(notes[0]);
+    CAPTURE(notes[1]);
+    CAPTURE(notes[2]);
+    // The needle's tip goes, then its two base vertices are within the width of
+    // each other and the later in the file goes too.
+    CHECK(notes[0] ==
+          "the outer ring: removed vertex 4 (tip of a needle of width 5e-05, narrower than 0.000164: edges 3-4 and "
+          "4-5 fold back); removed vertex 5 (lies 5e-05 from vertex 3, closer than the needle width 0.000164)");
+    CHECK(notes[1] == "hole 1: removed vertex 0 (tip of a zero-area spike: edges 4-0 and 0-1 overlap)");
+    CHECK(notes[2] ==
+          "hole 2: removed vertex 0 (tip of a needle of width 2e-05, narrower than 0.000164: edges 6-0 and 0-1 "
+          "fold back); removed vertex 6 (lies 2e-05 from vertex 1, closer than the needle width 0.000164)");
+    // The file numbering survives (the tips are gone; vertex 1 is now first).
+    CHECK(v.outer.vertices.size() == 5);
+    REQUIRE(v.holes.size() == 2);
+    CHECK(v.holes[0].vertices.size() == 4);
+    CHECK(v.holes[1].vertices.size() == 5);
+    auto has = [](const tspline::Polygon& p, std::size_t i) {
+      return std::find(p.file_index.begin(), p.file_index.end(), i) != p.file_index.end();
+    };
+    CHECK_FALSE(has(v.outer, 4));
+    CHECK_FALSE(has(v.holes[0], 0));
+    CHECK_FALSE(has(v.holes[1], 0));
+    for (std::size_t i = 0; i < v.holes[1].vertices.size(); ++i)
+      CHECK(v.holes[1].vertices[i] == raw.holes[1].vertices[v.holes[1].file_index[i]]);
+    for (std::size_t i = 0; i < v.outer.vertices.size(); ++i)
+      CHECK(v.outer.vertices[i] == raw.outer.vertices[v.outer.file_index[i]]);
+    // Areas: 100 - 0.75 - 2 exactly; the input's area differs by the two thin
+    // triangles removed (0.5 x 3 x 5e-5 and 0.5 x 2 x 2e-5); the zero-area
+    // spike changes nothing.
+    CHECK(tspline::domain_area(v) == doctest::Approx(97.25).epsilon(1e-14));
+    CHECK(std::abs(tspline::signed_area(v.holes[0])) == doctest::Approx(0.75).epsilon(1e-14));
+    CHECK(std::abs(tspline::signed_area(raw.holes[0])) == doctest::Approx(0.75).epsilon(1e-14));
+    CHECK(raw_area(raw) - tspline::domain_area(v) == doctest::Approx(7.5e-5 - 2e-5).epsilon(1e-6));
+    // A needle width below the needles' widths keeps the two thin needles (both
+    // are simple polygons), and the exact spike still goes.
+    notes.clear();
+    how.needle_width = 1e-5;
+    const Domain w = tspline::validate_domain(raw, how);
+    REQUIRE(notes.size() == 1);
+    CHECK(contains(notes[0], "hole 1: removed vertex 0"));
+    CHECK(w.outer.vertices.size() == 7);
+    CHECK(w.holes[1].vertices.size() == 7);
+    // Without cleaning, hole 1 is what stopped the Maldives sea.
+    CHECK(contains(message_of<tspline::InputError>([&] { (void)tspline::validate_polygon(raw.holes[0]); }),
+                   "edges 0-1 and 4-0 overlap"));
+  }
+
+  TEST_CASE("Maldives islet 9: its 10 cm needle at vertex 0 goes, and the islet is a valid hole") {
+    const Domain raw = read_text_domain(holes_file("maldives_islet9.txt"));
+    REQUIRE(raw.holes.size() == 1);
+    std::vector<std::string> notes;
+    tspline::DomainCleaningOptions how;
+    how.notes = &notes;
+    const Domain v = tspline::validate_domain(raw, how);
+    REQUIRE(notes.size() == 1);
+    CHECK(notes[0] == "hole 1: removed vertex 0 (tip of a zero-area spike: edges 6-0 and 0-1 overlap)");
+    CHECK(v.holes[0].vertices.size() == 6);
+    CHECK(std::abs(tspline::signed_area(v.holes[0])) ==
+          doctest::Approx(std::abs(tspline::signed_area(raw.holes[0]))).epsilon(1e-13));
+  }
+
+  TEST_CASE("domain validation: a triangle is a hole; true crossings are still named with ring and edges") {
+    // A triangular islet (the Maldives has 37).
+    const Domain t = tspline::validate_domain(Domain{square(0, 0, 10, 10), {make_polygon({{1, 1}, {3, 1}, {2, 2}})}});
+    CHECK(tspline::domain_area(t) == doctest::Approx(99));
+    // The outer ring still needs four vertices (a patch's corners).
+    CHECK(contains(validation_error(Domain{make_polygon({{0, 0}, {10, 0}, {0, 10}}), {}}),
+                   "The outer ring: polygon has 3 vertices; at least 4 are needed"));
+    // A bow tie in hole 2 (edges 1-2 and 3-4 cross), whatever the needle width.
+    const Domain bow{square(0, 0, 10, 10),
+                     {square(1, 1, 2, 2), make_polygon({{5, 5}, {6, 5}, {7, 6}, {7, 5}, {6, 6}})}};
+    const std::string m = validation_error(bow);
+    CAPTURE(m);
+    CHECK(contains(m, "Hole 2: polygon is not simple: edges 1-2 and 3-4 intersect near (6.5, 5.5)"));
+    tspline::DomainCleaningOptions wide;
+    wide.needle_width = 0.1;
+    CHECK(message_of<tspline::InputError>([&] { (void)tspline::validate_domain(bow, wide); }) == m);
+    // A hole that is nothing but a needle (Maldives islet 140: three nearly
+    // collinear vertices) is named, not reported as "2 vertices".
+    const Domain sliver{square(0, 0, 10, 10), {square(1, 1, 2, 2), make_polygon({{5, 5}, {7, 5.00001}, {6, 5}})}};
+    CHECK(validation_error(sliver) ==
+          "Hole 2: the ring encloses no area: it is nothing but needles narrower than 0.000141 (2 of its 3 vertices "
+          "are left once they are removed)");
   }
 
   TEST_CASE("cuts: crossing, off the rings or out of the domain are named") {
@@ -220,6 +322,21 @@ TEST_SUITE("holes") {
       for (const char* f : {"surface.vtu", "boundary.vtu", "parametric_tmesh.vtu", "physical_tmesh.vtu",
                             "control_net.vtu", "report.json"})
         CHECK(std::filesystem::exists(dir / f));
+      // physical_tmesh.vtu (read back with VTK): every patch's cells drawn
+      // through its map, none flagged invalid on this certified map.
+      const toolkit::io::VtuMesh phys = toolkit::io::read_vtu((dir / "physical_tmesh.vtu").string());
+      std::size_t cells = 0;
+      for (const auto& r : R.patches) cells += r.map->mesh().num_cells();
+      REQUIRE(phys.cells.size() == cells);
+      std::size_t flagged = 0, uncertified = 0;
+      for (std::size_t c = 0; c < cells; ++c) {
+        flagged += phys.cell_scalars.at("valid")[c] != 1.0;
+        uncertified += phys.cell_scalars.at("certified")[c] != 1.0;
+        CHECK(phys.cell_scalars.at("det_lower_bound")[c] > 0.0);
+      }
+      CHECK(flagged == 0);
+      CHECK(uncertified == 0);
+      CHECK(phys.cell_scalars.at("patch").back() == static_cast<double>(R.patches.size() - 1));
     }
   }
 

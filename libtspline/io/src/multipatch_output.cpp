@@ -133,7 +133,7 @@ void write_multipatch_outputs(const MultiPatchResult& R, const std::string& out_
     for (int v = 0; v < static_cast<int>(uv.size()); ++v)
       uv[v] = mesh.vertex_param(v) + Eigen::Vector2d(1.25 * static_cast<double>(p), 0.0);
     param.push_back(tmesh_vtu(mesh, uv));
-    phys.push_back(tmesh_vtu(mesh, r.front.optimized));
+    phys.push_back(physical_tmesh_vtu(r, samples));
     boundary.push_back(boundary_vtu(r.front.boundary));
   }
   write_multipatch_file((dir / output_files::kTSpline).string(), maps, metas, R.layout.interfaces, R.layout.cuts,

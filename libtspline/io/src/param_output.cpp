@@ -4,7 +4,11 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <limits>
+#include <map>
 #include <set>
+#include <stdexcept>
+#include <utility>
 
 #include <Eigen/LU>
 
@@ -12,6 +16,8 @@
 #include "tspline/io/cell_grid.h"
 #include "tspline/io/front_output.h"
 #include "tspline/io/tspline_file.h"
+#include "tspline/spline/bezier_extraction.h"
+#include "tspline/validity/map_certification.h"
 #include "tspline/validity/map_quality.h"
 #include "tspline/io/output_files.h"
 
@@ -69,9 +75,91 @@ toolkit::io::VtuMesh control_net_vtu(const TSplineMap& map) {
   return out;
 }
 
+toolkit::io::VtuMesh physical_tmesh_vtu(const TSplineMap& map, int k, const MapCertification* certificate,
+                                        const CertificationOptions& options,
+                                        const std::vector<CellMapQuality>* quality) {
+  if (k < 1 || k > 64) throw std::invalid_argument("samples per cell edge must be in [1, 64]");
+  const TMesh& mesh = map.mesh();
+  const int nc = static_cast<int>(mesh.num_cells());
+  if (certificate && certificate->cell_certified.size() != mesh.num_cells()) certificate = nullptr;
+  if (quality && quality->size() != mesh.num_cells()) quality = nullptr;
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  toolkit::io::VtuMesh out;
+  std::vector<Eigen::Vector2d> param;
+  std::vector<int> vertex, hanging, boundary;
+  // One point per parametric position: a segment is sampled from its
+  // lexicographically smaller end, so both cells along it get the same doubles.
+  std::map<std::pair<double, double>, int> index;
+  auto point = [&](const Eigen::Vector2d& uv, int c, int v) {
+    const auto [it, added] = index.emplace(std::make_pair(uv.x(), uv.y()), static_cast<int>(out.points.size()));
+    if (added) {
+      out.points.push_back(map.derivatives(uv, 0, c).x);
+      param.push_back(uv);
+      vertex.push_back(v);
+      hanging.push_back(v >= 0 && mesh.vertex_is_hanging(v) ? 1 : 0);
+      boundary.push_back(uv.x() == 0.0 || uv.x() == 1.0 || uv.y() == 0.0 || uv.y() == 1.0 ? 1 : 0);
+    }
+    return it->second;
+  };
+  std::vector<int> level(nc), valid(nc), certified(nc);
+  std::vector<double> lower(nc, nan), relative(nc, nan), min_det(nc, nan), min_jr(nc, nan);
+  out.cells.reserve(static_cast<std::size_t>(nc));
+  for (int c = 0; c < nc; ++c) {
+    const std::vector<int> poly = mesh.cell_polygon(c);
+    std::vector<int> cell;
+    cell.reserve(poly.size() * static_cast<std::size_t>(k));
+    for (std::size_t e = 0; e < poly.size(); ++e) {
+      const int va = poly[e], vb = poly[(e + 1) % poly.size()];
+      const Eigen::Vector2d a = mesh.vertex_param(va), b = mesh.vertex_param(vb);
+      cell.push_back(point(a, c, va));
+      const bool forward = std::make_pair(a.x(), a.y()) < std::make_pair(b.x(), b.y());
+      const Eigen::Vector2d &lo = forward ? a : b, &hi = forward ? b : a;
+      for (int j = 1; j < k; ++j) {
+        const int t = forward ? j : k - j;
+        cell.push_back(point(lo + (hi - lo) * (static_cast<double>(t) / k), c, -1));
+      }
+    }
+    out.cells.push_back(std::move(cell));
+    level[c] = mesh.cell_level(c);
+    if (quality) min_det[c] = (*quality)[c].min_det, min_jr[c] = (*quality)[c].min_mean_ratio;
+    certified[c] = certificate ? (certificate->cell_certified[c] ? 1 : 0) : -1;
+    valid[c] = certificate ? certified[c] : quality ? ((*quality)[c].min_det > 0.0 ? 1 : 0) : -1;
+  }
+  if (certificate) {
+    // The certified bounds per cell: the minimum over its Bezier elements.
+    const BezierExtraction extraction(map.basis());
+    const std::vector<Eigen::Vector2d>& P = map.control_points();
+    for (const BezierElement& e : extraction.elements()) {
+      const ElementCertificate cert = certify_element(e, P, options);
+      double& l = lower[e.cell];
+      double& r = relative[e.cell];
+      l = std::isnan(l) ? cert.det_lower_bound : std::min(l, cert.det_lower_bound);
+      r = std::isnan(r) ? cert.relative_lower_bound : std::min(r, cert.relative_lower_bound);
+    }
+  }
+  out.cell_ints["level"] = std::move(level);
+  out.cell_ints["valid"] = std::move(valid);
+  out.cell_ints["certified"] = std::move(certified);
+  out.cell_scalars["det_lower_bound"] = std::move(lower);
+  out.cell_scalars["relative_det_lower_bound"] = std::move(relative);
+  out.cell_scalars["min_det_jacobian"] = std::move(min_det);
+  out.cell_scalars["min_mean_ratio_jacobian"] = std::move(min_jr);
+  out.point_vectors["parametric"] = std::move(param);
+  out.point_ints["vertex"] = std::move(vertex);
+  out.point_ints["hanging"] = std::move(hanging);
+  out.point_ints["boundary"] = std::move(boundary);
+  return out;
+}
+
+toolkit::io::VtuMesh physical_tmesh_vtu(const ParameterizationResult& r, int k) {
+  if (!r.map) throw std::invalid_argument("physical_tmesh_vtu: the result has no map");
+  return physical_tmesh_vtu(*r.map, k, r.adaptive.certify ? &r.certification : nullptr, r.adaptive.certification,
+                            &r.cell_quality);
+}
+
 AdaptSeriesWriter::AdaptSeriesWriter(std::string out_dir, int samples) : out_dir_(std::move(out_dir)), samples_(samples) {}
 
-void AdaptSeriesWriter::add(int it, const TMesh& mesh, const std::vector<Eigen::Vector2d>& x, const TSplineMap& map) {
+void AdaptSeriesWriter::add(int it, const TSplineMap& map, const std::vector<CellMapQuality>* quality) {
   // Created on first use, so that a run failing before the first fit leaves nothing.
   if (entries_.empty()) toolkit::io::ensure_writable_directory((std::filesystem::path(out_dir_) / output_files::kAdaptFolder).string());
   char name[64];
@@ -80,7 +168,7 @@ void AdaptSeriesWriter::add(int it, const TMesh& mesh, const std::vector<Eigen::
   std::snprintf(name, sizeof name, "adapt/surface_%03d.vtu", it);
   const std::string surface_file = name;
   const std::filesystem::path dir(out_dir_);
-  toolkit::io::write_vtu((dir / mesh_file).string(), tmesh_vtu(mesh, x));
+  toolkit::io::write_vtu((dir / mesh_file).string(), physical_tmesh_vtu(map, samples_, nullptr, {}, quality));
   toolkit::io::write_vtu((dir / surface_file).string(), surface_vtu(map, samples_));
   entries_.push_back({static_cast<double>(it), mesh_file, 0});
   entries_.push_back({static_cast<double>(it), surface_file, 1});
@@ -242,7 +330,8 @@ nlohmann::json param_report(const ParameterizationResult& r, const std::string& 
 void write_param_outputs(const ParameterizationResult& r, const std::string& out_dir, const nlohmann::json& report,
                          int samples) {
   const std::filesystem::path dir(out_dir);
-  write_front_meshes(r.front, out_dir);
+  write_front_meshes(r.front, out_dir, /*physical=*/false);
+  toolkit::io::write_vtu((dir / output_files::kPhysicalTMesh).string(), physical_tmesh_vtu(r, samples));
   TSplineFileMeta meta;
   meta.source = report.value("input", "");
   meta.boundary = r.front.boundary.polygon();

@@ -95,12 +95,17 @@ void check_rings_disjoint(const Domain& d) {
 
 std::string ring_name(std::size_t r) { return r == 0 ? "the outer ring" : "hole " + std::to_string(r); }
 
-Domain validate_domain(Domain d) {
-  auto validated = [](Polygon p, std::size_t r) {
+Domain validate_domain(Domain d, const DomainCleaningOptions& cleaning) {
+  const double width = cleaning.needle_width
+                           ? *cleaning.needle_width
+                           : needle_width_for_ring(d.outer, std::nullopt, kDefaultNeedleWidthRelative);
+  auto validated = [&](Polygon p, std::size_t r) {
+    std::string name = ring_name(r);
     try {
-      return validate_polygon(std::move(p));
+      PolygonCleaning c = clean_polygon(std::move(p), std::isfinite(width) && width > 0.0 ? width : 0.0);
+      if (cleaning.notes && !c.notes.empty()) cleaning.notes->push_back(cleaning_summary(name, c));
+      return validate_cleaned_polygon(std::move(c), width, r == 0 ? 4 : 3);
     } catch (const InputError& e) {
-      std::string name = ring_name(r);
       name[0] = static_cast<char>(std::toupper(static_cast<unsigned char>(name[0])));
       throw InputError(name + ": " + e.what());
     }

@@ -127,7 +127,7 @@ double signed_area(const Polygon& p) {
   return 0.5 * twice;
 }
 
-Polygon validate_polygon(Polygon p) {
+Polygon validate_polygon(Polygon p, std::size_t min_vertices) {
   const std::size_t n = p.vertices.size();
   if (p.file_index.empty()) {
     p.file_index.resize(n);
@@ -137,8 +137,9 @@ Polygon validate_polygon(Polygon p) {
                                 " entries for " + std::to_string(n) + " vertices");
   }
   const auto& fi = p.file_index;
-  if (n < 4) {
-    throw InputError("polygon has " + std::to_string(n) + " vertices; at least 4 are needed");
+  if (n < std::max<std::size_t>(min_vertices, 3)) {
+    throw InputError("polygon has " + std::to_string(n) + " vertices; at least " +
+                     std::to_string(std::max<std::size_t>(min_vertices, 3)) + " are needed");
   }
   for (std::size_t i = 0; i < n; ++i) {
     const auto& v = p.vertices[i];
@@ -209,7 +210,22 @@ Polygon validate_polygon(Polygon p) {
   return p;
 }
 
-PolygonCleaning clean_polygon(Polygon p) {
+double bounding_box_diagonal(const Polygon& p) {
+  if (p.vertices.empty()) return 0.0;
+  Eigen::Vector2d lo = p.vertices.front(), hi = lo;
+  for (const auto& v : p.vertices) lo = lo.cwiseMin(v), hi = hi.cwiseMax(v);
+  return (hi - lo).norm();
+}
+
+double needle_width_for_tolerance(double tolerance_area, double diagonal) {
+  if (!(diagonal > 0.0) || !std::isfinite(diagonal) || !(tolerance_area > 0.0) || !std::isfinite(tolerance_area))
+    return 0.0;
+  return tolerance_area / diagonal;
+}
+
+PolygonCleaning clean_polygon(Polygon p, double needle_width) {
+  if (!(needle_width >= 0.0) || !std::isfinite(needle_width))
+    throw std::invalid_argument("clean_polygon: the needle width must be finite and >= 0");
   const std::size_t n0 = p.vertices.size();
   if (p.file_index.empty()) {
     p.file_index.resize(n0);
@@ -222,57 +238,96 @@ PolygonCleaning clean_polygon(Polygon p) {
       return out;
     }
   // One pass over a stack: a vertex is dropped if it repeats the previous one,
-  // or if the previous edge and the next one lie on one line and double back
-  // (the vertex is the tip of a zero-area spike). Dropping a vertex can expose
-  // the next spike (a -> b -> a -> ...), which the stack handles.
+  // or if it is the tip of a needle between the previous kept vertex and the
+  // next one (a zero-area spike: the two edges on one line, doubling back; or
+  // the two edges folding back within needle_width of each other). Dropping a
+  // vertex can expose the next needle (a -> b -> a -> ..., or a needle drawn
+  // with several vertices out and back), which the stack handles.
   std::vector<std::size_t> keep;
   keep.reserve(n0);
-  auto spike = [&](std::size_t a, std::size_t b, std::size_t c) {
+  // The width of the needle with tip b (< 0: b is no needle's tip). Exactly
+  // collinear fold-backs (exact predicates) have width 0.
+  auto needle = [&](std::size_t a, std::size_t b, std::size_t c) -> double {
     const Point pa(p.vertices[a].x(), p.vertices[a].y()), pb(p.vertices[b].x(), p.vertices[b].y()),
         pc(p.vertices[c].x(), p.vertices[c].y());
-    return CGAL::collinear(pa, pb, pc) && !CGAL::collinear_are_ordered_along_line(pa, pb, pc);
+    if (CGAL::collinear(pa, pb, pc)) return CGAL::collinear_are_ordered_along_line(pa, pb, pc) ? -1.0 : 0.0;
+    if (needle_width == 0.0) return -1.0;
+    // The edges b->a and b->c fold back (angle below 90 degrees); the width is the
+    // distance of the nearer neighbour from the line of the longer edge, whose
+    // foot lies on that edge.
+    const Eigen::Vector2d u = p.vertices[a] - p.vertices[b], v = p.vertices[c] - p.vertices[b];
+    if (!(u.dot(v) > 0.0)) return -1.0;
+    const double longer = std::max(u.norm(), v.norm());
+    const double width = std::abs(u.x() * v.y() - u.y() * v.x()) / longer;
+    return width <= needle_width ? width : -1.0;
   };
   auto note = [&](std::size_t dropped, const std::string& why) {
     out.removed_file_indices.push_back(p.file_index[dropped]);
     out.notes.push_back("removed vertex " + std::to_string(p.file_index[dropped]) + " " + why);
   };
-  bool changed = true;
+  auto fmt = [](double x) {
+    std::ostringstream os;
+    os.precision(3);
+    os << x;
+    return os.str();
+  };
+  bool changed = false;
   // i repeats the last kept vertex: the one later in the file goes (the
   // closing vertex of a file that repeats its first one, say).
-  auto repeats = [&](std::size_t i) {
-    if (keep.empty() || !(p.vertices[keep.back()] == p.vertices[i])) return false;
+  // Where a needle's tip has just gone, a vertex within needle_width of the
+  // last kept one repeats it too (the two base vertices of a needle, or the
+  // flat end of a needle drawn with two tip vertices): the change is a triangle
+  // of height at most needle_width. Elsewhere short edges are kept.
+  auto repeats = [&](std::size_t i, bool after_tip) {
+    if (keep.empty()) return false;
+    const bool exact = p.vertices[keep.back()] == p.vertices[i];
+    const double gap = (p.vertices[keep.back()] - p.vertices[i]).norm();
+    if (!exact && !(after_tip && needle_width > 0.0 && gap <= needle_width)) return false;
     changed = true;
-    if (p.file_index[i] < p.file_index[keep.back()]) {
-      note(keep.back(), "(repeats vertex " + std::to_string(p.file_index[i]) + ")");
-      keep.back() = i;
-    } else {
-      note(i, "(repeats vertex " + std::to_string(p.file_index[keep.back()]) + ")");
-    }
+    const bool drop_last = p.file_index[i] < p.file_index[keep.back()];
+    const std::size_t dropped = drop_last ? keep.back() : i, kept = drop_last ? i : keep.back();
+    note(dropped, exact ? "(repeats vertex " + std::to_string(p.file_index[kept]) + ")"
+                        : "(lies " + fmt(gap) + " from vertex " + std::to_string(p.file_index[kept]) +
+                              ", closer than the needle width " + fmt(needle_width) + ")");
+    if (drop_last) keep.back() = i;
     return true;
   };
   std::vector<std::size_t> order(n0);
   for (std::size_t i = 0; i < n0; ++i) order[i] = i;
-  // Repeat around the closing seam until nothing changes (at most a few passes).
-  while (changed && order.size() >= 3) {
+  // Repeat, rotating the ring between passes so that the triples across each
+  // pass's seam (the last, first and second vertex) are inside the next pass,
+  // until passes have found nothing three times in a row (a 3-vertex ring needs
+  // three rotations to look at each of its triples; a longer ring, two passes).
+  int quiet_passes = 0;
+  while (quiet_passes < 3 && order.size() >= 3) {
     changed = false;
     keep.clear();
     for (std::size_t i : order) {
-      if (repeats(i)) continue;
-      while (keep.size() >= 2 && spike(keep[keep.size() - 2], keep.back(), i)) {
-        note(keep.back(), "(tip of a zero-area spike: edges " + std::to_string(p.file_index[keep[keep.size() - 2]]) +
-                              "-" + std::to_string(p.file_index[keep.back()]) + " and " +
-                              std::to_string(p.file_index[keep.back()]) + "-" + std::to_string(p.file_index[i]) +
-                              " overlap)");
+      if (repeats(i, false)) continue;
+      double width = 0.0;
+      bool tip = false;
+      while (keep.size() >= 2 && (width = needle(keep[keep.size() - 2], keep.back(), i)) >= 0.0) {
+        const std::string a = std::to_string(p.file_index[keep[keep.size() - 2]]),
+                          b = std::to_string(p.file_index[keep.back()]), c = std::to_string(p.file_index[i]);
+        if (width == 0.0)
+          note(keep.back(), "(tip of a zero-area spike: edges " + a + "-" + b + " and " + b + "-" + c + " overlap)");
+        else
+          note(keep.back(), "(tip of a needle of width " + fmt(width) + ", narrower than " + fmt(needle_width) +
+                                ": edges " + a + "-" + b + " and " + b + "-" + c + " fold back)");
+        ++out.needles;
+        out.max_needle_width = std::max(out.max_needle_width, width);
         keep.pop_back();
         changed = true;
-        if (!keep.empty() && p.vertices[keep.back()] == p.vertices[i]) break;
+        tip = true;
+        if (!keep.empty() && (p.vertices[keep.back()] - p.vertices[i]).norm() <= needle_width) break;
       }
-      if (repeats(i)) continue;
+      if (repeats(i, tip)) continue;
       keep.push_back(i);
     }
     // Rotate so that the seam between the last and first vertex is looked at too.
     if (keep.size() >= 3) std::rotate(keep.begin(), keep.begin() + static_cast<std::ptrdiff_t>(keep.size() / 2), keep.end());
     order = keep;
+    quiet_passes = changed ? 0 : quiet_passes + 1;
   }
   std::sort(order.begin(), order.end());  // file order
   Polygon q;
@@ -280,6 +335,47 @@ PolygonCleaning clean_polygon(Polygon p) {
   std::sort(out.removed_file_indices.begin(), out.removed_file_indices.end());
   out.polygon = std::move(q);
   return out;
+}
+
+double needle_width_for_ring(const Polygon& p, std::optional<double> tolerance_absolute, double tolerance_relative) {
+  auto width_at = [&](double d) {
+    return needle_width_for_tolerance(tolerance_absolute ? *tolerance_absolute : tolerance_relative * d * d, d);
+  };
+  double d = bounding_box_diagonal(p);
+  double w = width_at(d);
+  // At most a few rounds: each one only looks at a smaller diagonal.
+  for (int round = 0; round < 8 && w > 0.0; ++round) {
+    const PolygonCleaning c = clean_polygon(p, w);
+    const double dc = c.polygon.vertices.size() >= 3 ? bounding_box_diagonal(c.polygon) : 0.0;
+    if (dc >= 0.5 * d) return w;
+    d = dc;
+    w = width_at(d);
+  }
+  return w > 0.0 && std::isfinite(w) ? w : 0.0;
+}
+
+Polygon validate_cleaned_polygon(PolygonCleaning c, double needle_width, std::size_t min_vertices) {
+  const std::size_t left = c.polygon.vertices.size();
+  if (c.needles > 0 && left < std::max<std::size_t>(min_vertices, 3)) {
+    std::ostringstream m;
+    m.precision(3);
+    m << "the ring encloses no area: it is nothing but ";
+    if (needle_width > 0.0) m << "needles narrower than " << needle_width;
+    else m << "zero-area spikes";
+    m << " (" << left << " of its " << left + c.removed_file_indices.size()
+      << " vertices are left once they are removed)";
+    throw InputError(m.str());
+  }
+  return validate_polygon(std::move(c.polygon), min_vertices);
+}
+
+std::string cleaning_summary(const std::string& ring, const PolygonCleaning& c) {
+  if (c.notes.empty()) return {};
+  constexpr std::size_t kShown = 4;
+  std::string s = ring + ": ";
+  for (std::size_t k = 0; k < c.notes.size() && k < kShown; ++k) s += (k ? "; " : "") + c.notes[k];
+  if (c.notes.size() > kShown) s += "; and " + std::to_string(c.notes.size() - kShown) + " more vertices";
+  return s;
 }
 
 }  // namespace tspline

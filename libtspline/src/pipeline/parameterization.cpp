@@ -287,10 +287,15 @@ FrontResult run_front(const Polygon& input, const ParameterizationOptions& opt) 
 
   std::vector<StageTime> times;
   StageClock clock(times);
-  PolygonCleaning cleaning = clean_polygon(input);
-  for (const std::string& note : cleaning.notes)
-    report_step(opt.progress, "cleaning", "note: " + note, -1, ProgressEvent::Kind::Note);
-  Polygon poly = validate_polygon(std::move(cleaning.polygon));
+  // Needles narrower than the boundary tolerance's width (epsilon / diagonal) go.
+  const double needle_width = needle_width_for_ring(input, opt.tolerance_absolute, opt.tolerance_relative);
+  PolygonCleaning cleaning = clean_polygon(input, needle_width);
+  if (!cleaning.notes.empty())
+    report_step(opt.progress, "cleaning", "note: " + cleaning_summary("the boundary", cleaning), -1,
+                ProgressEvent::Kind::Note);
+  const std::vector<std::size_t> removed_vertices = cleaning.removed_file_indices;
+  const std::vector<std::string> cleaning_notes = cleaning.notes;
+  Polygon poly = validate_cleaned_polygon(std::move(cleaning), needle_width);
   clock.stop("boundary");
   Corners corners;
   std::vector<CornerTrial> trials;
@@ -431,8 +436,8 @@ FrontResult run_front(const Polygon& input, const ParameterizationOptions& opt) 
       if (t.stage == "corner_trials") t.seconds = std::max(0.0, t.seconds - kept);
   }
   times.insert(times.end(), r.times.begin(), r.times.end());
-  r.removed_vertices = cleaning.removed_file_indices;
-  r.cleaning_notes = cleaning.notes;
+  r.removed_vertices = removed_vertices;
+  r.cleaning_notes = cleaning_notes;
   r.corner_trials = std::move(trials);
   r.times = std::move(times);
   return r;

@@ -3,6 +3,7 @@
 // whole (every ring simple, holes strictly inside the outer ring, no two rings
 // crossing or touching, no hole inside another).
 #include <Eigen/Core>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -21,13 +22,29 @@ struct Domain {
 /// Name of ring r in messages: ring 0 is "the outer ring", ring k >= 1 is "hole k".
 std::string ring_name(std::size_t r);
 
-/// Validates and orients the domain.
+/// How validate_domain cleans the rings.
+struct DomainCleaningOptions {
+  /// Needles narrower than this are removed from every ring (clean_polygon);
+  /// unset: needle_width_for_ring(outer, none, kDefaultNeedleWidthRelative), i.e.
+  /// 1e-5 x the outer ring's bounding-box diagonal, the width of the default
+  /// boundary tolerance. A caller with another boundary tolerance passes
+  /// needle_width_for_ring(outer, tolerance_absolute, tolerance_relative).
+  std::optional<double> needle_width;
+  /// If set, receives one note per ring that was cleaned ("hole 9: removed
+  /// vertex 0 (tip of a zero-area spike: edges 6-0 and 0-1 overlap)"), in ring order.
+  std::vector<std::string>* notes = nullptr;
+};
+
+/// Cleans (clean_polygon: repeated vertices, needles and spikes narrower than
+/// the needle width, anywhere in the ring, vertex 0 too), validates and orients
+/// the domain; the file numbering of every ring is kept. The outer ring needs 4
+/// vertices, a hole 3.
 /// \throw InputError with one line naming the rings and edges (file vertex
 /// indices of the ring): a ring that is not a simple polygon (prefixed with the
 /// ring's name), "hole 2 crosses the outer ring: edge 4-5 of hole 2 and edge
 /// 0-1 of the outer ring intersect near (x, y)" (also for touching rings), "hole
 /// 1 lies outside the outer ring", "hole 3 lies inside hole 1".
-Domain validate_domain(Domain d);
+Domain validate_domain(Domain d, const DomainCleaningOptions& cleaning = {});
 
 /// Area of the outer ring minus the areas of the holes (a validated domain).
 double domain_area(const Domain& d);

@@ -21,7 +21,10 @@ toolkit::io::VtuMesh boundary_vtu(const BoundaryMap& boundary);
 /// after optimization, quality statistics, sweeps and per-stage wall times.
 nlohmann::json front_report(const FrontResult& result, const std::string& input_path);
 
-/// Writes parametric_tmesh.vtu, physical_tmesh.vtu and boundary.vtu (each atomically) into out_dir.
-void write_front_meshes(const FrontResult& result, const std::string& out_dir);
+/// Writes parametric_tmesh.vtu, boundary.vtu and (if `physical`) physical_tmesh.vtu
+/// of the front half's vertex positions (straight cell edges; valid by the
+/// straight-polygon test), each atomically, into out_dir. A run with a map
+/// writes physical_tmesh.vtu through the map instead (param_output.h).
+void write_front_meshes(const FrontResult& result, const std::string& out_dir, bool physical = true);
 
 }  // namespace tspline::io

@@ -23,6 +23,9 @@
 #include <cstddef>
 #include <string>
 
+#include <vector>
+
+#include "tspline/multipatch/patch_layout.h"
 #include "tspline/spline/tspline_map.h"
 
 namespace tspline::io {
@@ -43,5 +46,23 @@ std::string msh_document(const TSplineMap& map, MshExportStats* stats = nullptr)
 
 /// Writes msh_document() atomically. \throw IoError.
 MshExportStats write_msh_file(const std::string& path, const TSplineMap& map);
+
+/// A multi-patch map (format version 2): surface entity p + 1 per patch p (its
+/// elements in one block, in BezierExtraction order; element tags numbered on
+/// across the patches), each in the physical group 1 "domain" and its own group
+/// p + 2 "patch p"; the nodes of a patch as above, and along every interface the
+/// two patches share their nodes where the parametric positions correspond (t on
+/// side_a of patch a is 1 - t on side_b of patch b, compared exactly; with the
+/// shared interface knots of `tspline param` that is every node of the cut), so
+/// that the mesh is conforming across cuts. A node belongs to the entity of the
+/// first patch that has it. One patch and no interfaces: msh_document(map).
+/// \throw std::invalid_argument for an empty map list or an interface naming a
+/// patch or side out of range.
+std::string msh_document(const std::vector<const TSplineMap*>& maps, const std::vector<Interface>& interfaces,
+                         MshExportStats* stats = nullptr);
+
+/// Writes the multi-patch msh_document() atomically. \throw IoError.
+MshExportStats write_msh_file(const std::string& path, const std::vector<const TSplineMap*>& maps,
+                              const std::vector<Interface>& interfaces);
 
 }  // namespace tspline::io

@@ -23,14 +23,41 @@ toolkit::io::VtuMesh surface_vtu(const TSplineMap& map, int samples);
 /// function (index).
 toolkit::io::VtuMesh control_net_vtu(const TSplineMap& map);
 
-/// Writes adapt/mesh_NNN.vtu and adapt/surface_NNN.vtu for each iteration (the
+/// The T-mesh as the map draws it (physical_tmesh.vtu): each cell a VTK
+/// polygon through its boundary sampled through the map, k segments per
+/// elementary cell edge (between consecutive vertices of the cell, hanging ones
+/// included), so that curved cell edges are drawn curved; the samples are shared
+/// by neighbouring cells (one point per parametric position). Cell data:
+/// level; valid (1 iff the certificate proves det J > 0 on the whole cell, i.e.
+/// MapCertification::cell_certified; without a certificate (`certificate` null
+/// or of another mesh): det J > 0 at the cell's quadrature points, from
+/// `quality`; -1 without either); certified (1 certified, 0 not, -1 no certificate);
+/// det_lower_bound and relative_det_lower_bound (the certified lower bound of
+/// det J over the cell's Bezier elements, parametric coordinates, and divided by
+/// the element mean: certify_element with `options`; NaN without a
+/// certificate); min_det_jacobian and min_mean_ratio_jacobian (at the
+/// quadrature points, from `quality`; NaN without). Point data: parametric (xi,
+/// eta), vertex (the T-mesh vertex, -1 for samples inside an edge), hanging,
+/// boundary (on the parametric square's border).
+/// \throw std::invalid_argument unless 1 <= k <= 64.
+toolkit::io::VtuMesh physical_tmesh_vtu(const TSplineMap& map, int k, const MapCertification* certificate,
+                                        const CertificationOptions& options,
+                                        const std::vector<CellMapQuality>* quality);
+
+/// The same for a result: its map, certificate (if AdaptiveOptions::certify
+/// was on), certification options and per-cell quality.
+toolkit::io::VtuMesh physical_tmesh_vtu(const ParameterizationResult& result, int k);
+
+/// Writes adapt/mesh_NNN.vtu (the iteration's T-mesh drawn through its map,
+/// physical_tmesh_vtu without a certificate: `valid` from the cells' quadrature
+/// points if `quality` is given) and adapt/surface_NNN.vtu for each iteration (the
 /// adapt/ folder is created on the first one) and,
 /// on finish(), adapt.pvd listing them (timestep = iteration; part 0 the
 /// physical T-mesh, part 1 the surface).
 class AdaptSeriesWriter {
  public:
   AdaptSeriesWriter(std::string out_dir, int samples);
-  void add(int iteration, const TMesh& mesh, const std::vector<Eigen::Vector2d>& x, const TSplineMap& map);
+  void add(int iteration, const TSplineMap& map, const std::vector<CellMapQuality>* quality = nullptr);
   void finish() const;
 
  private:
@@ -45,8 +72,9 @@ class AdaptSeriesWriter {
 /// are those stored in the result).
 nlohmann::json param_report(const ParameterizationResult& result, const std::string& input_path);
 
-/// Writes parametric_tmesh.vtu, physical_tmesh.vtu, boundary.vtu, tspline.json,
-/// surface.vtu, control_net.vtu and report.json into out_dir (each atomically).
+/// Writes parametric_tmesh.vtu, physical_tmesh.vtu (physical_tmesh_vtu with
+/// `samples` segments per cell edge), boundary.vtu, tspline.json, surface.vtu,
+/// control_net.vtu and report.json into out_dir (each atomically).
 void write_param_outputs(const ParameterizationResult& result, const std::string& out_dir,
                          const nlohmann::json& report, int samples);
 
