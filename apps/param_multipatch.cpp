@@ -6,6 +6,7 @@
 
 #include "tspline/errors.h"
 #include "tspline/io/multipatch_output.h"
+#include "tspline/io/param_output.h"
 #include "tspline/io/polygon_reader.h"
 #include "tspline/multipatch/multipatch_parameterization.h"
 
@@ -40,14 +41,15 @@ int run_multipatch_param(const tspline::io::DomainInput& input_domain, const std
                   {"patches", R.patches.size()},
                   {"cells", totals["cells"]},
                   {"min_mean_ratio_jacobian", R.min_mean_ratio_gauss()},
+                  {"whole_map", totals["whole_map"]},
                   {"max_interface_gap", R.max_gap()},
                   {"out", out_dir}});
   if (progress.human()) {
     std::ostringstream s;
     s << R.patches.size() << " patches, " << R.layout.cuts.size() << " cuts, " << totals["cells"] << " cells, "
       << totals["bezier_elements"] << " elements; certified " << (R.certified_valid() ? "valid" : "NOT valid")
-      << " (det J >= " << R.min_relative_det_bound() << " x element mean), min J_r " << R.min_mean_ratio_dense()
-      << " (whole map); area " << R.map_area << " vs " << R.domain_area << "; largest interface gap " << R.max_gap()
+      << " (det J >= " << R.min_relative_det_bound() << " x element mean); "
+      << tspline::io::whole_map_quality_summary(totals["whole_map"]) << "; area " << R.map_area << " vs " << R.domain_area << "; largest interface gap " << R.max_gap()
       << " (" << R.max_gap() / R.diameter << " x diameter); " << seconds << " s";
     std::cout << s.str() << "\nwrote tspline.json (format version 2), surface.vtu, control_net.vtu, "
                             "parametric_tmesh.vtu, physical_tmesh.vtu, boundary.vtu, report.json to "
