@@ -7,7 +7,9 @@
 #include <doctest/doctest.h>
 
 #include <Eigen/LU>
+#include <array>
 #include <cmath>
+#include <tuple>
 #include <vector>
 
 #include "separable_maps.h"
@@ -60,6 +62,59 @@ std::pair<double, double> bilinear_sampled_min(int n) {
   return {jr, sj};
 }
 
+// A polynomial map S(u, v) = sum_{i,j<=3} c[i][j] u^i v^j on [0,1]^2.
+struct CubicMap {
+  std::array<std::array<Eigen::Vector2d, 4>, 4> c;
+  Eigen::Vector2d at(double u, double v) const {
+    Eigen::Vector2d x = Eigen::Vector2d::Zero();
+    for (int i = 0; i < 4; ++i)
+      for (int j = 0; j < 4; ++j) x += c[i][j] * std::pow(u, i) * std::pow(v, j);
+    return x;
+  }
+  Eigen::Matrix2d jacobian(double u, double v) const {
+    Eigen::Matrix2d J = Eigen::Matrix2d::Zero();
+    for (int i = 0; i < 4; ++i)
+      for (int j = 0; j < 4; ++j) {
+        if (i > 0) J.col(0) += c[i][j] * i * std::pow(u, i - 1) * std::pow(v, j);
+        if (j > 0) J.col(1) += c[i][j] * j * std::pow(u, i) * std::pow(v, j - 1);
+      }
+    return J;
+  }
+  // Minima of J_r and SJ over an (n + 1)^2 grid, and where J_r's is.
+  std::tuple<double, double, Eigen::Vector2d> sampled_min(int n) const {
+    double jr = 1.0, sj = 1.0;
+    Eigen::Vector2d where = Eigen::Vector2d::Zero();
+    for (int j = 0; j <= n; ++j)
+      for (int i = 0; i <= n; ++i) {
+        const Eigen::Matrix2d J = jacobian(double(i) / n, double(j) / n);
+        const double m = tspline::mean_ratio_jacobian(J);
+        if (m < jr) jr = m, where = {double(i) / n, double(j) / n};
+        sj = std::min(sj, tspline::scaled_jacobian(J));
+      }
+    return {jr, sj, where};
+  }
+};
+
+// The T-spline of one cell reproducing f exactly: P_a = sum c_ij beta_i(xi knots) beta_j(eta knots)
+// with beta_k the blossom of t^k at the three middle local knots (separable_maps.h).
+TSplineMap cubic_map(const CubicMap& f) {
+  TSplineMap map(test_support::uniform_mesh(0));
+  auto beta = [](const std::array<double, 5>& k) {
+    const double a = k[1], b = k[2], c = k[3];
+    return std::array<double, 4>{1.0, (a + b + c) / 3.0, (a * b + a * c + b * c) / 3.0, a * b * c};
+  };
+  std::vector<Eigen::Vector2d> P;
+  for (const tspline::BlendingFunction& fn : map.basis().functions()) {
+    const auto bu = beta(fn.knots_xi), bv = beta(fn.knots_eta);
+    Eigen::Vector2d p = Eigen::Vector2d::Zero();
+    for (int i = 0; i < 4; ++i)
+      for (int j = 0; j < 4; ++j) p += f.c[i][j] * bu[i] * bv[j];
+    P.push_back(p);
+  }
+  map.set_control_points(P);
+  return map;
+}
+
 }  // namespace
 
 TEST_SUITE("map_quality_bounds") {
@@ -108,7 +163,7 @@ TEST_SUITE("map_quality_bounds") {
     CHECK(q.mean_ratio.sampled > exact);
   }
 
-  TEST_CASE("bilinear quadrilateral: below the 801 x 801 sample, within 2 %, converging with the depth") {
+  TEST_CASE("bilinear quadrilateral: the bounds are the corner minima, without subdivision") {
     const TSplineMap map = greville_map(0, bilinear);
     REQUIRE(map.point({0.3, 0.7}).isApprox(bilinear({0.3, 0.7}), 1e-14));
     const auto [jr_ref, sj_ref] = bilinear_sampled_min(800);
@@ -118,36 +173,76 @@ TEST_SUITE("map_quality_bounds") {
                                    << ", " << q.patches << " patches");
     CHECK(q.mean_ratio.lower_bound <= jr_ref);
     CHECK(q.scaled.lower_bound <= sj_ref);
-    CHECK(q.mean_ratio.lower_bound >= jr_ref * 0.98 - 1e-4);  // the default gap: 2 % + 1e-4
-    CHECK(q.scaled.lower_bound >= sj_ref * 0.98 - 1e-4);
+    // Both minima are at a corner of this quad; the ratio bound (8) finds J_r's
+    // from the element's coefficients, the cones (6) SJ's (spanned by the
+    // opposite edges A B, D C and A D, B C), up to their widening for round-off.
+    CHECK(q.mean_ratio.lower_bound >= jr_ref - 1e-11);
+    CHECK(q.scaled.lower_bound >= sj_ref - 1e-8);
+    CHECK(q.patches == 1);
     CHECK(q.elements_not_converged == 0);
     // The attained and sampled minima are values of the map, hence >= the minimum.
     CHECK(q.mean_ratio.attained >= jr_ref - 1e-6);
     CHECK(q.mean_ratio.sampled >= jr_ref - 1e-12);
+  }
+
+  TEST_CASE("curved cubic map (a swirl): below the 801 x 801 sample, converging to it with the depth") {
+    // S = (u, v) + c phi (-(v - 1/2), u - 1/2), phi = 16 u (1 - u) v (1 - v), c = 1/2:
+    // bidegree (3,3), exactly a T-spline map on one cell (control points: blossoms).
+    // J_r's minimum 0.6158 is on the edges u = 0 near v = 0.67 and u = 1 near
+    // v = 0.33 (the swirl's symmetry), not at a corner nor at a dyadic point.
+    const double c = 0.5;
+    CubicMap f;
+    for (auto& row : f.c) row.fill(Eigen::Vector2d::Zero());
+    // x = u - 16 c (u - u^2)(-v^3 + 1.5 v^2 - 0.5 v), y = v + 16 c (-u^3 + 1.5 u^2 - 0.5 u)(v - v^2).
+    const double xv[4] = {0.0, -0.5, 1.5, -1.0}, yu[4] = {0.0, -0.5, 1.5, -1.0};
+    f.c[1][0].x() = 1.0;
+    f.c[0][1].y() = 1.0;
+    for (int j = 1; j <= 3; ++j) {
+      f.c[1][j].x() += -16.0 * c * xv[j];
+      f.c[2][j].x() += 16.0 * c * xv[j];
+    }
+    for (int i = 1; i <= 3; ++i) {
+      f.c[i][1].y() += 16.0 * c * yu[i];
+      f.c[i][2].y() += -16.0 * c * yu[i];
+    }
+    const TSplineMap map = cubic_map(f);
+    REQUIRE(map.point({0.3, 0.7}).isApprox(f.at(0.3, 0.7), 1e-14));
+    REQUIRE(map.jacobian({0.3, 0.7}).isApprox(f.jacobian(0.3, 0.7), 1e-13));
+    const auto [jr_ref, sj_ref, where] = f.sampled_min(800);
+    MESSAGE("curved: sampled minima J_r " << jr_ref << " SJ " << sj_ref << ", J_r's at " << where.transpose());
+    CHECK(jr_ref == doctest::Approx(0.6158).epsilon(1e-3));
+    CHECK(std::abs(where.y() - 0.5) > 0.15);  // not at a corner of the element
+    CHECK(std::abs(where.y() - 0.5) < 0.2);
+    const MapQualityBounds q = tspline::certified_map_quality(map);
+    CHECK(q.mean_ratio.lower_bound <= jr_ref);
+    CHECK(q.scaled.lower_bound <= sj_ref);
+    CHECK(q.mean_ratio.lower_bound >= jr_ref * 0.98 - 1e-4);  // the default gap: 2 % + 1e-4
+    CHECK(q.scaled.lower_bound >= sj_ref * 0.98 - 1e-4);
     // The gap to the minimum shrinks with the depth limit (no gap target).
     QualityBoundOptions opt;
     opt.relative_gap = opt.absolute_gap = 0.0;
     opt.samples_per_edge = 0;
     std::vector<double> gap_jr, gap_sj;
-    for (int depth = 0; depth <= 8; depth += 2) {
+    for (int depth = 0; depth <= 6; ++depth) {
       opt.max_depth = depth;
       const MapQualityBounds b = tspline::certified_map_quality(map, opt);
       CHECK(b.mean_ratio.lower_bound <= jr_ref);
       CHECK(b.scaled.lower_bound <= sj_ref);
       gap_jr.push_back(jr_ref - b.mean_ratio.lower_bound);
       gap_sj.push_back(sj_ref - b.scaled.lower_bound);
-      MESSAGE("depth " << depth << ": J_r gap " << gap_jr.back() << ", SJ gap " << gap_sj.back() << ", "
-                       << b.patches << " patches");
+      MESSAGE("depth " << depth << ": J_r bound " << b.mean_ratio.lower_bound << " gap " << gap_jr.back()
+                       << ", SJ bound " << b.scaled.lower_bound << " gap " << gap_sj.back() << ", " << b.patches
+                       << " patches");
     }
-    for (std::size_t k = 1; k < gap_jr.size(); ++k) CHECK(gap_jr[k] <= gap_jr[k - 1]);
-    // J_r: 0.14 at depth 0 (the element's coefficients), 1e-4 at depth 8.
-    CHECK(gap_jr.front() > 0.1);
-    CHECK(gap_jr.back() < 2e-3 * gap_jr.front());
-    CHECK(gap_jr.back() < 2e-4);
-    // SJ: the cones (6) of a bilinear map's N_s, N_t are spanned by opposite
-    // edges (A B, D C and A D, B C), so the bound is the corner value from depth
-    // 0, up to the 2e-9 rad the cones are widened by.
-    CHECK(gap_sj.front() < 1e-8);
+    for (std::size_t k = 1; k < gap_jr.size(); ++k) {
+      CHECK(gap_jr[k] <= gap_jr[k - 1]);
+      CHECK(gap_sj[k] <= gap_sj[k - 1]);
+    }
+    // J_r: the gap falls by about 4 per level (the ratio bound's O(h^2)), 0.077 -> 6e-6.
+    CHECK(gap_jr.front() > 0.05);
+    CHECK(gap_jr.back() < 1e-4 * gap_jr.front());
+    CHECK(gap_jr.back() < 1e-2 * gap_jr.front());
+    CHECK(gap_sj.back() < 1e-2 * gap_sj.front());
   }
 
   TEST_CASE("folded element: negative bounds below the sampled values") {

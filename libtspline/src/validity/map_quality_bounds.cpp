@@ -40,10 +40,118 @@ Quality quality_at(double dw, double nsx, double nsy, double ntx, double nty, do
   return {q > 0.0 ? 2.0 * dw / q : 0.0, ab > 0.0 ? dw / ab : 0.0};
 }
 
-// One patch (the element or a sub-patch): D, w and the components of N_s, N_t
-// (1) in the Bernstein basis of the patch, and its position in the element.
+// A polynomial of bidegree (m, n) <= (12, 12) in the Bernstein basis, for the
+// ratio bound (8): A = 2 D w (11,11) and |N_s|^2 (10,12), |N_t|^2 (12,10), all
+// elevated to (12,12). (detail::BernsteinPoly stops at (8,8).)
+constexpr int kQ = 12;
+struct Poly12 {
+  int m = 0, n = 0;
+  std::array<double, (kQ + 1) * (kQ + 1)> c{};
+  Poly12() = default;
+  Poly12(int m_, int n_) : m(m_), n(n_) {}
+  double& at(int i, int j) { return c[i + (m + 1) * j]; }
+  double at(int i, int j) const { return c[i + (m + 1) * j]; }
+  int size() const { return (m + 1) * (n + 1); }
+};
+
+double binom24(int n, int k) {
+  static const auto table = [] {
+    std::array<std::array<double, 2 * kQ + 1>, 2 * kQ + 1> t{};
+    for (int i = 0; i <= 2 * kQ; ++i) {
+      t[i][0] = t[i][i] = 1.0;
+      for (int j = 1; j < i; ++j) t[i][j] = t[i - 1][j - 1] + t[i - 1][j];
+    }
+    return t;
+  }();
+  return table[n][k];
+}
+
+Poly12 to_poly12(const BernsteinPoly& p) {
+  Poly12 r(p.m, p.n);
+  for (int k = 0; k < p.size(); ++k) r.c[k] = p.c[k];
+  return r;
+}
+
+// The product (B_i^m1 B_k^m2 = binom(m1,i) binom(m2,k) / binom(m1+m2,i+k) B_{i+k}^{m1+m2}, in each direction).
+Poly12 product12(const Poly12& a, const Poly12& b) {
+  Poly12 r(a.m + b.m, a.n + b.n);
+  // Scaled coefficients a_ij binom(m, i) binom(n, j): the product is a plain convolution.
+  std::array<double, (kQ + 1) * (kQ + 1)> sa{}, sb{};
+  for (int j = 0; j <= a.n; ++j)
+    for (int i = 0; i <= a.m; ++i) sa[i + (a.m + 1) * j] = a.at(i, j) * binom24(a.m, i) * binom24(a.n, j);
+  for (int j = 0; j <= b.n; ++j)
+    for (int i = 0; i <= b.m; ++i) sb[i + (b.m + 1) * j] = b.at(i, j) * binom24(b.m, i) * binom24(b.n, j);
+  const int rs = r.m + 1, bs = b.m + 1;
+  for (int j1 = 0; j1 <= a.n; ++j1)
+    for (int i1 = 0; i1 <= a.m; ++i1) {
+      const double x = sa[i1 + (a.m + 1) * j1];
+      if (x == 0.0) continue;
+      for (int j2 = 0; j2 <= b.n; ++j2) {
+        double* out = &r.c[i1 + rs * (j1 + j2)];
+        const double* in = &sb[bs * j2];
+        for (int i2 = 0; i2 <= b.m; ++i2) out[i2] += x * in[i2];
+      }
+    }
+  for (int j = 0; j <= r.n; ++j)
+    for (int i = 0; i <= r.m; ++i) r.at(i, j) /= binom24(r.m, i) * binom24(r.n, j);
+  return r;
+}
+
+// Degree elevation to (kQ, kQ), one degree at a time:
+// c'_i = (i / (m + 1)) c_{i-1} + (1 - i / (m + 1)) c_i.
+Poly12 elevate12(Poly12 p) {
+  while (p.m < kQ) {
+    Poly12 q(p.m + 1, p.n);
+    for (int j = 0; j <= p.n; ++j)
+      for (int i = 0; i <= q.m; ++i) {
+        const double f = static_cast<double>(i) / q.m;
+        q.at(i, j) = (i > 0 ? f * p.at(i - 1, j) : 0.0) + (i < q.m ? (1.0 - f) * p.at(i, j) : 0.0);
+      }
+    p = q;
+  }
+  while (p.n < kQ) {
+    Poly12 q(p.m, p.n + 1);
+    for (int j = 0; j <= q.n; ++j) {
+      const double f = static_cast<double>(j) / q.n;
+      for (int i = 0; i <= p.m; ++i)
+        q.at(i, j) = (j > 0 ? f * p.at(i, j - 1) : 0.0) + (j < q.n ? (1.0 - f) * p.at(i, j) : 0.0);
+    }
+    p = q;
+  }
+  return p;
+}
+
+// de Casteljau split at 1/2 of deg + 1 values with the given stride.
+void split_row12(const double* in, int deg, int stride, double* left, double* right) {
+  double w[kQ + 1];
+  for (int i = 0; i <= deg; ++i) w[i] = in[i * stride];
+  for (int k = 0; k <= deg; ++k) {
+    left[k * stride] = w[0];
+    right[(deg - k) * stride] = w[deg - k];
+    for (int i = 0; i < deg - k; ++i) w[i] = 0.5 * (w[i] + w[i + 1]);
+  }
+}
+
+// The four quarters SW, SE, NW, NE (as detail::bernstein_subdivide).
+std::array<Poly12, 4> subdivide12(const Poly12& p) {
+  Poly12 ls(p.m, p.n), rs(p.m, p.n);
+  for (int j = 0; j <= p.n; ++j)
+    split_row12(&p.c[(p.m + 1) * j], p.m, 1, &ls.c[(p.m + 1) * j], &rs.c[(p.m + 1) * j]);
+  std::array<Poly12, 4> q = {Poly12(p.m, p.n), Poly12(p.m, p.n), Poly12(p.m, p.n), Poly12(p.m, p.n)};
+  for (int i = 0; i <= p.m; ++i) {
+    split_row12(&ls.c[i], p.n, p.m + 1, &q[0].c[i], &q[2].c[i]);
+    split_row12(&rs.c[i], p.n, p.m + 1, &q[1].c[i], &q[3].c[i]);
+  }
+  return q;
+}
+
+// One patch (the element or a sub-patch): the components of N_s, N_t (1) and
+// A = 2 D w, S2 = |N_s|^2, T2 = |N_t|^2 (8) in the Bernstein basis of the
+// patch, and its position in the element.
 struct Patch {
-  BernsteinPoly d, w, nsx, nsy, ntx, nty;
+  BernsteinPoly nsx, nsy, ntx, nty;
+  Poly12 a, s2, t2;     // only if `ratio` (made once the cone bound alone is not enough)
+  bool ratio = false;
   int depth = 0;
   double s0 = 0.0, t0 = 0.0, size = 1.0;
   double jr_lo = -1.0, sj_lo = -1.0;  // the patch's lower bounds
@@ -88,9 +196,12 @@ struct Cone {
   double min_dot = 0.0;       // <= |N| on the patch
 };
 Cone cone(const BernsteinPoly& x, const BernsteinPoly& y, double max_norm2) {
-  // Coefficients below 1e-6 of the largest: their angles could carry a round-off
-  // error above kAngleRoundOff (the coefficient error is ~1e-15 of the largest).
-  constexpr double kTiny2 = 1e-12, kAngleRoundOff = 1e-9;
+  // Coefficients below 1e-6 of the largest are not used (their angles are ill
+  // conditioned). The coefficients' round-off is taken as 1e3 eps of the
+  // largest, so the angle of c_k is off by at most 1e3 eps max|c| / |c_k|:
+  // the cone is widened by that (at most 2.2e-7 rad; 2.2e-13 where all
+  // coefficients have the same length, as for an affine map).
+  constexpr double kTiny2 = 1e-12, kCoefficientRoundOff = 1e3 * std::numeric_limits<double>::epsilon();
   const int n = x.size();
   double mx = 0.0, my = 0.0;
   for (int k = 0; k < n; ++k) mx += x.c[k], my += y.c[k];
@@ -98,20 +209,22 @@ Cone cone(const BernsteinPoly& x, const BernsteinPoly& y, double max_norm2) {
   Cone c;
   if (!(mn > 0.0)) return c;
   mx /= mn, my /= mn;
-  double tan_lo = 0.0, tan_hi = 0.0, min_dot = std::numeric_limits<double>::infinity();
+  double tan_lo = 0.0, tan_hi = 0.0, min_dot = std::numeric_limits<double>::infinity(), min_norm2 = max_norm2;
   for (int k = 0; k < n; ++k) {
-    const double d = mx * x.c[k] + my * y.c[k], cr = mx * y.c[k] - my * x.c[k];
-    if (!(d > 0.0) || d * d + cr * cr < kTiny2 * max_norm2) return c;
+    const double d = mx * x.c[k] + my * y.c[k], cr = mx * y.c[k] - my * x.c[k], n2 = d * d + cr * cr;
+    if (!(d > 0.0) || n2 < kTiny2 * max_norm2) return c;
     // theta_k in (-pi/2, pi/2), increasing with tan theta_k = cr / d.
     const double t = cr / d;
     tan_lo = k ? std::min(tan_lo, t) : t;
     tan_hi = k ? std::max(tan_hi, t) : t;
     min_dot = std::min(min_dot, d);
+    min_norm2 = std::min(min_norm2, n2);
   }
+  const double widen = kCoefficientRoundOff * std::sqrt(max_norm2 / min_norm2);
   const double alpha = std::atan2(my, mx);
   c.ok = true;
-  c.lo = alpha + std::atan(tan_lo) - kAngleRoundOff;
-  c.hi = alpha + std::atan(tan_hi) + kAngleRoundOff;
+  c.lo = alpha + std::atan(tan_lo) - widen;
+  c.hi = alpha + std::atan(tan_hi) + widen;
   c.min_dot = min_dot * (1.0 - kRoundOff);
   return c;
 }
@@ -127,34 +240,47 @@ double min_sin(double lo, double hi) {
 // g(t) = 2 t / (1 + t^2), increasing on [0, 1], decreasing beyond (g(inf) = 0).
 double g_ratio(double t) { return std::isfinite(t) ? 2.0 * t / (1.0 + t * t) : 0.0; }
 
+// min_k A_k / (alpha S2_k + beta T2_k) over the coefficients (8): a lower
+// bound of A / (alpha S2 + beta T2) if every denominator coefficient is > 0,
+// otherwise -1. tol_a: the round-off allowance of A.
+double ratio_bound(const Patch& p, double alpha, double beta, double tol_a) {
+  double lo = 1.0;
+  for (int k = 0; k < p.a.size(); ++k) {
+    const double q = alpha * p.s2.c[k] + beta * p.t2.c[k];
+    if (!(q > 0.0)) return -1.0;
+    const double a = p.a.c[k] - tol_a;
+    lo = std::min(lo, a / (a >= 0.0 ? q * (1.0 + kRoundOff) : q * (1.0 - kRoundOff)));
+  }
+  return std::max(-1.0, lo);
+}
+
 // The lower bounds of J_r and SJ on a patch: the larger of two valid bounds.
-//  (a) From D (header, "Bounds on a patch"): min D, w and the norm bounds (4), (5).
+//  (a) The ratio bound (8): J_r >= min_k A_k / (r S2_k + T2_k / r), and
+//      SJ >= min_k A_k / (rho S2_k + T2_k / rho) for any rho > 0 if A >= 0 on
+//      the patch (all A_k >= 0; AM-GM: rho |N_s|^2 + |N_t|^2 / rho >=
+//      2 |N_s| |N_t|), with rho the ratio of the mean coefficients of |N_t|
+//      and |N_s| on the patch (the best rho at a point is |N_t| / |N_s|).
 //  (b) From the cones (6) of N_s and N_t: the angle phi from N_s to N_t lies in
 //      [lo_t - hi_s, hi_t - lo_s], so SJ = sin phi >= sigma = min sin there, and
 //      J_r = g(tau) sin phi (7) with tau = |N_t| / (r |N_s|) in
 //      [b_lo / (r a_hi), b_hi / (r a_lo)]: J_r >= sigma min(g(tau_lo), g(tau_hi))
 //      if sigma >= 0 (g is unimodal), J_r >= sigma otherwise (0 <= g <= 1).
-//  (a) is exact for affine maps (constant D), (b) where the speed varies along
-//  straight or gently turning parameter lines (D varies, the angles do not).
-// tol_d is the round-off allowance of D.
-void bound_patch(Patch& p, double r, double tol_d) {
-  const double d = p.d.min_coefficient() - tol_d;
-  const double w_min = p.w.min_coefficient(), w_max = p.w.max_abs_coefficient();
+// tol_a is the round-off allowance of A.
+void bound_patch(Patch& p, double r, double tol_a) {
   p.jr_lo = p.sj_lo = -1.0;
-  if (!(w_min > 0.0)) return;  // w > 0 is not proven on the patch: no bound but the trivial one
-  const NormBounds a = norm_bounds(p.nsx, p.nsy), b = norm_bounds(p.ntx, p.nty);
   // (a)
-  if (d >= 0.0) {
-    const double q = r * a.hi2 + b.hi2 / r, ab = std::sqrt(a.hi2 * b.hi2);
-    // d = 0 with q = 0 (a collapsed patch): J_r = 0 is the right bound too.
-    p.jr_lo = q > 0.0 ? std::min(1.0, 2.0 * d * w_min / q) : 0.0;
-    p.sj_lo = ab > 0.0 ? std::min(1.0, d * w_min / ab) : 0.0;
-  } else {
-    const double q = r * a.lo * a.lo + b.lo * b.lo / r, ab = a.lo * b.lo;
-    if (q > 0.0) p.jr_lo = std::max(-1.0, 2.0 * d * w_max / q);
-    if (ab > 0.0) p.sj_lo = std::max(-1.0, d * w_max / ab);
+  if (p.ratio) {
+    double ms = 0.0, mt = 0.0;
+    for (int k = 0; k < p.s2.size(); ++k) ms += p.s2.c[k], mt += p.t2.c[k];
+    const double rho = ms > 0.0 && mt > 0.0 ? std::sqrt(mt / ms) : r;
+    p.jr_lo = ratio_bound(p, r, 1.0 / r, tol_a);
+    // The AM-GM step needs A >= 0 on the patch (for A < 0 it goes the other way).
+    double a_min = p.a.c[0];
+    for (int k = 1; k < p.a.size(); ++k) a_min = std::min(a_min, p.a.c[k]);
+    if (a_min - tol_a >= 0.0) p.sj_lo = ratio_bound(p, rho, 1.0 / rho, tol_a);
   }
   // (b)
+  const NormBounds a = norm_bounds(p.nsx, p.nsy), b = norm_bounds(p.ntx, p.nty);
   const Cone cs = cone(p.nsx, p.nsy, a.hi2), ct = cone(p.ntx, p.nty, b.hi2);
   if (!cs.ok || !ct.ok) return;
   const double sigma = min_sin(ct.lo - cs.hi, ct.hi - cs.lo);
@@ -261,38 +387,62 @@ ElementQualityBound bound_element(const BezierElement& e, const std::vector<Eige
   auto nt = [&](const BernsteinPoly& X) {
     return bernstein_axpy(bernstein_product(bernstein_dt(X), W), -1.0, bernstein_product(X, Wt));
   };
-  const double tol_d = kRoundOff * J.scale;
+  auto sum12 = [](Poly12 x, const Poly12& y) {
+    for (int k = 0; k < x.size(); ++k) x.c[k] += y.c[k];
+    return x;
+  };
+  auto square12 = [&](const BernsteinPoly& x, const BernsteinPoly& y) {
+    const Poly12 x12 = to_poly12(x), y12 = to_poly12(y);
+    return elevate12(sum12(product12(x12, x12), product12(y12, y12)));
+  };
 
   std::vector<Patch> leaves;
   leaves.reserve(64);
-  leaves.push_back(Patch{J.numerator, W, ns(xyw[0]), ns(xyw[1]), nt(xyw[0]), nt(xyw[1])});
-  bound_patch(leaves.back(), r, tol_d);
+  leaves.push_back(Patch{ns(xyw[0]), ns(xyw[1]), nt(xyw[0]), nt(xyw[1]), Poly12{}, Poly12{}, Poly12{}});
+  // A = 2 D w: the round-off allowance of D (header, "Round-off") times 2 max |w|.
+  const double tol_a = 2.0 * kRoundOff * J.scale * W.max_abs_coefficient();
+  // w > 0 on the element (a sum of B-splines covering it) is what makes S = X / w a map;
+  // a zero scale means D == 0. Neither gives a bound but the trivial one.
+  const bool degenerate = !(W.min_coefficient() > 0.0) || !(J.scale > 0.0) || !std::isfinite(J.scale);
+  if (!degenerate) bound_patch(leaves.back(), r, tol_a);
   res.patches = 1;
 
-  // Attained values at the corners of a patch (corner coefficients are values).
+  // Attained values at the corners of a patch (corner coefficients are values;
+  // det(N_s, N_t) = D w).
   auto sample_corners = [&](const Patch& p) {
     for (int cj = 0; cj < 2; ++cj)
       for (int ci = 0; ci < 2; ++ci) {
         auto corner = [&](const BernsteinPoly& f) { return f.at(ci * f.m, cj * f.n); };
-        const Quality q = quality_at(corner(p.d) * corner(p.w), corner(p.nsx), corner(p.nsy), corner(p.ntx),
-                                     corner(p.nty), r);
+        const double sx = corner(p.nsx), sy = corner(p.nsy), tx = corner(p.ntx), ty = corner(p.nty);
+        const Quality q = quality_at(sx * ty - sy * tx, sx, sy, tx, ty, r);
         const Eigen::Vector2d uv(e.lo.x() + hx * (p.s0 + ci * p.size), e.lo.y() + hy * (p.t0 + cj * p.size));
         if (q.jr < res.mean_ratio.attained) res.mean_ratio.attained = q.jr, res.mean_ratio.attained_at = uv;
         if (q.sj < res.scaled.attained) res.scaled.attained = q.sj, res.scaled.attained_at = uv;
       }
   };
   sample_corners(leaves.front());
+  auto open = [&](double lo, double attained) {
+    return attained - lo > opt.relative_gap * std::abs(attained) + opt.absolute_gap;
+  };
+  // The cone bound (b) suffices on many elements of fine maps; otherwise make
+  // A, S2, T2 (8) once, on the element, for the ratio bound (a).
+  if (!degenerate && (open(leaves[0].jr_lo, res.mean_ratio.attained) || open(leaves[0].sj_lo, res.scaled.attained))) {
+    Patch& p = leaves[0];
+    p.a = elevate12(product12(to_poly12(J.numerator), to_poly12(W)));
+    for (int k = 0; k < p.a.size(); ++k) p.a.c[k] *= 2.0;
+    p.s2 = square12(p.nsx, p.nsy);
+    p.t2 = square12(p.ntx, p.nty);
+    p.ratio = true;
+    bound_patch(p, r, tol_a);
+  }
 
-  bool stuck_jr = false, stuck_sj = false;
+  bool stuck_jr = degenerate, stuck_sj = degenerate;
   while (true) {
     std::size_t ijr = 0, isj = 0;
     for (std::size_t k = 1; k < leaves.size(); ++k) {
       if (leaves[k].jr_lo < leaves[ijr].jr_lo) ijr = k;
       if (leaves[k].sj_lo < leaves[isj].sj_lo) isj = k;
     }
-    auto open = [&](double lo, double attained) {
-      return attained - lo > opt.relative_gap * std::abs(attained) + opt.absolute_gap;
-    };
     const bool need_jr = !stuck_jr && open(leaves[ijr].jr_lo, res.mean_ratio.attained);
     const bool need_sj = !stuck_sj && open(leaves[isj].sj_lo, res.scaled.attained);
     if (!need_jr && !need_sj) break;
@@ -309,13 +459,15 @@ ElementQualityBound bound_element(const BezierElement& e, const std::vector<Eige
     }
     // De Casteljau on every polynomial: children SW, SE, NW, NE.
     Patch p = std::move(leaves[pick]);
-    const auto d = bernstein_subdivide(p.d), w = bernstein_subdivide(p.w);
     const auto sx = bernstein_subdivide(p.nsx), sy = bernstein_subdivide(p.nsy);
     const auto tx = bernstein_subdivide(p.ntx), ty = bernstein_subdivide(p.nty);
+    std::array<Poly12, 4> a, s2, t2;
+    if (p.ratio) a = subdivide12(p.a), s2 = subdivide12(p.s2), t2 = subdivide12(p.t2);
     const double h = 0.5 * p.size;
     for (int q = 0; q < 4; ++q) {
-      Patch c{d[q], w[q], sx[q], sy[q], tx[q], ty[q], p.depth + 1, p.s0 + (q & 1) * h, p.t0 + (q >> 1) * h, h};
-      bound_patch(c, r, tol_d);
+      Patch c{sx[q], sy[q], tx[q], ty[q], a[q], s2[q], t2[q], p.ratio,
+              p.depth + 1, p.s0 + (q & 1) * h, p.t0 + (q >> 1) * h, h};
+      bound_patch(c, r, tol_a);
       sample_corners(c);
       res.depth = std::max(res.depth, c.depth);
       if (q == 0)

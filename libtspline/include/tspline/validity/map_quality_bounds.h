@@ -21,57 +21,65 @@
 //   SJ  = D w / (|N_s| |N_t|).                                                 (3)
 //
 // Bounds on a patch of the element (the element or a de Casteljau sub-patch):
-// D, w and the two components of N_s, N_t are written in the tensor-product
-// Bernstein basis. The basis functions are non-negative and sum to one, so a
-// polynomial's values are convex combinations of its coefficients: for the
-// vector polynomial N_s with coefficients c_k, N_s(p) = sum b_k(p) c_k and
-//   |N_s(p)| <= max_k |c_k|                      (triangle inequality),        (4)
-//   |N_s(p)| >= |c| - max_k |c_k - c|            for any c (we take the mean), (5)
-// and d_min <= D <= d_max, w_min <= w <= w_max over the coefficients. Two lower
-// bounds follow; the patch's bound is the larger.
-//  (a) From D, with a_hi = max |c_k(N_s)|, b_hi = max |c_k(N_t)| and a_lo, b_lo
-//      from (5):
-//        if d_min >= 0:  J_r >= 2 d_min w_min / (r a_hi^2 + b_hi^2 / r),
-//                        SJ  >= d_min w_min / (a_hi b_hi);
-//        if d_min < 0:   J_r >= 2 d_min w_max / (r a_lo^2 + b_lo^2 / r),
-//                        SJ  >= d_min w_max / (a_lo b_lo),
-//      clamped below at -1 (|J_r| <= |SJ| <= 1 always, so -1 is also the bound
-//      where a_lo or b_lo is 0). Exact for affine maps (D, N_s, N_t constant).
-//  (b) From cones: if the coefficients of N_s lie in an open half-plane (all
-//      within 90 degrees of their mean direction m), N_s(p) lies in the cone
-//      they span, angle(N_s) in [lo_s, hi_s], and |N_s| >= min_k c_k . m/|m|;  (6)
+// the polynomials below are written in the tensor-product Bernstein basis of
+// the patch. The basis functions are non-negative and sum to one, so a
+// polynomial's values are convex combinations of its coefficients. Two lower
+// bounds follow for each quantity; the patch's bound is the larger.
+//  (a) The ratio bound. A = 2 D w (bidegree (11,11)), S2 = |N_s|^2 (10,12)
+//      and T2 = |N_t|^2 (12,10) are formed by exact Bernstein products and
+//      elevated to (12,12), so that J_r = A / (r S2 + T2 / r) by (2) is a
+//      ratio of two polynomials in the same basis, sum_k b_k A_k / sum_k b_k Q_k.
+//      If every Q_k > 0,
+//        J_r >= min_k A_k / Q_k,   Q_k = r S2_k + T2_k / r                    (8)
+//      (A - c Q = sum_k b_k (A_k - c Q_k) >= 0 for c the minimum). For SJ, by
+//      AM-GM, rho |N_s|^2 + |N_t|^2 / rho >= 2 |N_s| |N_t| for any rho > 0, so
+//      where A >= 0 (every A_k >= 0) SJ >= min_k A_k / (rho S2_k + T2_k / rho);
+//      rho is the ratio of the mean coefficients of T2 and S2 to the power 1/2
+//      (the best rho at a point is |N_t| / |N_s|, and the loss is second order
+//      in its error). Exact where A and Q are constant (affine maps); the
+//      coefficients converge to the values at rate O(h^2) on a sub-patch of size h.
+//  (b) The cone bound. For the vector polynomial N_s with coefficients c_k,
+//      N_s(p) = sum b_k(p) c_k, so
+//        |N_s(p)| <= max_k |c_k|,   |N_s(p)| >= |c| - max_k |c_k - c|          (4), (5)
+//      (c: the mean), and if the c_k lie in an open half-plane (all within 90
+//      degrees of their mean direction m), N_s(p) lies in the cone they span,
+//      angle(N_s) in [lo_s, hi_s], and |N_s| >= min_k c_k . m / |m|;          (6)
 //      the same for N_t. With phi the angle from N_s to N_t and
 //      tau = |N_t| / (r |N_s|),
 //        SJ = sin phi,   J_r = g(tau) sin phi,   g(tau) = 2 tau / (1 + tau^2),  (7)
 //      so SJ >= sigma = min of sin over [lo_t - hi_s, hi_t - lo_s], and, g
 //      being unimodal (max 1 at tau = 1), J_r >= sigma min(g(tau_lo), g(tau_hi))
-//      over tau in [b_lo / (r a_hi), b_hi / (r a_lo)] if sigma >= 0 (J_r >=
-//      sigma otherwise). Sharp where the speed varies along straight parameter
-//      lines (a graded map: D varies, the angles do not), where (a) is loose.
-// The bound of the element is the smallest over its final sub-patches.
+//      over tau in [b_lo / (r a_hi), b_hi / (r a_lo)] (a: bounds of |N_s|, b:
+//      of |N_t|) if sigma >= 0 (J_r >= sigma otherwise). Sharp from the start
+//      where the parameter lines are straight and only the speed varies (SJ = 1
+//      of a graded map), where (a) converges only with subdivision.
+// Both are clamped below at -1 (|J_r| <= |SJ| <= 1), which is also the bound
+// where neither applies (a fold: A_k < 0 and the cones not separated). The
+// bound of the element is the smallest over its final sub-patches.
 //
 // Subdivision (branch and bound): the corner coefficients of a patch are the
 // values of the polynomials at its corners, so (2) and (3) at the corners are
 // attained values, upper bounds U of the element's true minimum. The patch with
-// the smallest lower bound L is split at s = t = 1/2 (de Casteljau on D, w and
-// the four components of N_s, N_t), until U - L <= relative_gap |U| +
+// the smallest lower bound L is split at s = t = 1/2 (de Casteljau on A, S2,
+// T2 and the four components of N_s, N_t), until U - L <= relative_gap |U| +
 // absolute_gap for both J_r and SJ, or the patch to split is at max_depth
 // (each level halves both directions), or the element has max_patches patches.
-// The coefficients of a sub-patch of size h converge to the values at rate
-// O(h), so the gap halves per level near a regular minimum: about 4-6 levels
-// for 2 % on the elements of real maps (the tests measure it).
+// The ratio bound converges at rate O(h^2), so the gap falls by about 4 per
+// level near a regular minimum: on the pipeline maps of the test polygons at
+// most 2-4 levels for 2 %, most elements none (the tests measure it).
 //
 // Round-off: the arithmetic is ordinary floating point, not interval
-// arithmetic (as in map_certification.h). D is bounded below by its smallest
-// coefficient minus round_off (1e-12) times ElementJacobian::scale (a bound of
+// arithmetic (as in map_certification.h). The coefficients of A are lowered by
+// round_off (1e-12) times 2 ElementJacobian::scale max|w| (scale: a bound of
 // |D| from the magnitudes of its factors; the accumulated round-off of the
-// extraction, the products and the subdivisions is some 1e-15 to 1e-14 of it),
-// and the squared norms above by (1 + round_off) times their computed values;
-// the cones (6) are widened by 1e-9 rad and used only if no coefficient is
-// below 1e-6 of the largest (so that their angles' round-off is below that).
-// So the bounds are rigorous unless the round-off exceeds ~100 times its
-// usual size. For an affine map every coefficient of N_s (N_t) is the same
-// vector and D is constant: the bounds equal the exact J_r and SJ up to ~1e-12.
+// extraction, the products, the elevation and the subdivisions is some 1e-15
+// to 1e-14 of it) and the denominators raised (or lowered, for a negative
+// numerator) by the factor 1 + round_off; the norm bounds (4), (5) are
+// widened by the same factor; the cones (6) are used only if no coefficient is
+// below 1e-6 of the largest, and widened by the angle error of a coefficient
+// off by 1e3 eps of the largest (1e3 eps max|c| / |c_k| rad). So the bounds are rigorous unless the round-off
+// exceeds ~100 times its usual size. For an affine map A, S2, T2 are
+// constant: the bounds equal the exact J_r and SJ up to ~1e-12.
 //
 // The dense sample (samples_per_edge = k > 0): J_r and SJ at (k + 1)^2 points
 // of a uniform grid including the element's corners and edges, evaluated from
