@@ -74,7 +74,7 @@ TEST_SUITE("holes_app") {
       CHECK(t["sampled_min"].get<double>() == sampled);
       CHECK(t["certified_lower_bound"].get<double>() > 0.0);
       CHECK(t["certified_lower_bound"].get<double>() <= sampled);
-      CHECK(t["patch"].get<std::size_t>() < patches);
+      CHECK(t["certified_lower_bound_patch"].get<std::size_t>() < patches);
     }
     CHECK(contains(r.out, "whole map: J_r >= "));
     // The surface covers every patch: cell data `patch` in 0..3.

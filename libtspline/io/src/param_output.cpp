@@ -216,13 +216,12 @@ nlohmann::json combine_whole_map_quality_json(const std::vector<nlohmann::json>&
       const json& f = whole_maps[p].at(name);
       if (best.is_null()) {
         best = f;
-        best["patch"] = p;  // of the certified lower bound
-        best["attained_min_patch"] = best["sampled_min_patch"] = p;
+        best["certified_lower_bound_patch"] = best["attained_min_patch"] = best["sampled_min_patch"] = p;
         continue;
       }
       if (f["certified_lower_bound"].get<double>() < best["certified_lower_bound"].get<double>()) {
         best["certified_lower_bound"] = f["certified_lower_bound"];
-        best["patch"] = p;
+        best["certified_lower_bound_patch"] = p;
       }
       if (f["attained_min"].get<double>() < best["attained_min"].get<double>())
         best["attained_min"] = f["attained_min"], best["attained_min_at"] = f["attained_min_at"],

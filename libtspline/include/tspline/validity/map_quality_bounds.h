@@ -31,7 +31,8 @@
 //      ratio of two polynomials in the same basis, sum_k b_k A_k / sum_k b_k Q_k.
 //      If every Q_k > 0,
 //        J_r >= min_k A_k / Q_k,   Q_k = r S2_k + T2_k / r                    (8)
-//      (A - c Q = sum_k b_k (A_k - c Q_k) >= 0 for c the minimum). For SJ, by
+//      (A - c Q = sum_k b_k (A_k - c Q_k) >= 0 for c the minimum, whatever the
+//      signs of the A_k: (8) also bounds a folded patch). For SJ, by
 //      AM-GM, rho |N_s|^2 + |N_t|^2 / rho >= 2 |N_s| |N_t| for any rho > 0, so
 //      where A >= 0 (every A_k >= 0) SJ >= min_k A_k / (rho S2_k + T2_k / rho);
 //      rho is the ratio of the mean coefficients of T2 and S2 to the power 1/2
@@ -65,8 +66,10 @@
 // absolute_gap for both J_r and SJ, or the patch to split is at max_depth
 // (each level halves both directions), or the element has max_patches patches.
 // The ratio bound converges at rate O(h^2), so the gap falls by about 4 per
-// level near a regular minimum: on the pipeline maps of the test polygons at
-// most 2-4 levels for 2 %, most elements none (the tests measure it).
+// level near a regular minimum: on the pipeline maps of the test polygons and
+// coastlines at most 2-6 levels for 2 %, most elements none (the tests measure
+// it). The (12,12) forms of (a) are made only for an element where (b) on the
+// whole element does not already reach the gap (most elements of fine maps).
 //
 // Round-off: the arithmetic is ordinary floating point, not interval
 // arithmetic (as in map_certification.h). The coefficients of A are lowered by
@@ -77,8 +80,8 @@
 // numerator) by the factor 1 + round_off; the norm bounds (4), (5) are
 // widened by the same factor; the cones (6) are used only if no coefficient is
 // below 1e-6 of the largest, and widened by the angle error of a coefficient
-// off by 1e3 eps of the largest (1e3 eps max|c| / |c_k| rad). So the bounds are rigorous unless the round-off
-// exceeds ~100 times its usual size. For an affine map A, S2, T2 are
+// off by 1e3 eps of the largest (1e3 eps max|c| / |c_k| rad). So the bounds
+// are rigorous unless the round-off exceeds ~100 times its usual size. For an affine map A, S2, T2 are
 // constant: the bounds equal the exact J_r and SJ up to ~1e-12.
 //
 // The dense sample (samples_per_edge = k > 0): J_r and SJ at (k + 1)^2 points
@@ -117,7 +120,7 @@ struct QualityBound {
   /// value of the map: the minimum lies in [lower_bound, attained]).
   double attained = 1.0;
   Eigen::Vector2d attained_at = Eigen::Vector2d::Zero();  ///< parametric point of `attained`
-  /// Dense sample (if samples_per_edge > 0): the smallest sampled value and where.
+  /// Dense sample (if samples_per_edge > 0; 1 otherwise): the smallest sampled value and where.
   double sampled = 1.0;
   Eigen::Vector2d sampled_at = Eigen::Vector2d::Zero();
   /// Over a map: the elements (extraction order; over several maps counted
