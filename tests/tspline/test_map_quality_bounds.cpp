@@ -308,11 +308,11 @@ TEST_SUITE("map_quality_bounds") {
 }
 
 // Timing, not run by default (./unit_tests -ts=map_quality_bounds_timing --no-skip):
-// a smooth warp of the unit square on a 128 x 128 mesh (16,384 elements).
+// a smooth warp of the unit square on a 256 x 256 mesh (65,536 elements).
 TEST_SUITE("map_quality_bounds_timing" * doctest::skip()) {
   TEST_CASE("seconds per 10^4 elements") {
     const double pi = 3.14159265358979323846;
-    const TSplineMap map = greville_map(7, [&](const Eigen::Vector2d& p) -> Eigen::Vector2d {
+    const TSplineMap map = greville_map(8, [&](const Eigen::Vector2d& p) -> Eigen::Vector2d {
       const double u = p.x(), v = p.y();
       return {u + 0.12 * std::sin(2 * pi * v) * u * (1 - u) + 0.3 * u * u, v + 0.1 * std::sin(3 * pi * u) * v * (1 - v)};
     });
