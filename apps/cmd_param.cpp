@@ -89,15 +89,15 @@ int run_param(const std::string& input, const std::string& out_dir, const std::s
                   {"certified_valid", result.certified_valid()},
                   {"min_mean_ratio_jacobian", result.quality.min_mean_ratio},
                   {"whole_map",
-                   {{"mean_ratio", report["jacobian"]["whole_map"]["mean_ratio"]},
-                    {"scaled_jacobian", report["jacobian"]["whole_map"]["scaled_jacobian"]}}},
+                   {{"mean_ratio", report["jacobian"]["whole_map"].value("mean_ratio", nlohmann::json())},
+                    {"scaled_jacobian", report["jacobian"]["whole_map"].value("scaled_jacobian", nlohmann::json())}}},
                   {"cells", result.map ? result.map->mesh().num_cells() : 0},
                   {"stop_reason", result.stop_reason},
                   {"out", out_dir},
                   {"files", files}});
   if (!quiet) {
-    std::cout << tspline::io::whole_map_quality_summary(report["jacobian"]["whole_map"]) << "; at the Gauss points min J_r "
-              << result.quality.min_mean_ratio << std::endl;
+    std::cout << tspline::io::whole_map_quality_summary(report["jacobian"]["whole_map"])
+              << "; at the Gauss points min J_r " << result.quality.min_mean_ratio << std::endl;
     std::cout << "wrote " << file_list << " to " << out_dir << std::endl;
   }
   if (!result.valid()) {

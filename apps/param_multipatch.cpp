@@ -49,7 +49,8 @@ int run_multipatch_param(const tspline::io::DomainInput& input_domain, const std
     s << R.patches.size() << " patches, " << R.layout.cuts.size() << " cuts, " << totals["cells"] << " cells, "
       << totals["bezier_elements"] << " elements; certified " << (R.certified_valid() ? "valid" : "NOT valid")
       << " (det J >= " << R.min_relative_det_bound() << " x element mean); "
-      << tspline::io::whole_map_quality_summary(totals["whole_map"]) << "; area " << R.map_area << " vs " << R.domain_area << "; largest interface gap " << R.max_gap()
+      << tspline::io::whole_map_quality_summary(totals["whole_map"]) << "; area " << R.map_area << " vs "
+      << R.domain_area << "; largest interface gap " << R.max_gap()
       << " (" << R.max_gap() / R.diameter << " x diameter); " << seconds << " s";
     std::cout << s.str() << "\nwrote tspline.json (format version 2), surface.vtu, control_net.vtu, "
                             "parametric_tmesh.vtu, physical_tmesh.vtu, boundary.vtu, report.json to "

@@ -29,8 +29,8 @@ void append(Map& into, const Map& part) {
 // The patches' whole-map quality figures combined (combine_whole_map_quality_json).
 json whole_map_of(const json& patch_reports) {
   std::vector<json> w;
-  for (const json& p : patch_reports)
-    if (p.contains("jacobian") && p["jacobian"].contains("whole_map")) w.push_back(p["jacobian"]["whole_map"]);
+  for (const json& p : patch_reports)  // one entry per patch (null without figures), so that indices are patches
+    w.push_back(p.contains("jacobian") && p["jacobian"].contains("whole_map") ? p["jacobian"]["whole_map"] : json());
   return combine_whole_map_quality_json(w);
 }
 

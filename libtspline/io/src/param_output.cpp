@@ -197,6 +197,8 @@ std::string whole_map_quality_summary(const nlohmann::json& w) {
     std::snprintf(buf, sizeof buf, "%.4g", v.get<double>());
     return std::string(buf);
   };
+  if (!w.is_object() || !w.contains("mean_ratio") || !w["mean_ratio"].is_object() || !w.contains("scaled_jacobian"))
+    return "whole map: no quality figures (no map)";
   const nlohmann::json &jr = w.at("mean_ratio"), &sj = w.at("scaled_jacobian");
   const std::size_t k = jr.at("samples_per_element").get<std::size_t>();
   const std::string sample =
@@ -213,6 +215,7 @@ nlohmann::json combine_whole_map_quality_json(const std::vector<nlohmann::json>&
   for (const char* name : {"mean_ratio", "scaled_jacobian"}) {
     json best;
     for (std::size_t p = 0; p < whole_maps.size(); ++p) {
+      if (!whole_maps[p].is_object() || !whole_maps[p].contains(name)) continue;  // a patch without figures
       const json& f = whole_maps[p].at(name);
       if (best.is_null()) {
         best = f;

@@ -60,7 +60,7 @@ nlohmann::json whole_map_quality_json(const MapQualityBounds& bounds, const Qual
 std::string whole_map_quality_summary(const nlohmann::json& whole_map);
 
 /// The same figures over several patches from their reports' jacobian.whole_map
-/// objects: the minimum of each figure with the index of its patch
+/// objects (one per patch; those without the figures are skipped): the minimum of each figure with the index of its patch
 /// ("certified_lower_bound_patch", "attained_min_patch", "sampled_min_patch").
 nlohmann::json combine_whole_map_quality_json(const std::vector<nlohmann::json>& whole_maps);
 
