@@ -11,10 +11,12 @@
 #include "commands.h"
 #include "tspline/errors.h"
 #include "tspline/io/multipatch_file.h"
+#include "tspline/io/param_output.h"
 #include "tspline/io/tspline_file.h"
 #include "tspline/multipatch/multipatch_parameterization.h"
 #include "tspline/validity/map_certification.h"
 #include "tspline/validity/map_quality.h"
+#include "tspline/validity/map_quality_bounds.h"
 
 namespace tspline_app {
 
@@ -48,7 +50,17 @@ bool check_map(const tspline::io::LoadedTSpline& t, const CheckArgs& args) {
   std::printf("certified lower bound of det J: %.6g\n", c.min_det_lower_bound);
   const tspline::DenseMapQuality dq = tspline::dense_map_quality(t.map);
   const tspline::MapQualityStats gq = tspline::map_quality(t.map, 4);
-  std::printf("J_r min over the whole map: %.6g (the smaller of the two samples below)\n",
+  const tspline::QualityBoundOptions qo = tspline::io::report_quality_bound_options();
+  const tspline::MapQualityBounds qb = tspline::certified_map_quality(t.map, qo);
+  std::printf("J_r >= %.6g on the whole map (certified lower bound; J_r %.6g attained at (u, v) = (%.6g, %.6g))\n",
+              qb.mean_ratio.lower_bound, qb.mean_ratio.attained, qb.mean_ratio.attained_at.x(),
+              qb.mean_ratio.attained_at.y());
+  std::printf("scaled Jacobian >= %.6g on the whole map (certified lower bound; min %.6g in a dense sample of %d x %d "
+              "points per element)\n",
+              qb.scaled.lower_bound, qb.scaled.sampled, qo.samples_per_edge + 1, qo.samples_per_edge + 1);
+  std::printf("J_r min over a dense sample of %d x %d points per element: %.6g\n", qo.samples_per_edge + 1,
+              qo.samples_per_edge + 1, qb.mean_ratio.sampled);
+  std::printf("J_r min over the samples below: %.6g (the smaller of the two)\n",
               std::min(dq.min_mean_ratio, gq.min_mean_ratio));
   std::printf("J_r min over a dense sample: %.6g (%d x %d points per element, corners included; at (u, v) = (%.6g, "
               "%.6g))\n",

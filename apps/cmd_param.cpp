@@ -139,11 +139,18 @@ int run_param(const std::string& input, const std::string& out_dir, const std::s
                   {"good", result.good()},
                   {"certified_valid", result.certified_valid()},
                   {"min_mean_ratio_jacobian", result.quality.min_mean_ratio},
+                  {"whole_map",
+                   {{"mean_ratio", report["jacobian"]["whole_map"].value("mean_ratio", nlohmann::json())},
+                    {"scaled_jacobian", report["jacobian"]["whole_map"].value("scaled_jacobian", nlohmann::json())}}},
                   {"cells", result.map ? result.map->mesh().num_cells() : 0},
                   {"stop_reason", result.stop_reason},
                   {"out", out_dir},
                   {"files", files}});
-  if (!quiet) std::cout << "wrote " << file_list << " to " << out_dir << std::endl;
+  if (!quiet) {
+    std::cout << tspline::io::whole_map_quality_summary(report["jacobian"]["whole_map"])
+              << "; at the Gauss points min J_r " << result.quality.min_mean_ratio << std::endl;
+    std::cout << "wrote " << file_list << " to " << out_dir << std::endl;
+  }
   if (!result.valid()) {
     std::cerr << "tspline: error: the map is not valid: det J <= 0 at " << result.quality.nonpositive_det << " of "
               << result.quality.points << " quadrature points; adaptive refinement stopped: " << result.stop_reason

@@ -5,6 +5,7 @@
 
 #include "tspline/errors.h"
 #include "tspline/io/multipatch_output.h"
+#include "tspline/io/param_output.h"
 
 namespace tspline_app {
 
@@ -43,6 +44,7 @@ int write_multipatch_param(const tspline::DomainParameterization& P, const tspli
                   {"patches", R.patches.size()},
                   {"cells", totals["cells"]},
                   {"min_mean_ratio_jacobian", R.min_mean_ratio_gauss()},
+                  {"whole_map", totals["whole_map"]},
                   {"max_interface_gap", R.max_gap()},
                   {"out", out_dir}});
   if (progress.human()) {
@@ -50,10 +52,10 @@ int write_multipatch_param(const tspline::DomainParameterization& P, const tspli
     s << "layout " << P.layout << " (" << P.reason << "): " << R.patches.size() << " patches, "
       << R.layout.cuts.size() << " cuts, " << totals["cells"] << " cells, " << totals["bezier_elements"]
       << " elements; certified " << (R.certified_valid() ? "valid" : "NOT valid") << " (det J >= "
-      << R.min_relative_det_bound() << " x element mean), min J_r " << R.min_mean_ratio_dense()
-      << " and scaled Jacobian " << R.min_scaled_jacobian_dense() << " (whole map, dense sample); area "
-      << R.map_area << " vs " << R.domain_area << "; largest interface gap " << R.max_gap() << " ("
-      << R.max_gap() / R.diameter << " x diameter); " << seconds << " s";
+      << R.min_relative_det_bound() << " x element mean); "
+      << tspline::io::whole_map_quality_summary(totals["whole_map"]) << "; area " << R.map_area << " vs "
+      << R.domain_area << "; largest interface gap " << R.max_gap() << " (" << R.max_gap() / R.diameter
+      << " x diameter); " << seconds << " s";
     std::cout << s.str() << "\nwrote tspline.json (format version 2), surface.vtu, control_net.vtu, "
                             "parametric_tmesh.vtu, physical_tmesh.vtu, boundary.vtu, report.json to "
               << out_dir << std::endl;

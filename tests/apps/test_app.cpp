@@ -68,6 +68,20 @@ TEST_SUITE("app") {
     // The square maps onto itself: every triangle keeps its ideal shape.
     CHECK(rep["optimized"]["min_mean_ratio"].get<double>() == doctest::Approx(1.0).epsilon(1e-9));
     CHECK(rep["counts"]["cells"] == 64);  // default initial level 3, no boundary refinement needed
+    // Whole-map figures, each labelled: the certified bounds and the 26 x 26
+    // sample (the map is the identity up to round-off: all 1); the adaptive
+    // loop's sample stays under its old key.
+    const auto& wm = rep["jacobian"]["whole_map"];
+    for (const char* q : {"mean_ratio", "scaled_jacobian"}) {
+      CAPTURE(q);
+      CHECK(wm[q]["certified_lower_bound"].get<double>() == doctest::Approx(1.0).epsilon(1e-9));
+      CHECK(wm[q]["certified_lower_bound"].get<double>() <= wm[q]["sampled_min"].get<double>());
+      CHECK(wm[q]["samples_per_element"] == 26 * 26);
+    }
+    CHECK(wm["min_mean_ratio"].get<double>() == doctest::Approx(1.0).epsilon(1e-9));
+    CHECK(wm["points_per_element"] == 81);
+    CHECK(r.out.find("whole map: J_r >= 1 certified (min 1 in a dense sample of 676 points per element), scaled "
+                     "Jacobian >= 1 certified (sampled min 1)") != std::string::npos);
     for (const char* stage : {"boundary", "tmesh", "coons", "optimization", "total"})
       CHECK(rep["seconds"].contains(stage));
     // Progress lines for each stage.

@@ -68,6 +68,8 @@ TEST_SUITE("examples") {
     CHECK(value_after(r.out, "min_jr_gauss") >= 0.2);
     CHECK(value_after(r.out, "min_jr_whole_map") > 0.0);
     CHECK(value_after(r.out, "min_jr_whole_map") <= value_after(r.out, "min_jr_gauss"));
+    CHECK(value_after(r.out, "min_jr_certified") > 0.0);
+    CHECK(value_after(r.out, "min_jr_certified") <= value_after(r.out, "min_jr_whole_map"));
     CHECK(value_after(r.out, "min_jr_gauss") <= value_after(r.out, "mean_jr"));
     CHECK(value_after(r.out, "cells") > 100);
     CHECK(value_after(r.out, "functions") > value_after(r.out, "cells"));

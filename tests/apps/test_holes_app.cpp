@@ -63,6 +63,22 @@ TEST_SUITE("holes_app") {
     CHECK(rep["totals"]["area_relative_error"].get<double>() < 1e-3);
     CHECK(rep["totals"]["max_interface_gap_relative"].get<double>() <= 1e-12);
     CHECK(rep["patches"].size() == patches);
+    // Whole-map quality over all patches: the smallest certified bound and sample of the patches.
+    for (const char* q : {"mean_ratio", "scaled_jacobian"}) {
+      CAPTURE(q);
+      const auto& t = rep["totals"]["whole_map"][q];
+      double lowest = 2.0, sampled = 2.0;
+      for (const auto& p : rep["patches"]) {
+        lowest = std::min(lowest, p["jacobian"]["whole_map"][q]["certified_lower_bound"].get<double>());
+        sampled = std::min(sampled, p["jacobian"]["whole_map"][q]["sampled_min"].get<double>());
+      }
+      CHECK(t["certified_lower_bound"].get<double>() == lowest);
+      CHECK(t["sampled_min"].get<double>() == sampled);
+      CHECK(t["certified_lower_bound"].get<double>() > 0.0);
+      CHECK(t["certified_lower_bound"].get<double>() <= sampled);
+      CHECK(t["certified_lower_bound_patch"].get<std::size_t>() < patches);
+    }
+    CHECK(contains(r.out, "whole map: J_r >= "));
     // The surface covers every patch: cell data `patch` in 0..3.
     const std::string vtu = test_support::slurp(out / "surface.vtu");
     CHECK(contains(vtu, "Name=\"patch\""));

@@ -19,6 +19,7 @@
 #include "tspline/spline/bezier_extraction.h"
 #include "tspline/validity/map_certification.h"
 #include "tspline/validity/map_quality.h"
+#include "tspline/validity/map_quality_bounds.h"
 #include "tspline/io/output_files.h"
 
 namespace tspline::io {
@@ -245,6 +246,87 @@ nlohmann::json options_json(const ParameterizationOptions& o, const AdaptiveOpti
 
 }  // namespace
 
+QualityBoundOptions report_quality_bound_options() {
+  QualityBoundOptions o;
+  o.samples_per_edge = 25;  // 26 x 26 points per element, as in issue 21
+  return o;
+}
+
+nlohmann::json whole_map_quality_json(const MapQualityBounds& q, const QualityBoundOptions& o) {
+  using nlohmann::json;
+  const bool sampled = q.samples_per_element > 0 && q.elements > 0;
+  auto figure = [&](const QualityBound& b) {
+    json f = {{"certified_lower_bound", b.lower_bound},
+              {"attained_min", b.attained},
+              {"attained_min_at", {b.attained_at.x(), b.attained_at.y()}},
+              {"sampled_min", sampled ? json(b.sampled) : json(nullptr)},
+              {"samples_per_element", q.samples_per_element}};
+    if (sampled) f["sampled_min_at"] = {b.sampled_at.x(), b.sampled_at.y()};
+    return f;
+  };
+  return {{"mean_ratio", figure(q.mean_ratio)},
+          {"scaled_jacobian", figure(q.scaled)},
+          {"certified_bounds",
+           {{"method", "Bernstein bounds of det J, |S_xi|, |S_eta| with subdivision (map_quality_bounds.h)"},
+            {"elements", q.elements},
+            {"relative_gap_target", o.relative_gap},
+            {"absolute_gap_target", o.absolute_gap},
+            {"depth_limit", o.max_depth},
+            {"max_subdivision_depth", q.max_depth_used},
+            {"sub_patches", q.patches},
+            {"elements_stopped_at_a_limit", q.elements_not_converged},
+            {"seconds", q.seconds}}}};
+}
+
+std::string whole_map_quality_summary(const nlohmann::json& w) {
+  auto num = [](const nlohmann::json& v) {
+    if (v.is_null()) return std::string("none");
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%.4g", v.get<double>());
+    return std::string(buf);
+  };
+  if (!w.is_object() || !w.contains("mean_ratio") || !w["mean_ratio"].is_object() || !w.contains("scaled_jacobian"))
+    return "whole map: no quality figures (no map)";
+  const nlohmann::json &jr = w.at("mean_ratio"), &sj = w.at("scaled_jacobian");
+  const std::size_t k = jr.at("samples_per_element").get<std::size_t>();
+  const std::string sample =
+      k > 0 ? "min " + num(jr.at("sampled_min")) + " in a dense sample of " + std::to_string(k) + " points per element"
+            : "no dense sample";
+  return "whole map: J_r >= " + num(jr.at("certified_lower_bound")) + " certified (" + sample +
+         "), scaled Jacobian >= " + num(sj.at("certified_lower_bound")) + " certified (" +
+         (k > 0 ? "sampled min " + num(sj.at("sampled_min")) : std::string("no dense sample")) + ")";
+}
+
+nlohmann::json combine_whole_map_quality_json(const std::vector<nlohmann::json>& whole_maps) {
+  using nlohmann::json;
+  json out;
+  for (const char* name : {"mean_ratio", "scaled_jacobian"}) {
+    json best;
+    for (std::size_t p = 0; p < whole_maps.size(); ++p) {
+      if (!whole_maps[p].is_object() || !whole_maps[p].contains(name)) continue;  // a patch without figures
+      const json& f = whole_maps[p].at(name);
+      if (best.is_null()) {
+        best = f;
+        best["certified_lower_bound_patch"] = best["attained_min_patch"] = best["sampled_min_patch"] = p;
+        continue;
+      }
+      if (f["certified_lower_bound"].get<double>() < best["certified_lower_bound"].get<double>()) {
+        best["certified_lower_bound"] = f["certified_lower_bound"];
+        best["certified_lower_bound_patch"] = p;
+      }
+      if (f["attained_min"].get<double>() < best["attained_min"].get<double>())
+        best["attained_min"] = f["attained_min"], best["attained_min_at"] = f["attained_min_at"],
+        best["attained_min_patch"] = p;
+      if (!f["sampled_min"].is_null() &&
+          (best["sampled_min"].is_null() || f["sampled_min"].get<double>() < best["sampled_min"].get<double>()))
+        best["sampled_min"] = f["sampled_min"], best["sampled_min_at"] = f["sampled_min_at"],
+        best["sampled_min_patch"] = p;
+    }
+    out[name] = best;
+  }
+  return out;
+}
+
 nlohmann::json param_report(const ParameterizationResult& r, const std::string& input_path) {
   using nlohmann::json;
   const AdaptiveOptions& ad = r.adaptive;
@@ -263,7 +345,12 @@ nlohmann::json param_report(const ParameterizationResult& r, const std::string& 
   rep["jacobian"] = map_quality_json(r.quality);
   rep["jacobian"]["gauss_points_per_direction"] = ad.gauss;
   rep["jacobian"]["threshold"] = ad.min_jacobian;
-  rep["jacobian"]["note"] = "min/mean at the Gauss points; whole_map: the smaller minimum of a dense sample of every Bezier element and the Gauss points";
+  rep["jacobian"]["note"] =
+      "min/mean at the Gauss points; whole_map.mean_ratio and whole_map.scaled_jacobian: certified_lower_bound holds "
+      "everywhere on the map (Bernstein bounds), sampled_min is the minimum of a dense sample (samples_per_element "
+      "points per Bezier element), a value of the map, so the true minimum lies between them; whole_map.min_mean_ratio, "
+      "min_scaled, points, points_per_element and worst_at: the adaptive loop's sample (points_per_element points per "
+      "element and the Gauss points), kept for older readers";
   rep["jacobian"]["whole_map"] = {{"min_mean_ratio", r.dense_quality.min_mean_ratio},
                                   {"min_scaled", r.dense_quality.min_scaled},
                                   {"nonpositive_det_points", r.dense_quality.nonpositive_det},
@@ -271,6 +358,10 @@ nlohmann::json param_report(const ParameterizationResult& r, const std::string& 
                                   {"points_per_element", (r.dense_quality.samples_per_edge + 1) *
                                                              (r.dense_quality.samples_per_edge + 1)},
                                   {"worst_at", {r.dense_quality.worst_at.x(), r.dense_quality.worst_at.y()}}};
+  if (r.map) {
+    const QualityBoundOptions qo = report_quality_bound_options();
+    rep["jacobian"]["whole_map"].update(whole_map_quality_json(certified_map_quality(*r.map, qo), qo));
+  }
   rep["boundary_curve_proven_simple"] = r.boundary_simple;
   if (!r.boundary_problem.empty()) rep["boundary_problem"] = r.boundary_problem;
   rep["tspline"]["control_points_optimized"] = r.control_points_optimized;

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "tspline/pipeline/adaptive_parameterization.h"
+#include "tspline/validity/map_quality_bounds.h"
 #include "toolkit/io/vtu_writer.h"
 
 namespace tspline::io {
@@ -66,10 +67,35 @@ class AdaptSeriesWriter {
   std::vector<toolkit::io::PvdEntry> entries_;
 };
 
+/// The options of the whole-map quality figures of report.json: a 26 x 26
+/// sample per element next to the certified bounds, refined to a 2 % gap.
+QualityBoundOptions report_quality_bound_options();
+
+/// The whole-map quality figures (map_quality_bounds.h) as report.json writes
+/// them under jacobian.whole_map: for "mean_ratio" (J_r) and "scaled_jacobian"
+/// the "certified_lower_bound" (holds everywhere on the map), "sampled_min" of
+/// the dense sample with "samples_per_element" and "sampled_min_at", and the
+/// smallest value met by the subdivision, "attained_min" and "attained_min_at"
+/// (the minimum lies between the bound and it); "certified_bounds": how the
+/// bounds were computed (gap targets, depths, elements that stopped at a
+/// limit, seconds). Parametric locations are of the patch holding them.
+nlohmann::json whole_map_quality_json(const MapQualityBounds& bounds, const QualityBoundOptions& options);
+
+/// One line for the command line from a whole_map_quality_json object, e.g.
+/// "whole map: J_r >= 0.0354 certified (min 0.0357 in a 26 x 26 sample per
+/// element), scaled Jacobian >= 0.0357 certified (sample 0.0357)".
+std::string whole_map_quality_summary(const nlohmann::json& whole_map);
+
+/// The same figures over several patches from their reports' jacobian.whole_map
+/// objects (one per patch; those without the figures are skipped): the minimum of each figure with the index of its patch
+/// ("certified_lower_bound_patch", "attained_min_patch", "sampled_min_patch").
+nlohmann::json combine_whole_map_quality_json(const std::vector<nlohmann::json>& whole_maps);
+
 /// Full report: the front-half report plus the T-spline (functions, control
 /// points, interpolation residual), J_r min/mean, quadrature points with
-/// det J <= 0, the adaptive iterations and the per-stage times (the options
-/// are those stored in the result).
+/// det J <= 0, the whole-map figures (certified bounds and a dense sample,
+/// whole_map_quality_json), the adaptive iterations and the per-stage times
+/// (the options are those stored in the result).
 nlohmann::json param_report(const ParameterizationResult& result, const std::string& input_path);
 
 /// Writes parametric_tmesh.vtu, physical_tmesh.vtu (physical_tmesh_vtu with
