@@ -56,7 +56,7 @@ const char* kSquare = "0 0\n1 0\n1 1\n0 1\n";
 TEST_SUITE("app") {
   TEST_CASE("param on the unit square writes every output and a consistent report") {
     const fs::path d = scratch("square");
-    const RunResult r = run("param '" + polygons("square.txt") + "' --out '" + (d / "out").string() + "'", d);
+    const RunResult r = run("param --layout single '" + polygons("square.txt") + "' --out '" + (d / "out").string() + "'", d);
     CAPTURE(r.err);
     REQUIRE(r.exit_code == 0);
     for (const char* f : {"parametric_tmesh.vtu", "physical_tmesh.vtu", "boundary.vtu", "report.json"})
@@ -95,7 +95,7 @@ TEST_SUITE("app") {
     // The gear's interpolating map folds at reflex tooth roots; without the
     // control point repair and without adaptive rounds it stays invalid.
     const fs::path d = scratch("invalid_map");
-    const RunResult r = run("param '" + polygons("gear.txt") + "' --no-control-point-optimization --max-adapt 0 --out '" +
+    const RunResult r = run("param --layout single '" + polygons("gear.txt") + "' --no-control-point-optimization --max-adapt 0 --out '" +
                                 (d / "out").string() + "'",
                             d);
     CHECK(r.exit_code == 3);
@@ -122,7 +122,7 @@ TEST_SUITE("app") {
   TEST_CASE("given corners are used and reported in file numbering") {
     const fs::path d = scratch("corners");
     const RunResult r =
-        run("param '" + polygons("lshape_cw.txt") + "' --corners 7,15,31,39 --out '" + (d / "out").string() + "'", d);
+        run("param --layout single '" + polygons("lshape_cw.txt") + "' --corners 7,15,31,39 --out '" + (d / "out").string() + "'", d);
     CAPTURE(r.err);
     REQUIRE(r.exit_code == 0);
     const auto rep = nlohmann::json::parse(slurp(d / "out" / "report.json"));
@@ -139,7 +139,7 @@ TEST_SUITE("app") {
     // 5 -> 6 -> 7 that doubles back along the top edge: vertices 2 and 6 go.
     const fs::path in = write_file(d, "spiky.txt",
                                    "0 0\n0 4\n0 4\n2 4\n3 4\n3.5 4\n4.5 4\n4 4\n4 0\n");
-    const RunResult r = run("param '" + in.string() + "' --corners 0,1,7,8 --out '" + (d / "out").string() + "'", d);
+    const RunResult r = run("param --layout single '" + in.string() + "' --corners 0,1,7,8 --out '" + (d / "out").string() + "'", d);
     CAPTURE(r.err);
     REQUIRE(r.exit_code == 0);
     // One note for the ring, naming each removed vertex.
@@ -158,7 +158,7 @@ TEST_SUITE("app") {
     const fs::path d = scratch("bad");
     const std::string out = " --out '" + (d / "out").string() + "'";
     auto param = [&](const fs::path& in, const std::string& extra = "") {
-      return "param '" + in.string() + "'" + out + extra;
+      return "param --layout single '" + in.string() + "'" + out + extra;
     };
     SUBCASE("empty file") { expect_clean_failure(param(write_file(d, "e.txt", "")), d, "empty", 1); }
     SUBCASE("only comments") {
@@ -205,14 +205,14 @@ TEST_SUITE("app") {
     SUBCASE("unwritable output path") {
       const fs::path blocker = write_file(d, "blocker", "x");
       const std::string args =
-          "param '" + write_file(d, "q.txt", kSquare).string() + "' --out '" + (blocker / "sub").string() + "'";
+          "param --layout single '" + write_file(d, "q.txt", kSquare).string() + "' --out '" + (blocker / "sub").string() + "'";
       expect_clean_failure(args, d, "blocker", 2);
     }
     SUBCASE("negative tolerance") {
       expect_clean_failure(param(write_file(d, "q.txt", kSquare), " --tol -1"), d, "--tol", 1);
     }
     SUBCASE("missing --out") {
-      const RunResult r = run("param '" + write_file(d, "q.txt", kSquare).string() + "'", d);
+      const RunResult r = run("param --layout single '" + write_file(d, "q.txt", kSquare).string() + "'", d);
       CHECK(r.exit_code == 1);
       CHECK(count_lines(r.err) == 1);
       CHECK(r.err.find("--out") != std::string::npos);

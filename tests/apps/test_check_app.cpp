@@ -127,7 +127,7 @@ TEST_SUITE("check_app") {
       "param: the report says certified_valid, with the counts and the bound; check agrees on tspline.json") {
     const fs::path d = scratch("param");
     const auto r = run_app(
-        "param '" + test_support::polygon_file("disk.txt") + "' --out '" + (d / "out").string() + "' --quiet",
+        "param --layout single '" + test_support::polygon_file("disk.txt") + "' --out '" + (d / "out").string() + "' --quiet",
         d);
     CAPTURE(r.err);
     REQUIRE(r.exit_code == 0);

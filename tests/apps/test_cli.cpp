@@ -108,7 +108,7 @@ TEST_SUITE("cli") {
 
   TEST_CASE("--json: one JSON object per line, ending with the result; --quiet prints nothing") {
     const fs::path d = scratch("json");
-    const auto p = run_app("param " + q(test_support::polygon_file("square.txt")) + " --json --out " + q(d / "sq"), d);
+    const auto p = run_app("param --layout single " + q(test_support::polygon_file("square.txt")) + " --json --out " + q(d / "sq"), d);
     CAPTURE(p.err);
     REQUIRE(p.exit_code == 0);
     const auto events = json_lines(p.out);
@@ -136,7 +136,7 @@ TEST_SUITE("cli") {
     CHECK(pe.back()["event"] == "result");
     CHECK(pe.back()["steps"] == 3);
 
-    const auto quiet = run_app("param " + q(test_support::polygon_file("square.txt")) + " -q --out " + q(d / "q"), d);
+    const auto quiet = run_app("param --layout single " + q(test_support::polygon_file("square.txt")) + " -q --out " + q(d / "q"), d);
     CHECK(quiet.exit_code == 0);
     CHECK(quiet.out.empty());
     CHECK(quiet.err.empty());

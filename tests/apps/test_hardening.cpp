@@ -85,7 +85,7 @@ fs::path scaled(const std::string& src, double s, const fs::path& dst) {
 /// `tspline param IN --out DIR/out EXTRA`: the exit code is one of 0..3 and,
 /// unless it is 0, stderr is one line that starts with "tspline: error: ".
 test_support::AppRun param(const fs::path& in, const fs::path& d, const std::string& extra = "") {
-  const auto r = test_support::run_app("param " + quoted(in) + " --out " + quoted(d / "out") + " -q " + extra, d);
+  const auto r = test_support::run_app("param --layout single " + quoted(in) + " --out " + quoted(d / "out") + " -q " + extra, d);
   CAPTURE(in);
   CAPTURE(extra);
   CAPTURE(r.err);

@@ -49,7 +49,7 @@ fs::path geometry(const std::string& polygon) {
   if (it != made.end()) return it->second;
   const fs::path d = scratch("geometry_" + polygon);
   const auto r =
-      run_app("param " + q(test_support::polygon_file(polygon)) + " --out " + q(d / "out") + " -q", d);
+      run_app("param --layout single " + q(test_support::polygon_file(polygon)) + " --out " + q(d / "out") + " -q", d);
   CAPTURE(r.err);
   REQUIRE(r.exit_code == 0);
   const fs::path file = d / "out" / "tspline.json";

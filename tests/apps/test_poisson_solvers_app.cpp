@@ -34,7 +34,7 @@ fs::path geometry(const std::string& polygon) {
   auto it = made.find(polygon);
   if (it != made.end()) return it->second;
   const fs::path d = scratch("geometry_" + polygon);
-  const auto r = run_app("param " + q(test_support::polygon_file(polygon)) + " --out " + q(d / "out") +
+  const auto r = run_app("param --layout single " + q(test_support::polygon_file(polygon)) + " --out " + q(d / "out") +
                              " -q",
                          d);
   CAPTURE(r.err);

@@ -89,7 +89,7 @@ TEST_SUITE("bezier_export") {
 
   TEST_CASE("tspline export --bezier: file and bad input") {
     const fs::path d = test_support::scratch_dir("bezier_export", "app");
-    const auto p = test_support::run_app("param " + test_support::quoted(test_support::polygon_file("disk.txt")) +
+    const auto p = test_support::run_app("param --layout single " + test_support::quoted(test_support::polygon_file("disk.txt")) +
                                              " -q --out " + test_support::quoted(d / "disk"),
                                          d);
     REQUIRE(p.exit_code == 0);

@@ -113,7 +113,8 @@ TEST_SUITE("gis_input") {
          std::vector<std::string>{txt, (d / "isle_of_man.shp").string(), (d / "isle_of_man.gpkg").string()}) {
       CAPTURE(f);
       const fs::path out = d / ("out_" + fs::path(f).extension().string().substr(1));
-      const auto r = test_support::run_app("param " + test_support::quoted(f) + " -q --out " + test_support::quoted(out), d);
+      const auto r = test_support::run_app("param --layout single " + test_support::quoted(f) + " -q --out " +
+                                           test_support::quoted(out), d);
       CAPTURE(r.err);
       REQUIRE(r.exit_code == 0);
       const json pts = control_points(out / "tspline.json");

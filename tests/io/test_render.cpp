@@ -143,7 +143,7 @@ TEST_SUITE("render") {
 
   TEST_CASE("tspline render: every view of param and poisson outputs") {
     const fs::path d = scratch("views");
-    const auto p = run_app("param " + q(test_support::polygon_file("flower.txt")) + " --out " + q(d / "param") + " -q", d);
+    const auto p = run_app("param --layout single " + q(test_support::polygon_file("flower.txt")) + " --out " + q(d / "param") + " -q", d);
     REQUIRE(p.exit_code == 0);
     const auto s = run_app("poisson " + q(d / "param" / "tspline.json") +
                                " --problem gaussian --steps 3 -q --out " + q(d / "poisson"),

@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstdlib>
 #include <cmath>
 #include <limits>
 #include <map>
@@ -159,7 +160,8 @@ meshopt::SmoothingReport smooth_inner_nodes(std::vector<Eigen::Vector2d>& x, con
       // The cut n -> n1 (each cut of n is the edge to n1 of exactly one quad around n).
       if (ring[n1] < 0) continue;
       const RingCurve& rc = rings[ring[n1]];
-      const double l = 0.2 * (x[n1] - x[n]).norm();
+      // (On small rings l is capped: the points b+- must stay near b, on its own side.)
+      const double l = std::min(0.2 * (x[n1] - x[n]).norm(), 0.05 * rc.length());
       const double dir = ring[n1] == 0 ? 1.0 : -1.0;  // the domain lies left of the outer ring, right of holes
       const int plus = static_cast<int>(x.size()), minus = plus + 1;
       x.push_back(rc.point(arc[n1] + dir * l));
@@ -172,8 +174,21 @@ meshopt::SmoothingReport smooth_inner_nodes(std::vector<Eigen::Vector2d>& x, con
   }
   meshopt::SmoothingOptions so;
   so.max_sweeps = 200;
+  const std::vector<Eigen::Vector2d> before(x.begin(), x.begin() + static_cast<std::ptrdiff_t>(n_nodes));
   const meshopt::SmoothingReport report = meshopt::smooth(x, problem, so);
   x.resize(n_nodes);  // the ring points b+-
+  // The regularized objective of a tangled start can shrink quads to a point
+  // (|S|^2 / h(sigma) -> 0 as a triangle collapses with delta > 0): where a
+  // quad has lost more than 99 % of its shortest edge, its nodes go back.
+  for (const auto& q : quads) {
+    double now = std::numeric_limits<double>::infinity(), was = now;
+    for (int j = 0; j < 4; ++j) {
+      now = std::min(now, (x[q[j]] - x[q[(j + 1) % 4]]).norm());
+      was = std::min(was, (before[q[j]] - before[q[(j + 1) % 4]]).norm());
+    }
+    if (now < 1e-2 * was)
+      for (int j = 0; j < 4; ++j) x[q[j]] = before[q[j]];
+  }
   return report;
 }
 
@@ -260,7 +275,7 @@ void slide_ring_nodes(std::vector<Eigen::Vector2d>& x, std::vector<double>& arc,
     }
     const double best = fc > fd ? c : d;
     if (std::max(fc, fd) > before) {
-      arc[n] = std::fmod(best + L, L);
+      arc[n] = rc.snap_to_vertex(std::fmod(best + L, L), 1e-3 * (hi - lo));
       x[n] = rc.point(arc[n]);
     } else {
       x[n] = rc.point(start);
@@ -387,6 +402,7 @@ QuadLayout build_quad_layout(const Domain& d, const QuadLayoutOptions& o) {
   const double tol = 1e-9 * diam;
 
   QuadLayout out;
+  bool optimize = true;
   for (int round = 0;; ++round) {
     if (round > o.max_repair_rounds)
       throw NumericalError("no quad layout found: the layout still crosses the boundary after " +
@@ -443,7 +459,26 @@ QuadLayout build_quad_layout(const Domain& d, const QuadLayoutOptions& o) {
       continue;
     }
 
-    const PlanarQuadMesh m = quad_mesh(straight, h);
+    PlanarQuadMesh m;
+    try {
+      m = quad_mesh(straight, h);
+    } catch (const NumericalError& e) {
+      // Gmsh could not recover a boundary segment ("... on curve N ..."): that
+      // piece and its neighbours get a node more, and the mesh is made again.
+      const std::string what = e.what();
+      const std::size_t at = what.find("on curve ");
+      if (at == std::string::npos) throw;
+      long long curve = std::atoll(what.c_str() + at + 9) - 1;  // line tags count the segments from 1
+      std::size_t r = 0;
+      while (r < straight.size() && curve >= static_cast<long long>(straight[r].size()))
+        curve -= static_cast<long long>(straight[r].size()), ++r;
+      if (r == straight.size() || curve < 0) throw;
+      const std::size_t n = straight[r].size(), k = static_cast<std::size_t>(curve);
+      for (const std::size_t j : {(k + n - 1) % n, k, (k + 1) % n}) to_split[r].insert(j);
+      split_marked();
+      out.stats.repair_rounds = round + 1;
+      continue;
+    }
     // Boundary nodes onto the true rings.
     std::vector<Eigen::Vector2d> x = m.nodes;
     std::vector<double> arc(x.size(), 0.0);
@@ -453,16 +488,18 @@ QuadLayout build_quad_layout(const Domain& d, const QuadLayoutOptions& o) {
       const double L = rings[m.ring[n]].length();
       const std::size_t k = static_cast<std::size_t>(m.segment[n]);
       const double a = nr[k], b = k + 1 < nr.size() ? nr[k + 1] : nr.front() + L;
-      arc[n] = a + m.t[n] * (b - a);
+      arc[n] = rings[m.ring[n]].snap_to_vertex(a + m.t[n] * (b - a), 1e-3 * (b - a));
       x[n] = rings[m.ring[n]].point(arc[n]);
     }
     std::vector<std::array<int, 4>> quads = m.quads;
     std::vector<int> node_ring = m.ring;
     pillow_flat_rings(quads, x, node_ring, arc, rings);
-    smooth_inner_nodes(x, quads, node_ring, arc, rings);
-    for (int pass = 0; pass < 3; ++pass) {
-      slide_ring_nodes(x, arc, quads, node_ring, rings);
+    if (optimize) {
       smooth_inner_nodes(x, quads, node_ring, arc, rings);
+      for (int pass = 0; pass < 3; ++pass) {
+        slide_ring_nodes(x, arc, quads, node_ring, rings);
+        smooth_inner_nodes(x, quads, node_ring, arc, rings);
+      }
     }
     // Edges: shared by two quads (inner: cuts) or one (on a ring).
     std::map<std::pair<int, int>, int> edge_quads;
@@ -510,11 +547,22 @@ QuadLayout build_quad_layout(const Domain& d, const QuadLayoutOptions& o) {
 
     // The layout: inner edges are cuts, quad corners on rings without cuts are ring corners.
     std::vector<Cut> cuts;
-    for (const auto& [e, count] : edge_quads)
+    for (const auto& [e, count] : edge_quads) {
       if (count == 2) cuts.push_back({x[e.first], x[e.second]});
+    }
     for (std::size_t n = 0; n < x.size(); ++n)
       if (node_ring[n] >= 0 && inner_degree[n] == 0 && degree[n] > 0) out.ring_corners.push_back(x[n]);
-    out.layout = build_patch_layout(d, std::move(cuts), out.ring_corners);
+    try {
+      out.layout = build_patch_layout(d, std::move(cuts), out.ring_corners);
+    } catch (const InputError& e) {
+      // The optimization tangled the layout somewhere (a tangled start near
+      // rings much closer than the patch size): the same mesh, not optimized.
+      if (!optimize) throw NumericalError(std::string("no valid quad layout: ") + e.what());
+      optimize = false;
+      out.ring_corners.clear();
+      out.stats.optimized = false;
+      continue;
+    }
     QuadLayoutStats& st = out.stats;
     st.patches = out.layout.patches.size();
     st.min_size = so.min_size;

@@ -24,6 +24,18 @@ Eigen::Vector2d RingCurve::point(double s) const {
   return v_[i] + t * (v_[(i + 1) % v_.size()] - v_[i]);
 }
 
+double RingCurve::snap_to_vertex(double s, double eps) const {
+  const double L = length();
+  s = std::fmod(s, L);
+  if (s < 0.0) s += L;
+  const auto it = std::upper_bound(arc_.begin(), arc_.end(), s);
+  std::size_t i = static_cast<std::size_t>(std::max<std::ptrdiff_t>(0, (it - arc_.begin()) - 1));
+  i = std::min(i, v_.size() - 1);
+  if (s - arc_[i] <= eps) return arc_[i];
+  if (arc_[i + 1] - s <= eps) return i + 1 == v_.size() ? 0.0 : arc_[i + 1];
+  return s;
+}
+
 namespace {
 
 // Distance of p from the segment [a, b].
@@ -162,7 +174,14 @@ std::vector<double> ring_nodes(const RingCurve& ring, const RingNodeOptions& o,
     out.push_back(std::fmod(out[longest] + 0.5 * len, L));
     std::sort(out.begin(), out.end());
   }
-  return out;
+  // No two nodes closer (by arc length) than a thousandth of the ring or of the
+  // smallest piece size, also across the start of the ring.
+  const double gap = std::max(1e-3 * std::min(L, o.min_size > 0.0 ? o.min_size : L), 1e-12 * L);
+  std::vector<double> kept;
+  for (double s : out)
+    if (kept.empty() || s - kept.back() > gap) kept.push_back(s);
+  while (kept.size() > 1 && kept.front() + L - kept.back() <= gap) kept.pop_back();
+  return kept;
 }
 
 }  // namespace tspline

@@ -97,6 +97,7 @@ SizeField::SizeField(const Domain& d, const SizeFieldOptions& o) {
   mark_levels(cdt);
   // Widths: shortest inside edge to a sample "across".
   std::vector<double> width(pts.size(), std::numeric_limits<double>::infinity());
+  std::vector<char> between_rings(pts.size(), 0);  // the width is a gap to another ring
   for (auto e = cdt.finite_edges_begin(); e != cdt.finite_edges_end(); ++e) {
     CDT::Face_handle f = e->first, g = f->neighbor(e->second);
     const bool inside = (f->info() % 2 == 1 && !cdt.is_infinite(f)) || (g->info() % 2 == 1 && !cdt.is_infinite(g));
@@ -112,8 +113,8 @@ SizeField::SizeField(const Domain& d, const SizeFieldOptions& o) {
       across = arc > o.across_ratio * dist;
     }
     if (!across) continue;
-    width[a.sample] = std::min(width[a.sample], dist);
-    width[b.sample] = std::min(width[b.sample], dist);
+    for (const int k : {a.sample, b.sample})
+      if (dist < width[k]) width[k] = dist, between_rings[k] = a.ring != b.ring;
   }
   min_width_ = std::numeric_limits<double>::infinity();
   for (double w : width) min_width_ = std::min(min_width_, w);
@@ -129,7 +130,10 @@ SizeField::SizeField(const Domain& d, const SizeFieldOptions& o) {
   const double g = o.grading;
   for (std::size_t s = 0; s < pts.size(); ++s) {
     if (!std::isfinite(width[s])) continue;
-    const double v = std::clamp(o.factor * width[s], min_size_, max_size_);
+    // A gap between two rings is always resolved (two islands must not share a
+    // patch side); min_size only spares the narrow places of one ring.
+    const double floor = between_rings[s] ? 0.0 : min_size_;
+    const double v = std::clamp(o.factor * width[s], floor, max_size_);
     const int i = std::clamp(static_cast<int>((pts[s].x() - lo_.x()) / cell_), 0, nx_ - 1);
     const int j = std::clamp(static_cast<int>((pts[s].y() - lo_.y()) / cell_), 0, ny_ - 1);
     for (int di = 0; di <= 1; ++di)
@@ -171,7 +175,7 @@ double SizeField::operator()(const Eigen::Vector2d& x) const {
   auto at = [&](int a, int b) { return h_[static_cast<std::size_t>(b) * (nx_ + 1) + a]; };
   const double v = (1 - s) * (1 - t) * at(i, j) + s * (1 - t) * at(i + 1, j) + (1 - s) * t * at(i, j + 1) +
                    s * t * at(i + 1, j + 1);
-  return std::clamp(v, min_size_, max_size_);
+  return std::min(v, max_size_);
 }
 
 }  // namespace tspline

@@ -40,8 +40,11 @@ DomainParameterization parameterize_domain(const Domain& input, const Parameteri
                                            const AdaptiveOptions& adaptive, const DomainParameterizationOptions& c,
                                            const IterationCallback& on_iteration, const PatchCallback& on_patch) {
   if (c.first_try_rounds < 0) throw InputError("the first try's adaptive rounds must be >= 0");
-  const Domain domain = validate_domain(input);
-  const bool holes = !domain.holes.empty();
+  // One ring goes to run_parameterization as it is (it validates and cleans it
+  // itself, with the run's tolerance, and reports the notes); rings with holes
+  // are validated here.
+  const bool holes = !input.holes.empty();
+  const Domain domain = holes || c.cuts || c.layout == LayoutMode::Quad ? validate_domain(input) : input;
   DomainParameterization out;
   if (c.cuts) {
     if (c.layout == LayoutMode::Single) throw InputError("cuts make a layout of several patches: not with layout single");
@@ -60,7 +63,8 @@ DomainParameterization parameterize_domain(const Domain& input, const Parameteri
     return out;
   }
   auto run_quad = [&](const std::string& reason) {
-    QuadLayout L = build_quad_layout(domain, c.quad);
+    const Domain valid = holes || c.layout == LayoutMode::Quad ? domain : validate_domain(input);
+    QuadLayout L = build_quad_layout(valid, c.quad);
     report_step(options.progress, "layout", L.explanation());
     out.layout = "quad";
     out.reason = reason;
@@ -68,7 +72,7 @@ DomainParameterization parameterize_domain(const Domain& input, const Parameteri
     ParameterizationOptions po = options;
     if (c.patch_initial_level) po.initial_level = *c.patch_initial_level;
     out.patches.emplace(
-        run_multipatch_parameterization(domain, std::move(L.layout), L.explanation(), po, adaptive, c.multi, on_patch));
+        run_multipatch_parameterization(valid, std::move(L.layout), L.explanation(), po, adaptive, c.multi, on_patch));
   };
   auto good_patches = [&](const MultiPatchResult& R) {
     return (!adaptive.certify || R.certified_valid()) && R.min_scaled_jacobian_dense() >= c.good_scaled_jacobian &&

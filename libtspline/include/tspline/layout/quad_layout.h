@@ -46,6 +46,9 @@ struct QuadLayoutStats {
   double min_corner_scaled_jacobian = 1.0;   ///< of the quads with straight sides (chords on the rings)
   double mean_corner_scaled_jacobian = 1.0;
   int repair_rounds = 0;
+  /// The layout's nodes were smoothed and slid (false: that tangled the layout,
+  /// and the mesher's own nodes were kept).
+  bool optimized = true;
   double min_size = 0.0, max_size = 0.0;     ///< of the size field, absolute
   double seconds = 0.0;
 };

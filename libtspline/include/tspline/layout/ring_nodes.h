@@ -36,6 +36,10 @@ class RingCurve {
   /// (b may exceed length(): the piece wraps past vertex 0) from the chord, and
   /// the arc length of that vertex (-1 if there is none).
   std::pair<double, double> farthest_from_chord(double a, double b) const;
+  /// The arc length of the vertex nearest to arc length s if it is within eps
+  /// (so that a node never lies a hair's breadth from a vertex: the patch
+  /// polygon would have a needle edge there), else s; in [0, length).
+  double snap_to_vertex(double s, double eps) const;
 
  private:
   std::vector<Eigen::Vector2d> v_;
