@@ -9,7 +9,9 @@
 
 #include "test_support.h"
 #include "tspline/boundary/domain.h"
+#include "tspline/boundary/polygon_validation.h"
 #include "tspline/errors.h"
+#include "tspline/io/gis_reader.h"
 #include "tspline/layout/quad_layout.h"
 #include "tspline/layout/quad_mesher.h"
 #include "tspline/layout/ring_nodes.h"
@@ -172,6 +174,30 @@ TEST_SUITE("quad_layout") {
           if ((v - corner).norm() < 1e-12) touched = true;
       CHECK(touched);
     }
+  }
+
+  TEST_CASE("quad layout of a domain whose holes have needles at vertex 0: cleaned, then laid out and mapped") {
+    if (!tspline::quad_mesher_available()) return;
+    const tspline::io::DomainInput in =
+        tspline::io::read_domain(std::string(TSPLINE_TEST_DATA_DIR) + "/holes/needles.txt");
+    std::vector<std::string> notes;
+    tspline::DomainCleaningOptions how;
+    how.notes = &notes;
+    const tspline::Domain d = tspline::validate_domain({in.outer, in.holes}, how);
+    CHECK(notes.size() == 3);  // the outer ring and both holes were cleaned
+    // Areas (needles.txt): 100 - 0.75 - 2 once the needles are gone.
+    CHECK(tspline::domain_area(d) == doctest::Approx(100.0 - 0.75 - 2.0).epsilon(1e-9));
+    const tspline::QuadLayout L = tspline::build_quad_layout(d);
+    check_layout_tiles(d, L.layout);
+    tspline::ParameterizationOptions po;
+    po.initial_level = 1;
+    tspline::AdaptiveOptions ad;
+    ad.max_adapt = 2;
+    const tspline::MultiPatchResult R =
+        tspline::run_multipatch_parameterization(d, L.layout, L.explanation(), po, ad);
+    CHECK(R.certified_valid());
+    CHECK(std::abs(R.map_area - R.domain_area) < 1e-3 * R.domain_area);
+    CHECK(R.max_gap() <= 1e-12 * R.diameter);
   }
 
   TEST_CASE("multi-patch map on a quad layout: certified, conforming after adaptive refinement, area") {

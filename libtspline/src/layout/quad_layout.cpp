@@ -352,6 +352,127 @@ std::size_t pillow_flat_rings(std::vector<std::array<int, 4>>& quads, std::vecto
   return count;
 }
 
+// A ring node at a sharp tip of its ring (inner angle below 60 degrees next to
+// the node) with one cut: the cut would split the tip into two needle corners.
+// Its two quads (b, r1, y1, x) and (b, x, y2, r2) form a hexagon, split again
+// by a diagonal away from b, (r1, y1, x, y2) + (y2, r2, b, r1) or
+// (b, r1, y1, r2) + (y1, x, y2, r2), the one with the better worst corner, so
+// that b is the corner of one quad (an edge rotation; x keeps valence >= 3).
+std::size_t free_sharp_tips(std::vector<std::array<int, 4>>& quads, const std::vector<Eigen::Vector2d>& x,
+                            const std::vector<int>& ring, const std::vector<double>& arc,
+                            const std::vector<RingCurve>& rings) {
+  std::size_t changed = 0;
+  std::vector<std::vector<int>> quads_of(x.size());
+  auto rebuild = [&] {
+    for (auto& l : quads_of) l.clear();
+    for (std::size_t q = 0; q < quads.size(); ++q)
+      for (int j = 0; j < 4; ++j) quads_of[quads[q][j]].push_back(static_cast<int>(q));
+  };
+  rebuild();
+  auto quad_sj = [&](const std::array<int, 4>& q) {
+    double m = 1.0;
+    for (int j = 0; j < 4; ++j) m = std::min(m, corner_sj(x[q[j]], x[q[(j + 1) % 4]], x[q[(j + 3) % 4]]));
+    return m;
+  };
+  const double sharp = std::cos(60.0 * std::numbers::pi / 180.0);
+  for (std::size_t b = 0; b < x.size(); ++b) {
+    if (ring[b] < 0 || quads_of[b].size() != 2) continue;
+    const RingCurve& rc = rings[ring[b]];
+    const double dir = ring[b] == 0 ? 1.0 : -1.0;
+    double near = 1e300;
+    for (int q : quads_of[b])
+      for (int j = 0; j < 4; ++j)
+        if (quads[q][j] != static_cast<int>(b)) near = std::min(near, (x[quads[q][j]] - x[b]).norm());
+    const double delta = 1e-6 * near;
+    const Eigen::Vector2d ahead = rc.point(arc[b] + dir * delta) - x[b], behind = rc.point(arc[b] - dir * delta) - x[b];
+    // Convex and sharp: cross(ahead, behind) > 0 and the angle below 60 degrees.
+    if (!(cross(ahead, behind) > 0.0 && ahead.normalized().dot(behind.normalized()) > sharp)) continue;
+    // The two quads, each rotated to start at b: (b, r1, y1, x) and (b, x, y2, r2).
+    std::array<int, 4> qa = quads[quads_of[b][0]], qb = quads[quads_of[b][1]];
+    while (qa[0] != static_cast<int>(b)) std::rotate(qa.begin(), qa.begin() + 1, qa.end());
+    while (qb[0] != static_cast<int>(b)) std::rotate(qb.begin(), qb.begin() + 1, qb.end());
+    int ia = quads_of[b][0], ib = quads_of[b][1];
+    if (qa[3] != qb[1]) std::swap(qa, qb), std::swap(ia, ib);
+    if (qa[3] != qb[1]) continue;  // not sharing the cut b-x
+    const int r1 = qa[1], y1 = qa[2], xn = qa[3], y2 = qb[2], r2 = qb[3];
+
+    if (ring[xn] >= 0 || quads_of[xn].size() < 4) continue;  // x would drop below valence 3
+    const std::array<int, 4> A1 = {r1, y1, xn, y2}, B1 = {y2, r2, static_cast<int>(b), r1};
+    const std::array<int, 4> A2 = {static_cast<int>(b), r1, y1, r2}, B2 = {y1, xn, y2, r2};
+    const double m1 = std::min(quad_sj(A1), quad_sj(B1)), m2 = std::min(quad_sj(A2), quad_sj(B2));
+    if (std::max(m1, m2) <= 0.0) continue;
+    quads[ia] = m1 >= m2 ? A1 : A2;
+    quads[ib] = m1 >= m2 ? B1 : B2;
+    ++changed;
+    rebuild();
+  }
+  return changed;
+}
+
+// The worst corners: each inner node where a corner of its quads is below 20
+// or above 160 degrees moves, by a pattern search, to where the worst corner
+// of its quads is best (max-min: the K* smoothing spreads the distortion, a
+// patch map is bounded by its worst corner, SJ <= sin theta). At a ring node
+// the corner is measured against the ring itself next to the node (the patch
+// polygon's angle), not against the chord to the next ring node.
+void improve_worst_corners(std::vector<Eigen::Vector2d>& x, const std::vector<std::array<int, 4>>& quads,
+                           const std::vector<int>& ring, const std::vector<double>& arc,
+                           const std::vector<RingCurve>& rings) {
+  const std::size_t n_nodes = x.size();
+  std::vector<std::vector<int>> quads_of(n_nodes);
+  for (std::size_t q = 0; q < quads.size(); ++q)
+    for (int j = 0; j < 4; ++j) quads_of[quads[q][j]].push_back(static_cast<int>(q));
+  std::map<std::pair<int, int>, int> uses;
+  for (const auto& q : quads)
+    for (int j = 0; j < 4; ++j) ++uses[{std::min(q[j], q[(j + 1) % 4]), std::max(q[j], q[(j + 1) % 4])}];
+  auto on_ring_edge = [&](int a, int b) { return uses[{std::min(a, b), std::max(a, b)}] == 1; };
+  // Corner j of quad q, the ring's own direction where the side runs along it.
+  auto corner = [&](const std::array<int, 4>& q, int j) {
+    const int v = q[j], next = q[(j + 1) % 4], prev = q[(j + 3) % 4];
+    Eigen::Vector2d pn = x[next], pp = x[prev];
+    if (ring[v] >= 0) {
+      const RingCurve& rc = rings[ring[v]];
+      const double dir = ring[v] == 0 ? 1.0 : -1.0;
+      if (on_ring_edge(v, next)) pn = rc.point(arc[v] + dir * 0.2 * (x[next] - x[v]).norm());
+      if (on_ring_edge(v, prev)) pp = rc.point(arc[v] - dir * 0.2 * (x[prev] - x[v]).norm());
+    }
+    return corner_sj(x[v], pn, pp);
+  };
+  auto worst = [&](int n) {
+    double m = 1.0;
+    for (int q : quads_of[n])
+      for (int j = 0; j < 4; ++j) m = std::min(m, corner(quads[q], j));
+    return m;
+  };
+  const double bad = std::sin(20.0 * std::numbers::pi / 180.0);
+  for (int pass = 0; pass < 3; ++pass)
+    for (std::size_t n = 0; n < n_nodes; ++n) {
+      if (ring[n] >= 0 || quads_of[n].empty()) continue;
+      double best = worst(static_cast<int>(n));
+      if (best >= bad) continue;
+      double step = 1e300;
+      for (int q : quads_of[n])
+        for (int j = 0; j < 4; ++j) step = std::min(step, (x[quads[q][j]] - x[quads[q][(j + 1) % 4]]).norm());
+      step *= 0.25;
+      for (int it = 0; it < 24 && step > 0.0; ++it) {
+        bool moved = false;
+        const Eigen::Vector2d start = x[n];
+        for (int k = 0; k < 8; ++k) {
+          const double a = k * std::numbers::pi / 4.0;
+          x[n] = start + step * Eigen::Vector2d(std::cos(a), std::sin(a));
+          const double w = worst(static_cast<int>(n));
+          if (w > best + 1e-12) {
+            best = w;
+            moved = true;
+            break;
+          }
+          x[n] = start;
+        }
+        if (!moved) step *= 0.5;
+      }
+    }
+}
+
 }  // namespace
 
 double quad_corner_scaled_jacobian(const std::array<Eigen::Vector2d, 4>& q) {
@@ -371,7 +492,7 @@ std::string QuadLayout::explanation() const {
   for (std::size_t v = 0; v < stats.valence.size(); ++v)
     if (stats.valence[v]) s << ' ' << v << (v == 7 ? "+" : "") << ": " << stats.valence[v];
   s << "), straight-sided scaled Jacobian min " << stats.min_corner_scaled_jacobian << " mean "
-    << stats.mean_corner_scaled_jacobian;
+    << stats.mean_corner_scaled_jacobian << (stats.optimized ? "" : " (nodes not optimized: that tangled it)");
   return s.str();
 }
 
@@ -494,12 +615,14 @@ QuadLayout build_quad_layout(const Domain& d, const QuadLayoutOptions& o) {
     std::vector<std::array<int, 4>> quads = m.quads;
     std::vector<int> node_ring = m.ring;
     pillow_flat_rings(quads, x, node_ring, arc, rings);
+    free_sharp_tips(quads, x, node_ring, arc, rings);
     if (optimize) {
       smooth_inner_nodes(x, quads, node_ring, arc, rings);
       for (int pass = 0; pass < 3; ++pass) {
         slide_ring_nodes(x, arc, quads, node_ring, rings);
         smooth_inner_nodes(x, quads, node_ring, arc, rings);
       }
+      improve_worst_corners(x, quads, node_ring, arc, rings);
     }
     // Edges: shared by two quads (inner: cuts) or one (on a ring).
     std::map<std::pair<int, int>, int> edge_quads;
