@@ -94,6 +94,22 @@ class EdgeGrid {
   int nx_ = 1, ny_ = 1;
 };
 
+// The quads around each node (indices into quads).
+std::vector<std::vector<int>> quads_around(std::size_t nodes, const std::vector<std::array<int, 4>>& quads) {
+  std::vector<std::vector<int>> out(nodes);
+  for (std::size_t q = 0; q < quads.size(); ++q)
+    for (int j = 0; j < 4; ++j) out[quads[q][j]].push_back(static_cast<int>(q));
+  return out;
+}
+
+// Use count of every edge of the quads (1: on a ring, 2: inner).
+std::map<std::pair<int, int>, int> edge_uses(const std::vector<std::array<int, 4>>& quads) {
+  std::map<std::pair<int, int>, int> uses;
+  for (const auto& q : quads)
+    for (int j = 0; j < 4; ++j) ++uses[{std::min(q[j], q[(j + 1) % 4]), std::max(q[j], q[(j + 1) % 4])}];
+  return uses;
+}
+
 // Distance of p from the segment [a, b].
 double segment_distance(const Eigen::Vector2d& p, const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
   const Eigen::Vector2d ab = b - a;
@@ -208,13 +224,9 @@ void slide_ring_nodes(std::vector<Eigen::Vector2d>& x, std::vector<double>& arc,
                       const std::vector<std::array<int, 4>>& quads, const std::vector<int>& ring,
                       const std::vector<RingCurve>& rings) {
   const std::size_t n_nodes = x.size();
-  std::vector<std::vector<int>> quads_of(n_nodes);
-  for (std::size_t q = 0; q < quads.size(); ++q)
-    for (int j = 0; j < 4; ++j) quads_of[quads[q][j]].push_back(static_cast<int>(q));
+  const std::vector<std::vector<int>> quads_of = quads_around(n_nodes, quads);
   // Ring neighbours: the other ends of the node's edges on the ring (edges of one quad).
-  std::map<std::pair<int, int>, int> count;
-  for (const auto& q : quads)
-    for (int j = 0; j < 4; ++j) ++count[{std::min(q[j], q[(j + 1) % 4]), std::max(q[j], q[(j + 1) % 4])}];
+  const std::map<std::pair<int, int>, int> count = edge_uses(quads);
   std::vector<std::vector<int>> ring_nbr(n_nodes);
   for (const auto& [e, c] : count)
     if (c == 1) ring_nbr[e.first].push_back(e.second), ring_nbr[e.second].push_back(e.first);
@@ -295,9 +307,7 @@ void slide_ring_nodes(std::vector<Eigen::Vector2d>& x, std::vector<double>& arc,
 // are smoothed afterwards. Returns the rings pillowed.
 std::size_t pillow_flat_rings(std::vector<std::array<int, 4>>& quads, std::vector<Eigen::Vector2d>& x,
                               std::vector<int>& ring, std::vector<double>& arc, const std::vector<RingCurve>& rings) {
-  std::vector<std::vector<int>> quads_of(x.size());
-  for (std::size_t q = 0; q < quads.size(); ++q)
-    for (int j = 0; j < 4; ++j) quads_of[quads[q][j]].push_back(static_cast<int>(q));
+  const std::vector<std::vector<int>> quads_of = quads_around(x.size(), quads);
   auto flat_or_reflex = [](const Eigen::Vector2d& p, const Eigen::Vector2d& next, const Eigen::Vector2d& prev) {
     const double sv = corner_sj(p, next, prev);
     return sv < 0.0 || (sv <= 0.5 && (next - p).dot(prev - p) < 0.0);
@@ -319,9 +329,7 @@ std::size_t pillow_flat_rings(std::vector<std::array<int, 4>>& quads, std::vecto
   for (std::size_t r = 0; r < rings.size(); ++r) count += pillow[r];
   if (count == 0) return 0;
   // Edges along the ring, as directed in their quad.
-  std::map<std::pair<int, int>, int> uses;
-  for (const auto& q : quads)
-    for (int j = 0; j < 4; ++j) ++uses[{std::min(q[j], q[(j + 1) % 4]), std::max(q[j], q[(j + 1) % 4])}];
+  std::map<std::pair<int, int>, int> uses = edge_uses(quads);
   std::vector<std::pair<int, int>> along;
   for (const auto& q : quads)
     for (int j = 0; j < 4; ++j) {
@@ -362,13 +370,8 @@ std::size_t free_sharp_tips(std::vector<std::array<int, 4>>& quads, const std::v
                             const std::vector<int>& ring, const std::vector<double>& arc,
                             const std::vector<RingCurve>& rings) {
   std::size_t changed = 0;
-  std::vector<std::vector<int>> quads_of(x.size());
-  auto rebuild = [&] {
-    for (auto& l : quads_of) l.clear();
-    for (std::size_t q = 0; q < quads.size(); ++q)
-      for (int j = 0; j < 4; ++j) quads_of[quads[q][j]].push_back(static_cast<int>(q));
-  };
-  rebuild();
+  std::vector<std::vector<int>> quads_of = quads_around(x.size(), quads);
+  auto rebuild = [&] { quads_of = quads_around(x.size(), quads); };
   auto quad_sj = [&](const std::array<int, 4>& q) {
     double m = 1.0;
     for (int j = 0; j < 4; ++j) m = std::min(m, corner_sj(x[q[j]], x[q[(j + 1) % 4]], x[q[(j + 3) % 4]]));
@@ -414,17 +417,13 @@ std::size_t free_sharp_tips(std::vector<std::array<int, 4>>& quads, const std::v
 // of its quads is best (max-min: the K* smoothing spreads the distortion, a
 // patch map is bounded by its worst corner, SJ <= sin theta). At a ring node
 // the corner is measured against the ring itself next to the node (the patch
-// polygon's angle), not against the chord to the next ring node.
+// polygon's angle, at the vertex), not against the chord to the next ring node.
 void improve_worst_corners(std::vector<Eigen::Vector2d>& x, const std::vector<std::array<int, 4>>& quads,
                            const std::vector<int>& ring, const std::vector<double>& arc,
                            const std::vector<RingCurve>& rings) {
   const std::size_t n_nodes = x.size();
-  std::vector<std::vector<int>> quads_of(n_nodes);
-  for (std::size_t q = 0; q < quads.size(); ++q)
-    for (int j = 0; j < 4; ++j) quads_of[quads[q][j]].push_back(static_cast<int>(q));
-  std::map<std::pair<int, int>, int> uses;
-  for (const auto& q : quads)
-    for (int j = 0; j < 4; ++j) ++uses[{std::min(q[j], q[(j + 1) % 4]), std::max(q[j], q[(j + 1) % 4])}];
+  const std::vector<std::vector<int>> quads_of = quads_around(n_nodes, quads);
+  std::map<std::pair<int, int>, int> uses = edge_uses(quads);
   auto on_ring_edge = [&](int a, int b) { return uses[{std::min(a, b), std::max(a, b)}] == 1; };
   // Corner j of quad q, the ring's own direction where the side runs along it.
   auto corner = [&](const std::array<int, 4>& q, int j) {
@@ -433,8 +432,9 @@ void improve_worst_corners(std::vector<Eigen::Vector2d>& x, const std::vector<st
     if (ring[v] >= 0) {
       const RingCurve& rc = rings[ring[v]];
       const double dir = ring[v] == 0 ? 1.0 : -1.0;
-      if (on_ring_edge(v, next)) pn = rc.point(arc[v] + dir * 0.2 * (x[next] - x[v]).norm());
-      if (on_ring_edge(v, prev)) pp = rc.point(arc[v] - dir * 0.2 * (x[prev] - x[v]).norm());
+      // At the vertex itself: the patch polygon's own corner there.
+      if (on_ring_edge(v, next)) pn = rc.point(arc[v] + dir * 1e-6 * (x[next] - x[v]).norm());
+      if (on_ring_edge(v, prev)) pp = rc.point(arc[v] - dir * 1e-6 * (x[prev] - x[v]).norm());
     }
     return corner_sj(x[v], pn, pp);
   };
@@ -454,13 +454,26 @@ void improve_worst_corners(std::vector<Eigen::Vector2d>& x, const std::vector<st
       for (int q : quads_of[n])
         for (int j = 0; j < 4; ++j) step = std::min(step, (x[quads[q][j]] - x[quads[q][(j + 1) % 4]]).norm());
       step *= 0.25;
+      // No edge of the node shorter than a third of what it was (the angles alone
+      // would let it run onto a neighbour).
+      std::vector<std::pair<int, double>> edges;
+      for (int q : quads_of[n])
+        for (int j = 0; j < 4; ++j)
+          if (quads[q][j] == static_cast<int>(n))
+            for (const int o : {quads[q][(j + 1) % 4], quads[q][(j + 3) % 4]})
+              edges.push_back({o, (x[o] - x[n]).norm() / 3.0});
+      auto short_edge = [&]() {
+        for (const auto& [o, min_len] : edges)
+          if ((x[o] - x[n]).norm() < min_len) return true;
+        return false;
+      };
       for (int it = 0; it < 24 && step > 0.0; ++it) {
         bool moved = false;
         const Eigen::Vector2d start = x[n];
         for (int k = 0; k < 8; ++k) {
           const double a = k * std::numbers::pi / 4.0;
           x[n] = start + step * Eigen::Vector2d(std::cos(a), std::sin(a));
-          const double w = worst(static_cast<int>(n));
+          const double w = short_edge() ? -2.0 : worst(static_cast<int>(n));
           if (w > best + 1e-12) {
             best = w;
             moved = true;
@@ -492,7 +505,11 @@ std::string QuadLayout::explanation() const {
   for (std::size_t v = 0; v < stats.valence.size(); ++v)
     if (stats.valence[v]) s << ' ' << v << (v == 7 ? "+" : "") << ": " << stats.valence[v];
   s << "), straight-sided scaled Jacobian min " << stats.min_corner_scaled_jacobian << " mean "
-    << stats.mean_corner_scaled_jacobian << (stats.optimized ? "" : " (nodes not optimized: that tangled it)");
+    << stats.mean_corner_scaled_jacobian
+    << (stats.optimization_level == 3   ? ""
+        : stats.optimization_level == 2 ? " (sharp tips not rotated: that broke it)"
+        : stats.optimization_level == 1 ? " (worst corners not optimized: that broke it)"
+                                        : " (nodes not optimized: that tangled it)");
   return s.str();
 }
 
@@ -523,7 +540,7 @@ QuadLayout build_quad_layout(const Domain& d, const QuadLayoutOptions& o) {
   const double tol = 1e-9 * diam;
 
   QuadLayout out;
-  bool optimize = true;
+  int level = 3;
   for (int round = 0;; ++round) {
     if (round > o.max_repair_rounds)
       throw NumericalError("no quad layout found: the layout still crosses the boundary after " +
@@ -615,19 +632,17 @@ QuadLayout build_quad_layout(const Domain& d, const QuadLayoutOptions& o) {
     std::vector<std::array<int, 4>> quads = m.quads;
     std::vector<int> node_ring = m.ring;
     pillow_flat_rings(quads, x, node_ring, arc, rings);
-    free_sharp_tips(quads, x, node_ring, arc, rings);
-    if (optimize) {
+    if (level >= 3) free_sharp_tips(quads, x, node_ring, arc, rings);
+    if (level >= 1) {
       smooth_inner_nodes(x, quads, node_ring, arc, rings);
       for (int pass = 0; pass < 3; ++pass) {
         slide_ring_nodes(x, arc, quads, node_ring, rings);
         smooth_inner_nodes(x, quads, node_ring, arc, rings);
       }
-      improve_worst_corners(x, quads, node_ring, arc, rings);
     }
+    if (level >= 2) improve_worst_corners(x, quads, node_ring, arc, rings);
     // Edges: shared by two quads (inner: cuts) or one (on a ring).
-    std::map<std::pair<int, int>, int> edge_quads;
-    for (const auto& q : quads)
-      for (int j = 0; j < 4; ++j) ++edge_quads[{std::min(q[j], q[(j + 1) % 4]), std::max(q[j], q[(j + 1) % 4])}];
+    const std::map<std::pair<int, int>, int> edge_quads = edge_uses(quads);
     std::vector<int> inner_degree(x.size(), 0), degree(x.size(), 0);
     for (const auto& [e, count] : edge_quads) {
       ++degree[e.first], ++degree[e.second];
@@ -677,13 +692,25 @@ QuadLayout build_quad_layout(const Domain& d, const QuadLayoutOptions& o) {
       if (node_ring[n] >= 0 && inner_degree[n] == 0 && degree[n] > 0) out.ring_corners.push_back(x[n]);
     try {
       out.layout = build_patch_layout(d, std::move(cuts), out.ring_corners);
+      // Every patch corner convex where the map sees it (at the vertex itself).
+      for (const Patch& p : out.layout.patches)
+        for (int k = 0; k < 4; ++k) {
+          const auto& v = p.polygon.vertices;
+          const std::size_t c = p.corners[k], n = v.size();
+          const Eigen::Vector2d a = v[(c + 1) % n] - v[c], b = v[(c + n - 1) % n] - v[c];
+          if (!(cross(a, b) > 1e-3 * a.norm() * b.norm()))
+            throw InputError("a patch corner of 180 degrees or more at " + std::to_string(v[c].x()) + ", " +
+                             std::to_string(v[c].y()));
+        }
     } catch (const InputError& e) {
       // The optimization tangled the layout somewhere (a tangled start near
-      // rings much closer than the patch size): the same mesh, not optimized.
-      if (!optimize) throw NumericalError(std::string("no valid quad layout: ") + e.what());
-      optimize = false;
+      // rings much closer than the patch size, or a corner turned reflex):
+      // the same mesh, optimized less (level 3: all; 2: no sharp-tip rotations;
+      // 1: smoothing and sliding only; 0: the mesher's nodes).
+      if (level == 0) throw NumericalError(std::string("no valid quad layout: ") + e.what());
+      --level;
       out.ring_corners.clear();
-      out.stats.optimized = false;
+      out.stats.optimization_level = level;
       continue;
     }
     QuadLayoutStats& st = out.stats;

@@ -11,26 +11,25 @@ RingCurve::RingCurve(const std::vector<Eigen::Vector2d>& vertices) : v_(vertices
   for (std::size_t i = 0; i < v_.size(); ++i) arc_[i + 1] = arc_[i] + (v_[(i + 1) % v_.size()] - v_[i]).norm();
 }
 
-Eigen::Vector2d RingCurve::point(double s) const {
+std::pair<std::size_t, double> RingCurve::edge_at(double s) const {
   const double L = length();
   s = std::fmod(s, L);
   if (s < 0.0) s += L;
   // The edge [i, i+1] with arc(i) <= s < arc(i+1).
   const auto it = std::upper_bound(arc_.begin(), arc_.end(), s);
-  std::size_t i = static_cast<std::size_t>(std::max<std::ptrdiff_t>(0, (it - arc_.begin()) - 1));
-  i = std::min(i, v_.size() - 1);
+  const std::size_t i = static_cast<std::size_t>(std::max<std::ptrdiff_t>(0, (it - arc_.begin()) - 1));
+  return {std::min(i, v_.size() - 1), s};
+}
+
+Eigen::Vector2d RingCurve::point(double s_in) const {
+  const auto [i, s] = edge_at(s_in);
   const double len = arc_[i + 1] - arc_[i];
   const double t = len > 0.0 ? (s - arc_[i]) / len : 0.0;
   return v_[i] + t * (v_[(i + 1) % v_.size()] - v_[i]);
 }
 
-double RingCurve::snap_to_vertex(double s, double eps) const {
-  const double L = length();
-  s = std::fmod(s, L);
-  if (s < 0.0) s += L;
-  const auto it = std::upper_bound(arc_.begin(), arc_.end(), s);
-  std::size_t i = static_cast<std::size_t>(std::max<std::ptrdiff_t>(0, (it - arc_.begin()) - 1));
-  i = std::min(i, v_.size() - 1);
+double RingCurve::snap_to_vertex(double s_in, double eps) const {
+  const auto [i, s] = edge_at(s_in);
   if (s - arc_[i] <= eps) return arc_[i];
   if (arc_[i + 1] - s <= eps) return i + 1 == v_.size() ? 0.0 : arc_[i + 1];
   return s;

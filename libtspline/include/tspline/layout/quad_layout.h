@@ -46,9 +46,11 @@ struct QuadLayoutStats {
   double min_corner_scaled_jacobian = 1.0;   ///< of the quads with straight sides (chords on the rings)
   double mean_corner_scaled_jacobian = 1.0;
   int repair_rounds = 0;
-  /// The layout's nodes were smoothed and slid (false: that tangled the layout,
-  /// and the mesher's own nodes were kept).
-  bool optimized = true;
+  /// How far the layout was optimized: 3 all (sharp-tip rotations, smoothing,
+  /// sliding, worst corners), 2 without the rotations, 1 smoothing and sliding,
+  /// 0 the mesher's own nodes (a level is dropped where it tangles the layout
+  /// or turns a patch corner reflex).
+  int optimization_level = 3;
   double min_size = 0.0, max_size = 0.0;     ///< of the size field, absolute
   double seconds = 0.0;
 };

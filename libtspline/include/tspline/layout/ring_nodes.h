@@ -15,6 +15,7 @@
 #include <Eigen/Core>
 #include <cstddef>
 #include <functional>
+#include <utility>
 #include <vector>
 
 #include "tspline/boundary/domain.h"
@@ -42,6 +43,8 @@ class RingCurve {
   double snap_to_vertex(double s, double eps) const;
 
  private:
+  /// The edge i with arc(i) <= s < arc(i + 1), and s reduced to [0, length).
+  std::pair<std::size_t, double> edge_at(double s) const;
   std::vector<Eigen::Vector2d> v_;
   std::vector<double> arc_;  // size() + 1 entries
 };
