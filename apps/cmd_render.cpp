@@ -71,7 +71,7 @@ void add_render_command(CLI::App& app, CommandAction& action) {
       if (!a->quiet) {
         std::cout << "wrote " << a->png << " (" << o.width << "x" << o.height << ", " << view_name(s.view)
                   << " from " << s.source;
-        if (s.view == tspline::io::RenderView::Layout) std::cout << ", " << s.max << " patches";
+        if (s.view == tspline::io::RenderView::Layout) std::cout << ", " << s.max << (s.max == 1 ? " patch" : " patches");
         else if (s.max > s.min) std::cout << ", range " << s.min << " .. " << s.max;
         std::cout << ")" << std::endl;
       }

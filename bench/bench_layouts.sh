@@ -27,19 +27,25 @@ except Exception:
     print(f"{name}: exit {rc}, no report: {open(err).read().strip()[:300]}")
     sys.exit()
 mib = int(mem) // 1024 if mem.isdigit() else -1
+def g(v):  # a figure, or ? where the report has none (null: not finite)
+    return f"{v:.3g}" if isinstance(v, (int, float)) else "?"
 layout = r.get("layout", {}).get("chosen", "?")
 if "totals" in r:
     T = r["totals"]
+    W = T.get("whole_map", {})
     print(f"{name}: exit {rc}, layout {layout}, {len(r['patches'])} patches, {T['cells']} cells, "
-          f"{T['bezier_elements']} elements, certified {T['certified_valid']}, det J bound {T['min_relative_det_lower_bound']:.3g}, "
-          f"J_r {T['min_mean_ratio_whole_map']:.3g}, SJ {T['min_scaled_jacobian_whole_map']:.3g} (dense), "
-          f"area error {T['area_relative_error']:.2g}, gap {T['max_interface_gap_relative']:.2g}, {float(t):.1f} s, {mib} MiB")
+          f"{T['bezier_elements']} elements, certified {T['certified_valid']}, det J bound {g(T['min_relative_det_lower_bound'])}, "
+          f"J_r {g(T['min_mean_ratio_whole_map'])}, SJ {g(T['min_scaled_jacobian_whole_map'])} (dense 9x9), "
+          f"certified J_r >= {g(W.get('mean_ratio', {}).get('certified_lower_bound'))}, SJ >= {g(W.get('scaled_jacobian', {}).get('certified_lower_bound'))}, "
+          f"area error {g(T['area_relative_error'])}, gap {g(T['max_interface_gap_relative'])}, {float(t):.1f} s, {mib} MiB")
 else:
     w = r["jacobian"]["whole_map"]
     c = r["certification"]
     print(f"{name}: exit {rc}, layout {layout}, 1 patch, {r['counts']['cells']} cells, {c['elements']} elements, "
-          f"certified {r['certified_valid']}, det J bound {c['min_relative_det_lower_bound']:.3g}, "
-          f"J_r {w['min_mean_ratio']:.3g}, SJ {w['min_scaled']:.3g} (dense), {float(t):.1f} s, {mib} MiB")
+          f"certified {r['certified_valid']}, det J bound {g(c['min_relative_det_lower_bound'])}, "
+          f"J_r {g(w['min_mean_ratio'])}, SJ {g(w['min_scaled'])} (dense 9x9), "
+          f"certified J_r >= {g(w.get('mean_ratio', {}).get('certified_lower_bound'))}, SJ >= {g(w.get('scaled_jacobian', {}).get('certified_lower_bound'))}, "
+          f"{float(t):.1f} s, {mib} MiB")
 PY
 done
 rm -rf "$OUT"

@@ -177,6 +177,25 @@ TEST_SUITE("render") {
       CHECK(st.drawn_fraction >= c.min_drawn);
       CHECK(st.drawn_fraction <= c.max_drawn);
     }
+    // The layout view: one colour per patch (the palette has 10), outlines and corners.
+    {
+      const auto h = run_app("param " + q(std::string(TSPLINE_TEST_DATA_DIR) + "/holes/plate_with_hole.txt") +
+                                 " --out " + q(d / "plate") + " -q",
+                             d);
+      REQUIRE(h.exit_code == 0);
+      const fs::path png = d / "plate_layout.png";
+      const auto r = run_app("render " + q(d / "plate") + " --png " + q(png) + " --view layout --size 600x600", d);
+      CAPTURE(r.err);
+      REQUIRE(r.exit_code == 0);
+      CHECK(test_support::contains(r.out, "8 patches"));  // the plate's automatic cuts: 8 patches
+      const PngStats st = png_stats(png);
+      CHECK(st.colours >= 8 + 2);  // eight patch colours, black outlines, red corners (and antialiasing)
+      CHECK(st.drawn_fraction >= 0.5);
+      // A single patch is one colour.
+      const auto one = run_app("render " + q(d / "param") + " --png " + q(d / "one.png") + " --view layout", d);
+      CHECK(one.exit_code == 0);
+      CHECK(test_support::contains(one.out, ", 1 patch)"));
+    }
     // The same view as SVG and PDF, by the extension.
     for (const char* ext : {"svg", "pdf"}) {
       const fs::path file = d / (std::string("jacobian.") + ext);

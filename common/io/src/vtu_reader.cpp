@@ -61,6 +61,15 @@ VtuMesh read_vtu(const std::string& path) {
     for (vtkIdType k = 0; k < ids->GetNumberOfIds(); ++k) cell.push_back(static_cast<int>(ids->GetId(k)));
   }
   copy_arrays(grid->GetPointData(), np, out.point_scalars);
+  // Vectors of points (3 components; the writer's 2D vectors have z = 0).
+  vtkPointData* pd = grid->GetPointData();
+  for (int a = 0; a < pd->GetNumberOfArrays(); ++a) {
+    vtkDataArray* arr = vtkDataArray::SafeDownCast(pd->GetAbstractArray(a));
+    if (!arr || arr->GetNumberOfComponents() != 3 || arr->GetName() == nullptr) continue;
+    std::vector<Eigen::Vector2d>& v = out.point_vectors[arr->GetName()];
+    v.resize(static_cast<std::size_t>(np));
+    for (vtkIdType i = 0; i < np; ++i) v[static_cast<std::size_t>(i)] = {arr->GetComponent(i, 0), arr->GetComponent(i, 1)};
+  }
   copy_arrays(grid->GetCellData(), nc, out.cell_scalars);
   return out;
 }

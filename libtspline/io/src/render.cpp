@@ -156,26 +156,20 @@ fs::path solution_step(const fs::path& dir, int step) {
   return file;
 }
 
-/// The layout of a multi-patch surface.vtu (cell data "patch"): each patch
-/// filled with its own colour, the patch outlines (interfaces and boundary)
-/// drawn, and the layout nodes where three or more patches meet, or two on the
-/// domain's boundary, marked. Returns the number of patches.
+/// The layout of a multi-patch surface.vtu (cell data "patch", point data
+/// "parametric"): each patch filled with its own colour, the patch outlines
+/// (the sub-quad edges on the border of the unit square: interfaces and the
+/// domain's boundary) in black, the patch corners (the images of the square's
+/// corners) in red. Returns the number of patches.
 std::size_t draw_layout(Canvas& img, const toolkit::io::VtuMesh& m) {
   // A single-patch map has no "patch" array: one patch.
   const auto it = m.cell_scalars.find("patch");
   const std::vector<double> patch = it != m.cell_scalars.end() ? it->second : std::vector<double>(m.cells.size(), 0.0);
-  Box box;
-  box.add(m);
-  const double eps = 1e-9 * std::max(box.hi.x() - box.lo.x(), box.hi.y() - box.lo.y());
-  using Key = std::pair<long long, long long>;
-  auto key = [&](const Eigen::Vector2d& p) {
-    return Key(std::llround(p.x() / eps), std::llround(p.y() / eps));
-  };
+  const auto pit = m.point_vectors.find("parametric");
   // A muted palette, patch p gets colour p mod 10 (neighbours mostly differ).
   static const Rgb palette[10] = {{253, 205, 158}, {179, 214, 237}, {204, 235, 197}, {247, 181, 189},
                                   {217, 201, 235}, {253, 237, 166}, {191, 230, 227}, {237, 209, 199},
                                   {224, 224, 224}, {214, 232, 153}};
-  std::map<std::pair<Key, Key>, std::map<int, int>> edges;  // edge -> patch -> count
   std::size_t patches = 0;
   for (std::size_t c = 0; c < m.cells.size(); ++c) {
     const auto& cell = m.cells[c];
@@ -185,29 +179,26 @@ std::size_t draw_layout(Canvas& img, const toolkit::io::VtuMesh& m) {
     std::vector<Eigen::Vector2d> poly;
     for (const auto v : cell) poly.push_back(m.points[v]);
     img.fill_polygon(poly, palette[p % 10]);
-    for (std::size_t k = 0; k < cell.size(); ++k) {
-      Key a = key(m.points[cell[k]]), b = key(m.points[cell[(k + 1) % cell.size()]]);
-      if (b < a) std::swap(a, b);
-      ++edges[{a, b}][p];
+  }
+  if (pit == m.point_vectors.end()) {
+    draw_all_edges(img, m, kDark, 0.5);
+    return patches;
+  }
+  const std::vector<Eigen::Vector2d>& uv = pit->second;
+  auto at = [](double t, double e) { return std::abs(t - e) <= 1e-12; };
+  auto on_border = [&](int a, int b) {
+    for (const double e : {0.0, 1.0})
+      if ((at(uv[a].x(), e) && at(uv[b].x(), e)) || (at(uv[a].y(), e) && at(uv[b].y(), e))) return true;
+    return false;
+  };
+  for (const auto& cell : m.cells)
+    for (std::size_t k = 0; k < cell.size() && cell.size() >= 3; ++k) {
+      const int a = cell[k], b = cell[(k + 1) % cell.size()];
+      if (on_border(a, b)) img.draw_line(m.points[a], m.points[b], kBlack, 1.0);
     }
-  }
-  std::map<Key, std::set<int>> node_patches;
-  std::set<Key> on_boundary;
-  for (const auto& [e, per_patch] : edges) {
-    int outlines = 0;
-    for (const auto& [p, count] : per_patch)
-      if (count == 1) {
-        ++outlines;
-        node_patches[e.first].insert(p), node_patches[e.second].insert(p);
-      }
-    if (outlines == 0) continue;
-    const Eigen::Vector2d a(e.first.first * eps, e.first.second * eps), b(e.second.first * eps, e.second.second * eps);
-    img.draw_line(a, b, kBlack, outlines == 1 ? 1.5 : 1.0);
-    if (outlines == 1) on_boundary.insert(e.first), on_boundary.insert(e.second);
-  }
-  for (const auto& [k, ps] : node_patches)
-    if (ps.size() >= 3 || (ps.size() == 2 && on_boundary.count(k)))
-      img.draw_dot(Eigen::Vector2d(k.first * eps, k.second * eps), 2.5, kRed);
+  for (std::size_t v = 0; v < uv.size(); ++v)
+    if ((at(uv[v].x(), 0.0) || at(uv[v].x(), 1.0)) && (at(uv[v].y(), 0.0) || at(uv[v].y(), 1.0)))
+      img.draw_dot(m.points[v], 2.5, kRed);
   return patches;
 }
 

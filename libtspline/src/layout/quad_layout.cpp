@@ -295,6 +295,104 @@ void slide_ring_nodes(std::vector<Eigen::Vector2d>& x, std::vector<double>& arc,
   }
 }
 
+// Whether ring node v, as the corner of a single quad (v, a, ., b), would be
+// a flat (inner angle above 150 degrees) or reflex patch corner: between the
+// chords to a and b, or between the ring's own edges at v.
+bool flat_single_corner(const std::vector<Eigen::Vector2d>& x, const std::vector<int>& ring,
+                        const std::vector<double>& arc, const std::vector<RingCurve>& rings, int v, int a, int b) {
+  auto flat_or_reflex = [](const Eigen::Vector2d& p, const Eigen::Vector2d& next, const Eigen::Vector2d& prev) {
+    const double sv = corner_sj(p, next, prev);
+    return sv < 0.0 || (sv <= 0.5 && (next - p).dot(prev - p) < 0.0);
+  };
+  const RingCurve& rc = rings[ring[v]];
+  const double delta = 1e-6 * std::min((x[a] - x[v]).norm(), (x[b] - x[v]).norm());
+  const double dir = ring[v] == 0 ? 1.0 : -1.0;  // the domain lies left of the outer ring, right of holes
+  return flat_or_reflex(x[v], x[a], x[b]) ||
+         flat_or_reflex(x[v], rc.point(arc[v] + dir * delta), rc.point(arc[v] - dir * delta));
+}
+
+// A flat single-quad ring corner moved along its ring by edge rotations until
+// it lands where a patch corner is fine (a convex turn of the ring, or a node
+// with more quads): the quad (v, a, o, b) and its neighbour across (a, o),
+// (o, a, p, r), become (v, a, p, r) and (v, r, o, b), so that v has two quads
+// and a one fewer (and o, an inner node, one fewer: never below three); then
+// the same from a, up to 8 steps, in whichever direction ends first. Returns
+// the corners moved; the others are left to pillowing.
+std::size_t walk_flat_ring_corners(std::vector<std::array<int, 4>>& quads, const std::vector<Eigen::Vector2d>& x,
+                                   const std::vector<int>& ring, const std::vector<double>& arc,
+                                   const std::vector<RingCurve>& rings) {
+  std::size_t moved = 0;
+  for (std::size_t v0 = 0; v0 < x.size(); ++v0) {
+    if (ring[v0] < 0) continue;
+    std::vector<std::vector<int>> quads_of = quads_around(x.size(), quads);
+    if (quads_of[v0].size() != 1) continue;
+    {
+      std::array<int, 4> q = quads[quads_of[v0][0]];
+      while (q[0] != static_cast<int>(v0)) std::rotate(q.begin(), q.begin() + 1, q.end());
+      if (!flat_single_corner(x, ring, arc, rings, static_cast<int>(v0), q[1], q[3])) continue;
+    }
+    std::vector<std::array<int, 4>> best;
+    int best_steps = 1 << 30;
+    for (const bool forward : {true, false}) {
+      std::vector<std::array<int, 4>> trial = quads;
+      int v = static_cast<int>(v0), steps = 0;
+      bool ok = false;
+      for (; steps < 8; ++steps) {
+        const std::vector<std::vector<int>> around = quads_around(x.size(), trial);
+        if (around[v].size() != 1) break;
+        const int qi = around[v][0];
+        std::array<int, 4> q = trial[qi];
+        while (q[0] != v) std::rotate(q.begin(), q.begin() + 1, q.end());
+        // Mirror the quad for the other direction: (v, b, o, a) walks towards b.
+        const int a = forward ? q[1] : q[3], o = q[2], b = forward ? q[3] : q[1];
+        if (ring[a] < 0 || ring[o] >= 0 || around[o].size() < 4) break;
+        // The neighbour across (a, o).
+        int ni = -1, nj = -1;
+        for (int cand : around[a])
+          for (int j = 0; j < 4; ++j)
+            if (cand != qi && ((trial[cand][j] == o && trial[cand][(j + 1) % 4] == a) ||
+                               (trial[cand][j] == a && trial[cand][(j + 1) % 4] == o)))
+              ni = cand, nj = j;
+        if (ni < 0) break;
+        std::array<int, 4> n = trial[ni];
+        while (n[0] != (forward ? o : a)) std::rotate(n.begin(), n.begin() + 1, n.end());
+        // forward: n = (o, a, p, r); backward (mirrored): n = (a, o, r, p).
+        const int p = forward ? n[2] : n[3], r = forward ? n[3] : n[2];
+        if (p == v || r == v) break;
+        if (forward) {
+          trial[qi] = {v, a, p, r};
+          trial[ni] = {v, r, o, b};
+        } else {
+          trial[qi] = {v, r, p, a};
+          trial[ni] = {v, b, o, r};
+        }
+        (void)nj;
+        // Where the corner is now: a, with one quad fewer.
+        const std::vector<std::vector<int>> after = quads_around(x.size(), trial);
+        if (after[a].size() >= 2) {
+          ok = true;
+          ++steps;
+          break;
+        }
+        std::array<int, 4> qa = trial[after[a][0]];
+        while (qa[0] != a) std::rotate(qa.begin(), qa.begin() + 1, qa.end());
+        if (!flat_single_corner(x, ring, arc, rings, a, qa[1], qa[3])) {
+          ok = true;
+          ++steps;
+          break;
+        }
+        v = a;
+      }
+      if (ok && steps < best_steps) best = trial, best_steps = steps;
+    }
+    if (best_steps < (1 << 30)) {
+      quads = std::move(best);
+      ++moved;
+    }
+  }
+  return moved;
+}
+
 // A ring node that is the corner of one quad only, where the ring is nearly
 // straight (inner angle above 150 degrees, between the chords to the quad's
 // neighbours or between the ring's own edges at the node) or reflex, would be
@@ -507,7 +605,7 @@ std::string QuadLayout::explanation() const {
   s << "), straight-sided scaled Jacobian min " << stats.min_corner_scaled_jacobian << " mean "
     << stats.mean_corner_scaled_jacobian
     << (stats.optimization_level == 3   ? ""
-        : stats.optimization_level == 2 ? " (sharp tips not rotated: that broke it)"
+        : stats.optimization_level == 2 ? " (no edge rotations: they broke it)"
         : stats.optimization_level == 1 ? " (worst corners not optimized: that broke it)"
                                         : " (nodes not optimized: that tangled it)");
   return s.str();
@@ -541,8 +639,14 @@ QuadLayout build_quad_layout(const Domain& d, const QuadLayoutOptions& o) {
 
   QuadLayout out;
   int level = 3;
+  int repairs = 0;  // rounds that added nodes (dropping an optimization level is not one)
   for (int round = 0;; ++round) {
-    if (round > o.max_repair_rounds)
+    // Optimized nodes that keep crossing the rings after many repairs: optimize less.
+    if (repairs > 0 && repairs % 10 == 0 && level > 0 && repairs / 10 > 3 - level) {
+      --level;
+      out.stats.optimization_level = level;
+    }
+    if (repairs > o.max_repair_rounds)
       throw NumericalError("no quad layout found: the layout still crosses the boundary after " +
                            std::to_string(o.max_repair_rounds) + " rounds of adding nodes");
     std::vector<std::set<std::size_t>> to_split(rings.size());
@@ -583,6 +687,7 @@ QuadLayout build_quad_layout(const Domain& d, const QuadLayoutOptions& o) {
       }
     auto split_marked = [&]() {
       bool any = false;
+
       for (std::size_t r = 0; r < rings.size(); ++r) {
         // Split from the last piece down: indices of earlier pieces stay valid.
         for (auto it = to_split[r].rbegin(); it != to_split[r].rend(); ++it) {
@@ -593,7 +698,7 @@ QuadLayout build_quad_layout(const Domain& d, const QuadLayoutOptions& o) {
       return any;
     };
     if (split_marked()) {
-      out.stats.repair_rounds = round + 1;
+      out.stats.repair_rounds = ++repairs;
       continue;
     }
 
@@ -614,7 +719,7 @@ QuadLayout build_quad_layout(const Domain& d, const QuadLayoutOptions& o) {
       const std::size_t n = straight[r].size(), k = static_cast<std::size_t>(curve);
       for (const std::size_t j : {(k + n - 1) % n, k, (k + 1) % n}) to_split[r].insert(j);
       split_marked();
-      out.stats.repair_rounds = round + 1;
+      out.stats.repair_rounds = ++repairs;
       continue;
     }
     // Boundary nodes onto the true rings.
@@ -631,8 +736,11 @@ QuadLayout build_quad_layout(const Domain& d, const QuadLayoutOptions& o) {
     }
     std::vector<std::array<int, 4>> quads = m.quads;
     std::vector<int> node_ring = m.ring;
+    if (level >= 3) walk_flat_ring_corners(quads, x, node_ring, arc, rings);
     pillow_flat_rings(quads, x, node_ring, arc, rings);
     if (level >= 3) free_sharp_tips(quads, x, node_ring, arc, rings);
+    const std::vector<Eigen::Vector2d> x_start = x;  // the mesher's nodes, on the true rings
+    const std::vector<double> arc_start = arc;
     if (level >= 1) {
       smooth_inner_nodes(x, quads, node_ring, arc, rings);
       for (int pass = 0; pass < 3; ++pass) {
@@ -660,26 +768,45 @@ QuadLayout build_quad_layout(const Domain& d, const QuadLayoutOptions& o) {
         }
       to_split[br].insert(piece_of(nodes[br], rings[br].arc(be)));
     };
-    for (std::size_t n = 0; n < x.size(); ++n)
-      if (node_ring[n] < 0 && grid.ray_crossings(x[n]) % 2 == 0) mark_nearest_piece(x[n]);
-    for (const auto& [e, count] : edge_quads) {
-      if (count != 2) continue;
-      const Eigen::Vector2d a = x[e.first], b = x[e.second];
-      for (int g : grid.near(a.cwiseMin(b), a.cwiseMax(b))) {
-        const auto& f = grid.edge(g);
-        if (!segments_intersect(a, b, f.a, f.b)) continue;
-        // Allowed: the cut's end on this ring edge, the rest of the cut off it.
-        const bool a_on = node_ring[e.first] >= 0 && segment_distance(a, f.a, f.b) <= tol;
-        const bool b_on = node_ring[e.second] >= 0 && segment_distance(b, f.a, f.b) <= tol;
-        if (a_on != b_on) {
-          const Eigen::Vector2d from = a_on ? a + 1e-6 * (b - a) : a, to = b_on ? b + 1e-6 * (a - b) : b;
-          if (!segments_intersect(from, to, f.a, f.b)) continue;
+    // The nodes involved in a violation: inner nodes outside the domain, the
+    // ends of inner edges that cross a ring. Those the optimization moved go
+    // back where the mesher put them; what still fails gets ring nodes more.
+    auto violations = [&](bool mark) {
+      std::set<int> involved;
+      for (std::size_t n = 0; n < x.size(); ++n)
+        if (node_ring[n] < 0 && grid.ray_crossings(x[n]) % 2 == 0) {
+          involved.insert(static_cast<int>(n));
+          if (mark) mark_nearest_piece(x[n]);
         }
-        to_split[f.ring].insert(piece_of(nodes[f.ring], rings[f.ring].arc(f.index)));
+      for (const auto& [e, count] : edge_quads) {
+        if (count != 2) continue;
+        const Eigen::Vector2d a = x[e.first], b = x[e.second];
+        for (int g : grid.near(a.cwiseMin(b), a.cwiseMax(b))) {
+          const auto& f = grid.edge(g);
+          if (!segments_intersect(a, b, f.a, f.b)) continue;
+          // Allowed: the cut's end on this ring edge, the rest of the cut off it.
+          const bool a_on = node_ring[e.first] >= 0 && segment_distance(a, f.a, f.b) <= tol;
+          const bool b_on = node_ring[e.second] >= 0 && segment_distance(b, f.a, f.b) <= tol;
+          if (a_on != b_on) {
+            const Eigen::Vector2d from = a_on ? a + 1e-6 * (b - a) : a, to = b_on ? b + 1e-6 * (a - b) : b;
+            if (!segments_intersect(from, to, f.a, f.b)) continue;
+          }
+          involved.insert(e.first), involved.insert(e.second);
+          if (mark) to_split[f.ring].insert(piece_of(nodes[f.ring], rings[f.ring].arc(f.index)));
+        }
       }
+      return involved;
+    };
+    for (int pass = 0; pass < 3; ++pass) {
+      const std::set<int> bad = violations(false);
+      bool changed = false;
+      for (int n : bad)
+        if (x[n] != x_start[n]) x[n] = x_start[n], arc[n] = arc_start[n], changed = true;
+      if (!changed) break;
     }
+    violations(true);
     if (split_marked()) {
-      out.stats.repair_rounds = round + 1;
+      out.stats.repair_rounds = ++repairs;
       continue;
     }
 
@@ -698,15 +825,21 @@ QuadLayout build_quad_layout(const Domain& d, const QuadLayoutOptions& o) {
           const auto& v = p.polygon.vertices;
           const std::size_t c = p.corners[k], n = v.size();
           const Eigen::Vector2d a = v[(c + 1) % n] - v[c], b = v[(c + n - 1) % n] - v[c];
-          if (!(cross(a, b) > 1e-3 * a.norm() * b.norm()))
-            throw InputError("a patch corner of 180 degrees or more at " + std::to_string(v[c].x()) + ", " +
+          // Between 1 and 170 degrees (sin 1 deg = 0.0175, sin 10 deg = 0.174): a corner
+          // near 180 degrees leaves the patch map det J ~ 0 there.
+          // (The mesher's own layout, level 0, only needs convex corners.)
+          const double sn = cross(a, b) / (a.norm() * b.norm());
+          const bool fine = level == 0 ? sn > 1e-3 : sn > 0.0175 && (a.dot(b) > 0.0 || sn > 0.174);
+          if (!fine)
+            throw InputError("a patch corner outside 1-170 degrees at " + std::to_string(v[c].x()) + ", " +
                              std::to_string(v[c].y()));
         }
     } catch (const InputError& e) {
       // The optimization tangled the layout somewhere (a tangled start near
       // rings much closer than the patch size, or a corner turned reflex):
-      // the same mesh, optimized less (level 3: all; 2: no sharp-tip rotations;
-      // 1: smoothing and sliding only; 0: the mesher's nodes).
+      // the same mesh, optimized less (level 3: all; 2: no edge rotations (flat
+      // corners walked, sharp tips freed); 1: smoothing and sliding only; 0: the
+      // mesher's nodes).
       if (level == 0) throw NumericalError(std::string("no valid quad layout: ") + e.what());
       --level;
       out.ring_corners.clear();

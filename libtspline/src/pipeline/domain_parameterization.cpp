@@ -142,9 +142,26 @@ DomainParameterization parameterize_domain(const Domain& input, const Parameteri
   std::string why = !certified ? std::string("one patch is not certified after ") +
                                      std::to_string(first.max_adapt) + " adaptive rounds"
                                : "one patch is certified but poor over the whole map (" + figures(q) + ")";
-  out.rejected_single = q;
   report_step(options.progress, "layout", why + ": building a quad layout");
-  run_quad(why);
+  try {
+    run_quad(why);
+    if (!adaptive.certify || out.patches->certified_valid() || !certified) {
+      out.rejected_single = q;
+      return out;
+    }
+    why = "the quad layout's map is not certified on every patch; one patch is (" + figures(q) + ")";
+  } catch (const NumericalError& e) {
+    if (!certified) throw;
+    why = std::string("no quad layout (") + e.what() + "); one patch is certified (" + figures(q) + ")";
+  }
+  // The quad layout did worse than the certified single patch: keep that one.
+  report_step(options.progress, "layout", why);
+  out.patches.reset();
+  out.quad_stats.reset();
+  out.layout = "single";
+  out.reason = why;
+  if (cut_short) single = run_parameterization(domain.outer, options, adaptive, on_iteration);
+  out.single.emplace(std::move(single));
   return out;
 }
 

@@ -46,8 +46,9 @@ struct QuadLayoutStats {
   double min_corner_scaled_jacobian = 1.0;   ///< of the quads with straight sides (chords on the rings)
   double mean_corner_scaled_jacobian = 1.0;
   int repair_rounds = 0;
-  /// How far the layout was optimized: 3 all (sharp-tip rotations, smoothing,
-  /// sliding, worst corners), 2 without the rotations, 1 smoothing and sliding,
+  /// How far the layout was optimized: 3 all (edge rotations of flat corners
+  /// and sharp tips, smoothing, sliding, worst corners), 2 without the
+  /// rotations, 1 smoothing and sliding,
   /// 0 the mesher's own nodes (a level is dropped where it tangles the layout
   /// or turns a patch corner reflex).
   int optimization_level = 3;
