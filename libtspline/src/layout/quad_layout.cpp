@@ -840,7 +840,25 @@ QuadLayout build_quad_layout(const Domain& d, const QuadLayoutOptions& o) {
       // the same mesh, optimized less (level 3: all; 2: no edge rotations (flat
       // corners walked, sharp tips freed); 1: smoothing and sliding only; 0: the
       // mesher's nodes).
-      if (level == 0) throw NumericalError(std::string("no valid quad layout: ") + e.what());
+      if (level == 0) {
+        // Two cuts of the mesher's own layout cross (the true rings are far
+        // from their chords there): ring nodes more near the place, and again.
+        const std::string what = e.what();
+        const std::size_t at = what.find("cross near (");
+        if (at == std::string::npos || repairs >= o.max_repair_rounds)
+          throw NumericalError("no valid quad layout: " + what);
+        const char* p = what.c_str() + at + 12;
+        char* end = nullptr;
+        const double px = std::strtod(p, &end);
+        const double py = end && *end == ',' ? std::strtod(end + 1, nullptr) : 0.0;
+        mark_nearest_piece(Eigen::Vector2d(px, py));
+        split_marked();
+        out.ring_corners.clear();
+        out.stats.repair_rounds = ++repairs;
+        level = 3;  // the new mesh is optimized again
+        out.stats.optimization_level = level;
+        continue;
+      }
       --level;
       out.ring_corners.clear();
       out.stats.optimization_level = level;

@@ -86,6 +86,7 @@ DomainParameterization parameterize_domain(const Domain& input, const Parameteri
   if (holes) {
     // A few holes: the automatic cuts first (few, large patches), kept where good.
     std::string why = "the domain has holes";
+    std::optional<MultiPatchResult> by_cuts;  // kept in case the quad layout does worse
     if (domain.holes.size() <= static_cast<std::size_t>(c.first_try_max_holes) && quad_mesher_available()) {
       try {
         AutomaticCuts a = automatic_cuts(domain);
@@ -102,13 +103,31 @@ DomainParameterization parameterize_domain(const Domain& input, const Parameteri
           return out;
         }
         why = "the automatic cuts between the holes are certified but poor, or not certified (" + q.str() + ")";
+        if (!adaptive.certify || R.certified_valid()) by_cuts.emplace(std::move(R));
       } catch (const InputError& e) {
         why = std::string("the domain has holes, and no automatic cuts were found (") + e.what() + ")";
       }
       report_step(options.progress, "layout", why + ": building a quad layout");
     }
     if (quad_mesher_available()) {
-      run_quad(why);
+      if (!by_cuts) {
+        run_quad(why);
+        return out;
+      }
+      // The certified automatic cuts stay where the quad layout fails or is not certified.
+      std::string fallback;
+      try {
+        run_quad(why);
+        if (!adaptive.certify || out.patches->certified_valid()) return out;
+        fallback = "the quad layout's map is not certified on every patch";
+      } catch (const NumericalError& e) {
+        fallback = std::string("no quad layout (") + e.what() + ")";
+      }
+      report_step(options.progress, "layout", fallback + ": keeping the automatic cuts");
+      out.quad_stats.reset();
+      out.layout = "automatic cuts";
+      out.reason = why + "; " + fallback + ", so the certified automatic cuts are kept";
+      out.patches.emplace(std::move(*by_cuts));
       return out;
     }
     AutomaticCuts a = automatic_cuts(domain);
