@@ -9,7 +9,7 @@ cd "$(dirname "$0")/.."
 bash scripts/install_deps.sh
 bash scripts/build.sh
 T=./build/apps/tspline
-$T param tests/data/polygons/flower.txt --out out/flower -q
+$T param tests/data/polygons/flower.txt --layout single --out out/flower -q   # the one-patch pictures of the README
 $T poisson out/flower/tspline.json --problem gaussian --steps 8 --out out/flower_poisson -q
 mkdir -p docs/images
 for view in jacobian tmesh control-net; do
@@ -17,5 +17,5 @@ for view in jacobian tmesh control-net; do
 done
 $T render out/flower_poisson --view solution --size 800x600 --png docs/images/flower_poisson.png
 cp out/flower_poisson/convergence.png docs/images/flower_convergence.png
-$T param tests/data/gis/corsica_lonlat.geojson --out out/corsica -q
+$T param tests/data/gis/corsica_lonlat.geojson --layout single --out out/corsica -q
 $T render out/corsica --view jacobian --size 800x600 --png docs/images/corsica_jacobian.png
