@@ -15,6 +15,7 @@
 #include <random>
 
 #include "separable_maps.h"
+#include "perturbed_map.h"
 #include "test_support.h"
 #include "tspline/validity/map_certification.h"
 #include "tspline/validity/map_energy.h"
@@ -26,17 +27,7 @@ using tspline::TSplineMap;
 namespace {
 
 TSplineMap perturbed(unsigned seed, double amplitude, bool t_junctions = true) {
-  TSplineMap map = tspline::greville_identity_map(t_junctions ? test_support::random_leaf_splits(2, 6, seed)
-                                                              : test_support::uniform_mesh(2));
-  std::mt19937 rng(seed);
-  std::uniform_real_distribution<double> u(-amplitude, amplitude);
-  std::vector<Eigen::Vector2d> P = map.control_points();
-  for (std::size_t a = 0; a < P.size(); ++a) {
-    P[a] *= 10.0;
-    if (!tspline::touches_border(map.basis().function(static_cast<int>(a)))) P[a] += 10.0 * Eigen::Vector2d(u(rng), u(rng));
-  }
-  map.set_control_points(P);
-  return map;
+  return test_support::perturbed_map(seed, amplitude, t_junctions);
 }
 
 Eigen::Vector4d vec(const Eigen::Matrix2d& J) { return {J(0, 0), J(0, 1), J(1, 0), J(1, 1)}; }

@@ -13,6 +13,7 @@
 #include <random>
 
 #include "separable_maps.h"
+#include "perturbed_map.h"
 #include "test_support.h"
 #include "tspline/validity/map_certification.h"
 #include "tspline/validity/map_energy.h"
@@ -23,20 +24,8 @@ using tspline::TSplineMap;
 
 namespace {
 
-// The identity of [0,1]^2 scaled by 10 on a T-mesh with T-junctions, with every
-// interior control point moved at random by up to `amplitude` (units of 10).
 TSplineMap perturbed_map(unsigned seed, double amplitude, bool t_junctions = true) {
-  TSplineMap map = tspline::greville_identity_map(t_junctions ? test_support::random_leaf_splits(2, 6, seed)
-                                                              : test_support::uniform_mesh(2));
-  std::mt19937 rng(seed);
-  std::uniform_real_distribution<double> u(-amplitude, amplitude);
-  std::vector<Eigen::Vector2d> P = map.control_points();
-  for (std::size_t a = 0; a < P.size(); ++a) {
-    P[a] *= 10.0;
-    if (!tspline::touches_border(map.basis().function(static_cast<int>(a)))) P[a] += 10.0 * Eigen::Vector2d(u(rng), u(rng));
-  }
-  map.set_control_points(P);
-  return map;
+  return test_support::perturbed_map(seed, amplitude, t_junctions);
 }
 
 std::vector<Eigen::Vector2d> border_points(const TSplineMap& map) {
