@@ -27,6 +27,8 @@ int write_multipatch_param(const tspline::DomainParameterization& P, const tspli
                                 {"straight_min_scaled_jacobian", s.min_corner_scaled_jacobian},
                                 {"straight_mean_scaled_jacobian", s.mean_corner_scaled_jacobian},
                                 {"repair_rounds", s.repair_rounds},
+                                {"pillowed_rings", s.pillowed_rings},
+                                {"optimization_level", s.optimization_level},
                                 {"min_size", s.min_size},
                                 {"max_size", s.max_size},
                                 {"seconds", s.seconds}};

@@ -602,7 +602,9 @@ std::string QuadLayout::explanation() const {
     << stats.inner_nodes << " inside (valence";
   for (std::size_t v = 0; v < stats.valence.size(); ++v)
     if (stats.valence[v]) s << ' ' << v << (v == 7 ? "+" : "") << ": " << stats.valence[v];
-  s << "), straight-sided scaled Jacobian min " << stats.min_corner_scaled_jacobian << " mean "
+  s << ")";
+  if (stats.pillowed_rings) s << ", " << stats.pillowed_rings << " ring(s) pillowed";
+  s << ", straight-sided scaled Jacobian min " << stats.min_corner_scaled_jacobian << " mean "
     << stats.mean_corner_scaled_jacobian
     << (stats.optimization_level == 3   ? ""
         : stats.optimization_level == 2 ? " (no edge rotations: they broke it)"
@@ -737,7 +739,7 @@ QuadLayout build_quad_layout(const Domain& d, const QuadLayoutOptions& o) {
     std::vector<std::array<int, 4>> quads = m.quads;
     std::vector<int> node_ring = m.ring;
     if (level >= 3) walk_flat_ring_corners(quads, x, node_ring, arc, rings);
-    pillow_flat_rings(quads, x, node_ring, arc, rings);
+    out.stats.pillowed_rings = pillow_flat_rings(quads, x, node_ring, arc, rings);
     if (level >= 3) free_sharp_tips(quads, x, node_ring, arc, rings);
     const std::vector<Eigen::Vector2d> x_start = x;  // the mesher's nodes, on the true rings
     const std::vector<double> arc_start = arc;

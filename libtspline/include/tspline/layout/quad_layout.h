@@ -46,6 +46,7 @@ struct QuadLayoutStats {
   double min_corner_scaled_jacobian = 1.0;   ///< of the quads with straight sides (chords on the rings)
   double mean_corner_scaled_jacobian = 1.0;
   int repair_rounds = 0;
+  std::size_t pillowed_rings = 0;            ///< rings given a layer of quads (a flat single-quad corner)
   /// How far the layout was optimized: 3 all (edge rotations of flat corners
   /// and sharp tips, smoothing, sliding, worst corners), 2 without the
   /// rotations, 1 smoothing and sliding,
