@@ -164,16 +164,16 @@ DomainParameterization parameterize_domain(const Domain& input, const Parameteri
   report_step(options.progress, "layout", why + ": building a quad layout");
   try {
     run_quad(why);
-    if (!adaptive.certify || out.patches->certified_valid() || !certified) {
+    if (!adaptive.certify || out.patches->certified_valid()) {
       out.rejected_single = q;
       return out;
     }
-    why = "the quad layout's map is not certified on every patch; one patch is (" + figures(q) + ")";
+    why = "the quad layout's map is not certified on every patch; one patch instead";
   } catch (const NumericalError& e) {
-    if (!certified) throw;
-    why = std::string("no quad layout (") + e.what() + "); one patch is certified (" + figures(q) + ")";
+    why = std::string("no quad layout (") + e.what() + "); one patch instead";
   }
-  // The quad layout did worse than the certified single patch: keep that one.
+  // The quad layout failed or did worse: the single patch, with every adaptive
+  // round it may take (what layout single gives).
   report_step(options.progress, "layout", why);
   out.patches.reset();
   out.quad_stats.reset();
