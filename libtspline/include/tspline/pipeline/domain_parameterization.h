@@ -10,7 +10,9 @@
 //           and J_r >= 0.1 over the dense sample), the quad layout otherwise;
 //           for domains with holes the quad layout, unless they have at most
 //           4 holes and the automatic cuts are certified and good by the same
-//           measure. Without a quad mesher in the
+//           measure. Where the quad layout fails (NumericalError) or its map is
+//           not certified, auto keeps the single patch (run in full) or the
+//           certified automatic cuts. Without a quad mesher in the
 //           build, domains with holes fall back to the automatic cuts
 //           (automatic_cuts.h) and domains without keep the single patch.
 #include <functional>
