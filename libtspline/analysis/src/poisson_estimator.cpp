@@ -1,5 +1,5 @@
-// Errors, residual estimator, marking, refinement and the adaptive loop of the
-// IGA Poisson solver (see poisson.h).
+// Errors, interface jumps, residual estimator and marking of the IGA Poisson
+// solver (see poisson_solver.h, poisson_estimator.h).
 #include <Eigen/Dense>
 #include <algorithm>
 #include <array>
@@ -9,6 +9,8 @@
 #include <stdexcept>
 #include <vector>
 
+#include "tspline/boundary/border_knots.h"
+#include "tspline/multipatch/multipatch_parameterization.h"
 #include "tspline/spline/bezier_extraction.h"
 #include "tspline/errors.h"
 #include "tspline/validity/map_quality.h"
@@ -17,9 +19,6 @@
 namespace tspline {
 
 namespace {
-
-using Clock = std::chrono::steady_clock;
-double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
 
 Eigen::Vector2d exact_gradient(const PoissonProblem& p, double x, double y) {
   if (p.exact_gradient) return p.exact_gradient(x, y);
@@ -36,11 +35,14 @@ Eigen::Vector2d exact_gradient(const PoissonProblem& p, double x, double y) {
 /// per distinct coordinate (as the assembly's CellKernel does).
 class CellEvaluator {
  public:
-  CellEvaluator(const TSplineMap& map, const PoissonSolution& sol) : map_(map), sol_(sol) {}
+  explicit CellEvaluator(const PoissonSolution& sol) : sol_(sol) {}
 
-  /// Tabulates cell c at the points qp, derivatives up to `order` (1 or 2).
-  void set_cell(int c, const std::vector<QuadraturePoint>& qp, int order) {
+  /// Tabulates cell c of patch p at the points qp, derivatives up to `order` (1 or 2).
+  void set_cell(std::size_t p, int c, const std::vector<QuadraturePoint>& qp, int order) {
     order_ = order;
+    map_ = &sol_.space->map(p);
+    const PatchSpace& sp = sol_.space->patch(p);
+    const std::span<const int> dofs = sol_.space->dofs(p);
     xs_.clear();
     ys_.clear();
     qx_.resize(qp.size());
@@ -49,27 +51,27 @@ class CellEvaluator {
       qx_[q] = index_of(xs_, qp[q].uv.x());
       qy_[q] = index_of(ys_, qp[q].uv.y());
     }
-    const HierarchicalBasis& basis = sol_.space->basis();
+    const HierarchicalBasis& basis = sp.basis();
     ids_ = basis.functions_on_cell(c);
     coef_.resize(ids_.size());
-    for (std::size_t k = 0; k < ids_.size(); ++k) coef_[k] = sol_.coefficients[ids_[k]];
+    for (std::size_t k = 0; k < ids_.size(); ++k) coef_[k] = sol_.coefficients[dofs[ids_[k]]];
     analysis_.build(
         ids_.size(), [&](std::size_t k) -> const auto& { return basis.function(ids_[k]).knots_xi; },
         [&](std::size_t k) -> const auto& { return basis.function(ids_[k]).knots_eta; }, xs_, ys_, order);
-    const TSplineBasis& gb = map_.basis();
-    gids_ = &gb.functions_on_cell(sol_.space->geometry_cell(c));
+    const TSplineBasis& gb = map_->basis();
+    gids_ = &gb.functions_on_cell(sp.geometry_cell(c));
     geometry_.build(
         gids_->size(), [&](std::size_t k) -> const auto& { return gb.function((*gids_)[k]).knots_xi; },
         [&](std::size_t k) -> const auto& { return gb.function((*gids_)[k]).knots_eta; }, xs_, ys_, order);
   }
 
-  /// evaluate_solution(map, sol, c, qp[q].uv, order) of the current cell.
+  /// evaluate_solution(sol, p, c, qp[q].uv, order) of the current cell.
   SolutionValue at(std::size_t q) const {
     const bool d2 = order_ >= 2;
     // S = A / W with A = sum N_a P_a, W = sum N_a (TSplineBasis: R_a = N_a / W);
     // differentiating A = S W: S_i = (A_i - S W_i) / W,
     // S_ij = (A_ij - S_i W_j - S_j W_i - S W_ij) / W.
-    const std::vector<Eigen::Vector2d>& P = map_.control_points();
+    const std::vector<Eigen::Vector2d>& P = map_->control_points();
     double W = 0, Wx = 0, Wy = 0, Wxx = 0, Wxy = 0, Wyy = 0;
     Eigen::Vector2d A = Eigen::Vector2d::Zero(), Ax = A, Ay = A, Axx = A, Axy = A, Ayy = A;
     for (std::size_t k = 0; k < gids_->size(); ++k) {
@@ -170,8 +172,8 @@ class CellEvaluator {
     std::vector<Factor> ux_, uy_;
   };
 
-  const TSplineMap& map_;
   const PoissonSolution& sol_;
+  const TSplineMap* map_ = nullptr;  // the current cell's patch
   int order_ = 1;
   std::span<const int> ids_;
   const std::vector<int>* gids_ = nullptr;
@@ -182,19 +184,21 @@ class CellEvaluator {
 
 }  // namespace
 
-PoissonErrors compute_errors(const TSplineMap& map, const PoissonSolution& sol, const PoissonProblem& problem,
+PoissonErrors compute_errors(const PoissonSolution& sol, const PoissonProblem& problem,
                              const InteriorSystemSolver* distributed) {
   if (!problem.exact) throw InputError("Poisson errors: no exact solution given");
-  const TMesh& mesh = sol.space->mesh();
+  const AnalysisSpace& space = *sol.space;
   std::vector<QuadraturePoint> qp;
   PoissonErrors e;
   double l2 = 0, h1 = 0, l2u = 0, h1u = 0;
-  const int nc = static_cast<int>(mesh.num_cells());
+  const int nc = static_cast<int>(space.num_cells());
   const auto [first, last] = distributed ? distributed->cell_share(nc) : std::pair<int, int>{0, nc};
-  CellEvaluator cell(map, sol);
-  for (int c = first; c < last; ++c) {
-    box_quadrature(mesh.cell_min(c), mesh.cell_max(c), 6, qp, map.basis(), sol.space->geometry_cell(c));
-    cell.set_cell(c, qp, 1);
+  CellEvaluator cell(sol);
+  for (int gc = first; gc < last; ++gc) {
+    const auto [p, c] = space.cell(static_cast<std::size_t>(gc));
+    const TMesh& mesh = space.patch(p).mesh();
+    box_quadrature(mesh.cell_min(c), mesh.cell_max(c), 6, qp, space.map(p).basis(), space.patch(p).geometry_cell(c));
+    cell.set_cell(p, c, qp, 1);
     for (std::size_t iq = 0; iq < qp.size(); ++iq) {
       const QuadraturePoint& q = qp[iq];
       const SolutionValue v = cell.at(iq);
@@ -224,18 +228,33 @@ PoissonErrors compute_errors(const TSplineMap& map, const PoissonSolution& sol, 
   return e;
 }
 
-std::vector<double> estimate_cells(const TSplineMap& map, const PoissonSolution& sol, const PoissonProblem& problem,
+double interface_jump(const PoissonSolution& sol) {
+  double jump = 0.0;
+  for (const Interface& f : sol.space->geometry().interfaces)
+    for (int k = 0; k <= 32; ++k) {
+      const double t = k / 32.0;
+      const double ua = evaluate_solution(sol, f.patch_a, side_point_uv(f.side_a, t), 0).u;
+      const double ub = evaluate_solution(sol, f.patch_b, side_point_uv(f.side_b, reversed_param(t)), 0).u;
+      jump = std::max(jump, std::abs(ua - ub));
+    }
+  return jump;
+}
+
+std::vector<double> estimate_cells(const PoissonSolution& sol, const PoissonProblem& problem,
                                    std::vector<double>* eta_scale, const InteriorSystemSolver* distributed) {
-  const TMesh& mesh = sol.space->mesh();
+  const AnalysisSpace& space = *sol.space;
   std::vector<QuadraturePoint> qp;
-  std::vector<double> eta(mesh.num_cells(), 0.0);
-  if (eta_scale) eta_scale->assign(mesh.num_cells(), 0.0);
-  const int nc = static_cast<int>(mesh.num_cells());
+  std::vector<double> eta(space.num_cells(), 0.0);
+  if (eta_scale) eta_scale->assign(space.num_cells(), 0.0);
+  const int nc = static_cast<int>(space.num_cells());
   const auto [first, last] = distributed ? distributed->cell_share(nc) : std::pair<int, int>{0, nc};
-  CellEvaluator cell(map, sol);
-  for (int c = first; c < last; ++c) {
+  CellEvaluator cell(sol);
+  for (int gc = first; gc < last; ++gc) {
+    const auto [p, c] = space.cell(static_cast<std::size_t>(gc));
+    const TMesh& mesh = space.patch(p).mesh();
+    const TSplineMap& map = space.map(p);
     const Eigen::Vector2d lo = mesh.cell_min(c), hi = mesh.cell_max(c);
-    const int g = sol.space->geometry_cell(c);
+    const int g = space.patch(p).geometry_cell(c);
     // h_e: the longer diagonal of the image of the cell's corners.
     const Eigen::Vector2d p00 = map.derivatives(lo, 0, g).x, p11 = map.derivatives(hi, 0, g).x;
     const Eigen::Vector2d p10 = map.derivatives({hi.x(), lo.y()}, 0, g).x;
@@ -243,7 +262,7 @@ std::vector<double> estimate_cells(const TSplineMap& map, const PoissonSolution&
     const double h = std::max((p11 - p00).norm(), (p01 - p10).norm());
     double s = 0, scale = 0;
     box_quadrature(lo, hi, 4, qp, map.basis(), g);
-    cell.set_cell(c, qp, 2);
+    cell.set_cell(p, c, qp, 2);
     for (std::size_t iq = 0; iq < qp.size(); ++iq) {
       const QuadraturePoint& q = qp[iq];
       const SolutionValue v = cell.at(iq);
@@ -253,8 +272,8 @@ std::vector<double> estimate_cells(const TSplineMap& map, const PoissonSolution&
       s += w * r * r;
       scale += w * (fv * fv + lap * lap);
     }
-    eta[c] = h * std::sqrt(s);
-    if (eta_scale) (*eta_scale)[c] = h * std::sqrt(scale);
+    eta[gc] = h * std::sqrt(s);
+    if (eta_scale) (*eta_scale)[gc] = h * std::sqrt(scale);
   }
   if (distributed) {  // every process gets every cell's value (the others' are 0 here)
     distributed->sum_over_processes(eta);
@@ -297,81 +316,6 @@ std::vector<int> mark_cells(const std::vector<double>& eta, double gamma) {
   for (int c = 0; c < static_cast<int>(eta.size()); ++c)
     if (eta[c] > gamma * m) marked.push_back(c);
   return marked;
-}
-
-std::string describe(AdaptiveSolveStop stop, const AdaptiveSolveOptions& options) {
-  switch (stop) {
-    case AdaptiveSolveStop::AllSteps: return "all " + std::to_string(options.steps) + " steps done";
-    case AdaptiveSolveStop::EstimatorAtRoundoff:
-      return "the estimator is at round-off (u_h solves the problem exactly): nothing to refine";
-    case AdaptiveSolveStop::NothingMarked: return "no cell marked (eta = 0 everywhere)";
-    case AdaptiveSolveStop::MaxDofs:
-      return "the next space would have more than " + std::to_string(options.max_dofs) + " DOFs (max_dofs)";
-  }
-  return "unknown";
-}
-
-AdaptiveSolveResult solve_adaptive(const TSplineMap& map, const PoissonProblem& problem,
-                                   const AdaptiveSolveOptions& options, const PoissonStepCallback& callback) {
-  if (options.steps < 1) throw InputError("Poisson: steps must be at least 1");
-  if (!(options.gamma >= 0.0 && options.gamma <= 1.0))
-    throw InputError("gamma must lie in [0, 1], got " + std::to_string(options.gamma));
-  AdaptiveSolveResult result;
-  std::vector<PoissonStep>& steps = result.steps;
-  TMesh mesh = map.mesh();
-  for (int k = 0; k < options.steps; ++k) {
-    const auto t0 = Clock::now();
-    auto space = std::make_shared<const AnalysisSpace>(map, mesh);
-    if (k > 0 && space->num_dofs() > options.max_dofs) {
-      result.stop = AdaptiveSolveStop::MaxDofs;
-      break;
-    }
-    const PoissonSolution sol = solve_poisson(map, space, problem, options.solver);
-    PoissonStep st;
-    st.step = k;
-    st.dofs = space->num_dofs();
-    st.cells = space->mesh().num_cells();
-    st.solver = sol.solver;
-    st.assembly_seconds = sol.assembly_seconds;
-    if (problem.exact) {
-      st.has_errors = true;
-      st.errors = compute_errors(map, sol, problem, options.solver);
-    }
-    std::vector<double> scale;
-    const std::vector<double> eta = estimate_cells(map, sol, problem, &scale, options.solver);
-    double s = 0, s_scale = 0;
-    for (std::size_t c = 0; c < eta.size(); ++c) {
-      s += eta[c] * eta[c];
-      s_scale += scale[c] * scale[c];
-    }
-    st.eta = std::sqrt(s);
-    // The residual f + Laplace(u_h) is a difference of two terms of size ~scale:
-    // below kRoundoffResidual * scale it is round-off (u_h solves the problem
-    // exactly, e.g. a solution in the discrete space) and there is nothing to refine.
-    st.eta_at_roundoff = st.eta <= kRoundoffResidual * std::sqrt(s_scale);
-    std::vector<int> marked;
-    if (options.refine == AdaptiveSolveOptions::Refine::Uniform) {
-      marked.resize(eta.size());
-      for (int c = 0; c < static_cast<int>(eta.size()); ++c) marked[c] = c;
-    } else if (!st.eta_at_roundoff) {
-      marked = mark_cells(eta, options.gamma);
-      st.marked = marked.size();
-      marked = refinement_patch(mesh, marked);
-    }
-    if (options.refine == AdaptiveSolveOptions::Refine::Uniform) st.marked = marked.size();
-    st.refined = marked.size();
-    st.seconds = seconds_since(t0);
-    steps.push_back(st);
-    if (callback) callback(st, sol, eta);
-    if (k + 1 < options.steps) {
-      if (marked.empty()) {  // nothing to refine
-        result.stop = st.eta_at_roundoff ? AdaptiveSolveStop::EstimatorAtRoundoff : AdaptiveSolveStop::NothingMarked;
-        break;
-      }
-      mesh = refine_cells(mesh, marked);
-    }
-  }
-  return result;
 }
 
 }  // namespace tspline

@@ -139,7 +139,7 @@ bool PetscPoissonSolver::accepts(std::size_t ni) const {
   return ni >= impl_->options.auto_threshold;
 }
 
-std::vector<int> PetscPoissonSolver::begin(const AnalysisSpace& space, const std::vector<int>& dof, int ni) {
+std::vector<int> PetscPoissonSolver::begin(const AnalysisSpace& space, const std::vector<int>& interior, int ni) {
   Impl& m = *impl_;
   m.release();
 #if defined(__GLIBC__)
@@ -149,16 +149,22 @@ std::vector<int> PetscPoissonSolver::begin(const AnalysisSpace& space, const std
   // (mmap'ed) and would not reuse them. Give them back first.
   malloc_trim(0);
 #endif
-  const HierarchicalBasis& basis = space.basis();
-  const int nc = static_cast<int>(space.mesh().num_cells());
+  const int nc = static_cast<int>(space.num_cells());
   const int P = process_count(), R = process_rank();
+  // The interior numbers of the functions of global cell c (-1: Dirichlet).
+  std::vector<int> cell_rows;
+  const auto rows_of = [&](int c) -> const std::vector<int>& {
+    space.cell_dofs(static_cast<std::size_t>(c), cell_rows);
+    for (int& a : cell_rows) a = interior[a];
+    return cell_rows;
+  };
 
   // Owner of interior DOF i: the process whose block of cells
   // [r nc / P, (r+1) nc / P) holds the first cell of its support.
   std::vector<int> first_cell(static_cast<std::size_t>(ni), -1);
   for (int c = 0; c < nc; ++c)
-    for (int a : basis.functions_on_cell(c))
-      if (dof[a] >= 0 && first_cell[dof[a]] < 0) first_cell[dof[a]] = c;
+    for (int i : rows_of(c))
+      if (i >= 0 && first_cell[i] < 0) first_cell[i] = c;
   std::vector<int> owner(static_cast<std::size_t>(ni));
   std::vector<PetscInt> count(static_cast<std::size_t>(P) + 1, 0);
   {
@@ -194,9 +200,9 @@ std::vector<int> PetscPoissonSolver::begin(const AnalysisSpace& space, const std
   std::vector<int> cells_mine;
   for (int c = 0; c < nc; ++c) {
     bool mine = false;
-    for (int a : basis.functions_on_cell(c))
-      if (dof[a] >= 0 && own(m.perm[dof[a]])) {
-        ++start[m.perm[dof[a]] - m.row_begin + 1];
+    for (int i : rows_of(c))
+      if (i >= 0 && own(m.perm[i])) {
+        ++start[m.perm[i] - m.row_begin + 1];
         mine = true;
       }
     if (mine) cells_mine.push_back(c);
@@ -206,8 +212,8 @@ std::vector<int> PetscPoissonSolver::begin(const AnalysisSpace& space, const std
   {
     std::vector<std::int64_t> fill(start.begin(), start.end() - 1);
     for (int c : cells_mine)
-      for (int a : basis.functions_on_cell(c))
-        if (dof[a] >= 0 && own(m.perm[dof[a]])) cells[fill[m.perm[dof[a]] - m.row_begin]++] = c;
+      for (int i : rows_of(c))
+        if (i >= 0 && own(m.perm[i])) cells[fill[m.perm[i] - m.row_begin]++] = c;
   }
 
   // Row k's columns: the interior functions of the cells of its support, each
@@ -217,10 +223,10 @@ std::vector<int> PetscPoissonSolver::begin(const AnalysisSpace& space, const std
   const auto row_columns = [&](PetscInt k) {
     cols.clear();
     for (std::int64_t e = start[k]; e < start[k + 1]; ++e)
-      for (int a : basis.functions_on_cell(cells[e])) {
-        if (dof[a] < 0 || mark[dof[a]] == k) continue;
-        mark[dof[a]] = k;
-        cols.push_back(m.perm[dof[a]]);
+      for (int i : rows_of(cells[e])) {
+        if (i < 0 || mark[i] == k) continue;
+        mark[i] = k;
+        cols.push_back(m.perm[i]);
       }
     std::sort(cols.begin(), cols.end());
   };

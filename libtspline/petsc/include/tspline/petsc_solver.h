@@ -108,7 +108,7 @@ class PetscPoissonSolver final : public InteriorSystemSolver {
   PetscPoissonSolver& operator=(const PetscPoissonSolver&) = delete;
 
   bool accepts(std::size_t ni) const override;
-  std::vector<int> begin(const AnalysisSpace& space, const std::vector<int>& dof, int ni) override;
+  std::vector<int> begin(const AnalysisSpace& space, const std::vector<int>& interior, int ni) override;
   void add_cell(std::span<const int> rows, const Eigen::MatrixXd& Kloc, const Eigen::VectorXd& floc) override;
   bool end_assembly(bool ok) override;
   /// \throw NumericalError if CG does not reach rtol within max_iterations (or diverges).

@@ -1,0 +1,128 @@
+#pragma once
+// The analysis space of the IGA Poisson solver on a map of 1 to n patches
+// (poisson_solver.h). A single map is the case n = 1 of the same code.
+//
+// Per patch: cubic hierarchical B-splines (hierarchical_basis.h) on an ANALYSIS
+// T-mesh that refines the patch's geometry T-mesh (PatchSpace); every analysis
+// cell lies inside one geometry cell, located once.
+//
+// Across the interfaces (patch_layout.h): the two patches of a cut carry the
+// same border knots (multipatch_parameterization.h, and refine_conforming in
+// poisson_adaptive.h keeps them so), so the traces of their border functions
+// on the cut are the same univariate hierarchical B-splines. The function of
+// level l with tangential index k on side_a is glued to the one of level l
+// with index 2^l + 2 - k on side_b (the cut is traversed the other way): one
+// global unknown per glued pair (or group, at a node shared by several
+// patches). The glued space is continuous across the cuts (C0).
+//
+// Global numbering: patch by patch, function by function, a function takes
+// the number of its glued group if an earlier function of the group has one,
+// else the next number. With one patch the global number of function a is a.
+// The DIRICHLET functions are those non-zero on a patch side that is not an
+// interface (a ring of the domain: its outer boundary or a hole).
+//
+// Cells are numbered globally patch by patch: cell c of patch p is
+// cell_offset(p) + c.
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <span>
+#include <utility>
+#include <vector>
+
+#include "tspline/analysis/hierarchical_basis.h"
+#include "tspline/multipatch/patch_layout.h"
+#include "tspline/spline/tspline_map.h"
+#include "tspline/tmesh/tmesh.h"
+
+namespace tspline {
+
+/// The geometry of an analysis: the patch maps and the interfaces between
+/// them (one patch and no interfaces for a single map). The maps must outlive
+/// every space and solution made on them.
+struct AnalysisGeometry {
+  std::vector<const TSplineMap*> patches;
+  std::vector<Interface> interfaces;
+
+  AnalysisGeometry() = default;
+  explicit AnalysisGeometry(const TSplineMap& map) : patches{&map} {}
+  AnalysisGeometry(std::vector<const TSplineMap*> maps, std::vector<Interface> cuts)
+      : patches(std::move(maps)), interfaces(std::move(cuts)) {}
+
+  std::size_t size() const { return patches.size(); }
+  const TSplineMap& patch(std::size_t p) const { return *patches[p]; }
+  /// The geometry T-meshes: the analysis meshes of the first step.
+  std::vector<TMesh> meshes() const;
+};
+
+/// One patch's analysis space: T-mesh, its basis, and per analysis cell its geometry cell.
+class PatchSpace {
+ public:
+  /// \pre analysis_mesh has topology and refines map.mesh() (each cell inside one
+  /// geometry cell). \throw InputError otherwise.
+  PatchSpace(const TSplineMap& map, TMesh analysis_mesh);
+  const TMesh& mesh() const { return *mesh_; }
+  const HierarchicalBasis& basis() const { return *basis_; }
+  int geometry_cell(int c) const { return geometry_cell_[c]; }
+  std::size_t num_functions() const { return basis_->size(); }
+
+ private:
+  std::unique_ptr<TMesh> mesh_;  // heap: the basis keeps a pointer to it
+  std::unique_ptr<HierarchicalBasis> basis_;
+  std::vector<int> geometry_cell_;
+};
+
+/// Tangential index (in the side's own direction, boundary_map.h) of a
+/// function that does not vanish on `side` of its patch, or -1 if it vanishes there.
+std::int64_t side_index(const HierarchicalFunction& f, int side);
+
+/// The glued space of all patches (see the file comment).
+class AnalysisSpace {
+ public:
+  /// One patch: the space of a single map.
+  AnalysisSpace(const TSplineMap& map, TMesh analysis_mesh);
+  /// \param meshes per patch an analysis T-mesh refining the patch's geometry T-mesh.
+  /// \throw InputError (a mesh that does not refine its patch's, a count that
+  /// does not match); NumericalError if an interface is not conforming (a
+  /// border function without partner on the other side).
+  AnalysisSpace(AnalysisGeometry geometry, std::vector<TMesh> meshes);
+
+  const AnalysisGeometry& geometry() const { return geometry_; }
+  const TSplineMap& map(std::size_t p) const { return geometry_.patch(p); }
+  std::size_t num_patches() const { return patches_.size(); }
+  const PatchSpace& patch(std::size_t p) const { return *patches_[p]; }
+
+  /// Global unknowns (glued functions, Dirichlet ones included).
+  std::size_t num_dofs() const { return num_dofs_; }
+  /// Global number of function a of patch p.
+  int dof(std::size_t p, int a) const { return dofs_[p][a]; }
+  std::span<const int> dofs(std::size_t p) const { return dofs_[p]; }
+  /// Whether global DOF g is non-zero on the domain's boundary (a Dirichlet DOF).
+  bool is_dirichlet(int g) const { return dirichlet_[g] != 0; }
+  /// (function, function) pairs identified across the interfaces.
+  std::size_t glued_pairs() const { return glued_pairs_; }
+  /// Whether side `side` of patch p is an interface (else a ring: Dirichlet).
+  bool is_interface_side(std::size_t p, int side) const { return interface_side_[p][side] != 0; }
+
+  /// Cells of every patch.
+  std::size_t num_cells() const { return cell_offset_.back(); }
+  std::size_t cell_offset(std::size_t p) const { return cell_offset_[p]; }
+  /// (patch, cell of the patch) of global cell gc.
+  std::pair<std::size_t, int> cell(std::size_t gc) const;
+  /// Global DOFs of the functions of global cell gc, in the order of the
+  /// patch's basis().functions_on_cell (not sorted).
+  void cell_dofs(std::size_t gc, std::vector<int>& out) const;
+
+ private:
+  AnalysisGeometry geometry_;
+  std::vector<std::unique_ptr<PatchSpace>> patches_;
+  std::vector<std::vector<int>> dofs_;
+  std::vector<char> dirichlet_;
+  std::vector<std::array<char, 4>> interface_side_;
+  std::vector<std::size_t> cell_offset_;
+  std::size_t num_dofs_ = 0;
+  std::size_t glued_pairs_ = 0;
+};
+
+}  // namespace tspline

@@ -1,0 +1,169 @@
+// The glued analysis space of a map of 1..n patches (see analysis_space.h).
+#include "tspline/analysis/analysis_space.h"
+
+#include <algorithm>
+#include <map>
+#include <numeric>
+#include <string>
+
+#include "tspline/boundary/boundary_map.h"
+#include "tspline/errors.h"
+
+namespace tspline {
+
+namespace {
+
+// Index range of a level-l function along a side: [0, 2^l + 2].
+std::int64_t last_index(int level) { return (std::int64_t{1} << level) + 2; }
+
+struct UnionFind {
+  std::vector<int> parent;
+  explicit UnionFind(std::size_t n) : parent(n) { std::iota(parent.begin(), parent.end(), 0); }
+  int find(int x) {
+    while (parent[x] != x) x = parent[x] = parent[parent[x]];
+    return x;
+  }
+  void unite(int a, int b) { parent[find(a)] = find(b); }
+};
+
+}  // namespace
+
+std::int64_t side_index(const HierarchicalFunction& f, int side) {
+  const std::int64_t n = last_index(f.level);
+  switch (static_cast<Side>(side)) {
+    case Side::Bottom: return f.iy == 0 ? f.ix : -1;
+    case Side::Right: return f.ix == n ? f.iy : -1;
+    case Side::Top: return f.iy == n ? n - f.ix : -1;
+    case Side::Left: return f.ix == 0 ? n - f.iy : -1;
+  }
+  return -1;
+}
+
+std::vector<TMesh> AnalysisGeometry::meshes() const {
+  std::vector<TMesh> out;
+  out.reserve(patches.size());
+  for (const TSplineMap* m : patches) out.push_back(m->mesh());
+  return out;
+}
+
+// ------------------------------------------------------------------ PatchSpace
+
+PatchSpace::PatchSpace(const TSplineMap& map, TMesh analysis_mesh)
+    : mesh_(std::make_unique<TMesh>(std::move(analysis_mesh))) {
+  if (!mesh_->has_topology()) throw InputError("analysis T-mesh: topology not built");
+  basis_ = std::make_unique<HierarchicalBasis>(*mesh_);
+  const TMesh& gm = map.mesh();
+  geometry_cell_.resize(mesh_->num_cells());
+  for (int c = 0; c < static_cast<int>(mesh_->num_cells()); ++c) {
+    const QuadNode& q = mesh_->node(mesh_->cell_node(c));
+    const IPoint lo = TMesh::node_min(q), hi = TMesh::node_max(q);
+    const Eigen::Vector2d centre = 0.5 * (mesh_->cell_min(c) + mesh_->cell_max(c));
+    const int g = map.basis().locate(centre);
+    bool inside = g >= 0;
+    if (inside) {
+      const QuadNode& gq = gm.node(gm.cell_node(g));
+      const IPoint glo = TMesh::node_min(gq), ghi = TMesh::node_max(gq);
+      inside = glo.x <= lo.x && glo.y <= lo.y && hi.x <= ghi.x && hi.y <= ghi.y;
+    }
+    if (!inside)
+      throw InputError("analysis T-mesh is not a refinement of the geometry T-mesh (cell " + std::to_string(c) + ")");
+    geometry_cell_[c] = g;
+  }
+}
+
+// ------------------------------------------------------------------ AnalysisSpace
+
+AnalysisSpace::AnalysisSpace(const TSplineMap& map, TMesh analysis_mesh)
+    : AnalysisSpace(AnalysisGeometry(map), [&] {
+        std::vector<TMesh> m;
+        m.push_back(std::move(analysis_mesh));
+        return m;
+      }()) {}
+
+AnalysisSpace::AnalysisSpace(AnalysisGeometry geometry, std::vector<TMesh> meshes) : geometry_(std::move(geometry)) {
+  const std::size_t P = geometry_.size();
+  if (P == 0) throw InputError("analysis space: the map has no patch");
+  if (meshes.size() != P)
+    throw InputError("analysis space: " + std::to_string(meshes.size()) + " analysis meshes for " +
+                     std::to_string(P) + " patches");
+  for (const Interface& f : geometry_.interfaces)
+    if (f.patch_a >= P || f.patch_b >= P || f.side_a < 0 || f.side_a > 3 || f.side_b < 0 || f.side_b > 3)
+      throw InputError("analysis space: interface along cut " + std::to_string(f.cut) + " names a patch or side "
+                       "that does not exist");
+  std::vector<std::size_t> offset(P + 1, 0);
+  cell_offset_.assign(P + 1, 0);
+  interface_side_.assign(P, {0, 0, 0, 0});
+  for (std::size_t p = 0; p < P; ++p) {
+    patches_.push_back(std::make_unique<PatchSpace>(geometry_.patch(p), std::move(meshes[p])));
+    offset[p + 1] = offset[p] + patches_[p]->num_functions();
+    cell_offset_[p + 1] = cell_offset_[p] + patches_[p]->mesh().num_cells();
+  }
+
+  // Gluing across the interfaces: the border functions of side_b keyed by
+  // (level, tangential index), each function of side_a matched to its mirror.
+  UnionFind uf(offset[P]);
+  for (const Interface& f : geometry_.interfaces) {
+    interface_side_[f.patch_a][f.side_a] = interface_side_[f.patch_b][f.side_b] = 1;
+    std::map<std::pair<int, std::int64_t>, int> on_b;
+    const HierarchicalBasis& bb = patches_[f.patch_b]->basis();
+    for (int a = 0; a < static_cast<int>(bb.size()); ++a) {
+      const std::int64_t k = side_index(bb.function(a), f.side_b);
+      if (k >= 0) on_b[{bb.function(a).level, k}] = a;
+    }
+    const HierarchicalBasis& ba = patches_[f.patch_a]->basis();
+    std::size_t matched = 0;
+    for (int a = 0; a < static_cast<int>(ba.size()); ++a) {
+      const HierarchicalFunction& h = ba.function(a);
+      const std::int64_t k = side_index(h, f.side_a);
+      if (k < 0) continue;
+      const auto it = on_b.find({h.level, last_index(h.level) - k});
+      if (it == on_b.end())
+        throw NumericalError("interface along cut " + std::to_string(f.cut) + ": patch " + std::to_string(f.patch_a) +
+                             " has a border function with no partner in patch " + std::to_string(f.patch_b) +
+                             " (the analysis spaces are not conforming there)");
+      uf.unite(static_cast<int>(offset[f.patch_a]) + a, static_cast<int>(offset[f.patch_b]) + it->second);
+      ++matched;
+    }
+    if (matched != on_b.size())
+      throw NumericalError("interface along cut " + std::to_string(f.cut) + ": the two sides have " +
+                           std::to_string(matched) + " and " + std::to_string(on_b.size()) + " border functions");
+    glued_pairs_ += matched;
+  }
+
+  // Numbering in patch order; Dirichlet: non-zero on a side that is not an interface.
+  std::vector<int> root_id(offset[P], -1);
+  dofs_.resize(P);
+  int n = 0;
+  for (std::size_t p = 0; p < P; ++p) {
+    dofs_[p].resize(patches_[p]->num_functions());
+    for (std::size_t a = 0; a < dofs_[p].size(); ++a) {
+      const int r = uf.find(static_cast<int>(offset[p] + a));
+      if (root_id[r] < 0) root_id[r] = n++;
+      dofs_[p][a] = root_id[r];
+    }
+  }
+  num_dofs_ = static_cast<std::size_t>(n);
+  dirichlet_.assign(num_dofs_, 0);
+  for (std::size_t p = 0; p < P; ++p) {
+    const HierarchicalBasis& b = patches_[p]->basis();
+    for (int a = 0; a < static_cast<int>(b.size()); ++a) {
+      if (!b.function(a).on_border) continue;
+      for (int side = 0; side < 4; ++side)
+        if (!interface_side_[p][side] && side_index(b.function(a), side) >= 0) dirichlet_[dofs_[p][a]] = 1;
+    }
+  }
+}
+
+std::pair<std::size_t, int> AnalysisSpace::cell(std::size_t gc) const {
+  const auto it = std::upper_bound(cell_offset_.begin(), cell_offset_.end(), gc);
+  const std::size_t p = static_cast<std::size_t>(it - cell_offset_.begin()) - 1;
+  return {p, static_cast<int>(gc - cell_offset_[p])};
+}
+
+void AnalysisSpace::cell_dofs(std::size_t gc, std::vector<int>& out) const {
+  const auto [p, c] = cell(gc);
+  out.clear();
+  for (int a : patches_[p]->basis().functions_on_cell(c)) out.push_back(dofs_[p][a]);
+}
+
+}  // namespace tspline
