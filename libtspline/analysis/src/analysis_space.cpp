@@ -4,10 +4,13 @@
 #include <algorithm>
 #include <map>
 #include <numeric>
+#include <set>
 #include <string>
 
+#include "tspline/boundary/border_knots.h"
 #include "tspline/boundary/boundary_map.h"
 #include "tspline/errors.h"
+#include "tspline/spline/bezier_extraction.h"
 
 namespace tspline {
 
@@ -39,11 +42,51 @@ std::int64_t side_index(const HierarchicalFunction& f, int side) {
   return -1;
 }
 
+std::size_t refine_conforming(std::vector<TMesh>& meshes, const std::vector<Interface>& interfaces,
+                              const std::vector<std::vector<int>>& cells) {
+  for (std::size_t p = 0; p < meshes.size(); ++p)
+    if (!cells[p].empty()) meshes[p] = refine_cells(meshes[p], cells[p]);
+  // Refining one side of a cut adds border knots there; the other side gets
+  // them too (and balancing may add more, hence the loop).
+  std::size_t propagated = 0;
+  for (std::size_t splits = 1; splits > 0;) {
+    splits = 0;
+    for (const Interface& f : interfaces) {
+      std::set<double> u;
+      for (double t : border_params(meshes[f.patch_a], static_cast<Side>(f.side_a))) u.insert(t);
+      for (double t : border_params(meshes[f.patch_b], static_cast<Side>(f.side_b))) u.insert(reversed_param(t));
+      BorderParams a, b;
+      a[f.side_a].assign(u.begin(), u.end());
+      for (double t : u) b[f.side_b].push_back(reversed_param(t));
+      splits += refine_to_border_params(meshes[f.patch_a], a, TMesh::kMaxLevel);
+      splits += refine_to_border_params(meshes[f.patch_b], b, TMesh::kMaxLevel);
+    }
+    propagated += splits;
+  }
+  return propagated;
+}
+
 std::vector<TMesh> AnalysisGeometry::meshes() const {
   std::vector<TMesh> out;
   out.reserve(patches.size());
   for (const TSplineMap* m : patches) out.push_back(m->mesh());
-  return out;
+  std::vector<QuadraturePoint> pieces;
+  for (std::vector<std::vector<int>> crossed(patches.size());;) {
+    std::size_t n = 0;
+    for (std::size_t p = 0; p < patches.size(); ++p) {
+      const TMesh& mesh = out[p];
+      const TSplineBasis& basis = patches[p]->basis();
+      crossed[p].clear();
+      for (int c = 0; c < static_cast<int>(mesh.num_cells()); ++c) {
+        const Eigen::Vector2d lo = mesh.cell_min(c), hi = mesh.cell_max(c);
+        box_quadrature(lo, hi, 1, pieces, basis, basis.locate(0.5 * (lo + hi)));
+        if (pieces.size() > 1) crossed[p].push_back(c);
+      }
+      n += crossed[p].size();
+    }
+    if (n == 0) return out;
+    refine_conforming(out, interfaces, crossed);
+  }
 }
 
 // ------------------------------------------------------------------ PatchSpace

@@ -4,9 +4,7 @@
 
 #include <chrono>
 #include <cmath>
-#include <set>
 
-#include "tspline/boundary/border_knots.h"
 #include "tspline/errors.h"
 
 namespace tspline {
@@ -17,30 +15,6 @@ using Clock = std::chrono::steady_clock;
 double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
 
 }  // namespace
-
-std::size_t refine_conforming(std::vector<TMesh>& meshes, const std::vector<Interface>& interfaces,
-                              const std::vector<std::vector<int>>& cells) {
-  for (std::size_t p = 0; p < meshes.size(); ++p)
-    if (!cells[p].empty()) meshes[p] = refine_cells(meshes[p], cells[p]);
-  // Refining one side of a cut adds border knots there; the other side gets
-  // them too (and balancing may add more, hence the loop).
-  std::size_t propagated = 0;
-  for (std::size_t splits = 1; splits > 0;) {
-    splits = 0;
-    for (const Interface& f : interfaces) {
-      std::set<double> u;
-      for (double t : border_params(meshes[f.patch_a], static_cast<Side>(f.side_a))) u.insert(t);
-      for (double t : border_params(meshes[f.patch_b], static_cast<Side>(f.side_b))) u.insert(reversed_param(t));
-      BorderParams a, b;
-      a[f.side_a].assign(u.begin(), u.end());
-      for (double t : u) b[f.side_b].push_back(reversed_param(t));
-      splits += refine_to_border_params(meshes[f.patch_a], a, TMesh::kMaxLevel);
-      splits += refine_to_border_params(meshes[f.patch_b], b, TMesh::kMaxLevel);
-    }
-    propagated += splits;
-  }
-  return propagated;
-}
 
 std::string describe(AdaptiveSolveStop stop, const AdaptiveSolveOptions& options) {
   switch (stop) {

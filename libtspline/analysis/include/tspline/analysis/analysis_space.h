@@ -52,9 +52,24 @@ struct AnalysisGeometry {
 
   std::size_t size() const { return patches.size(); }
   const TSplineMap& patch(std::size_t p) const { return *patches[p]; }
-  /// The geometry T-meshes: the analysis meshes of the first step.
+  /// The analysis meshes of the first step: the geometry T-meshes refined
+  /// (conformingly, refine_conforming) until no knot line of a patch's
+  /// geometry functions crosses a cell, so that every cell lies in one Bezier
+  /// element of its map (bezier_extraction.h) and u o S is as smooth on a cell
+  /// as the analysis functions are. (From the geometry T-meshes themselves,
+  /// whose cells such lines cross near T-junctions, the analysis functions are
+  /// polynomial where u o S is only C^2, and the first refinements are
+  /// pre-asymptotic: measured on a sea's layout, L2 rates 2.5, 5.4, 5.1 and H1
+  /// 1.7, 4.4, 3.9.)
   std::vector<TMesh> meshes() const;
 };
+
+/// Splits cells[p] of meshes[p] (cells to split, e.g. a refinement_patch), then
+/// makes the interfaces conforming again: both sides of each cut are refined
+/// to the union of their border knots (mirrored), repeatedly, until no side
+/// changes. Returns the number of cells split beyond `cells` by that propagation.
+std::size_t refine_conforming(std::vector<TMesh>& meshes, const std::vector<Interface>& interfaces,
+                              const std::vector<std::vector<int>>& cells);
 
 /// One patch's analysis space: T-mesh, its basis, and per analysis cell its geometry cell.
 class PatchSpace {

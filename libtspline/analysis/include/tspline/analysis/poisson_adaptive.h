@@ -69,11 +69,4 @@ AdaptiveSolveResult solve_adaptive(const AnalysisGeometry& geometry, const Poiss
 AdaptiveSolveResult solve_adaptive(const TSplineMap& map, const PoissonProblem& problem,
                                    const AdaptiveSolveOptions& options, const PoissonStepCallback& callback = {});
 
-/// Splits cells[p] of meshes[p] (cells to split, e.g. a refinement_patch), then
-/// makes the interfaces conforming again: both sides of each cut are refined
-/// to the union of their border knots (mirrored), repeatedly, until no side
-/// changes. Returns the number of cells split beyond `cells` by that propagation.
-std::size_t refine_conforming(std::vector<TMesh>& meshes, const std::vector<Interface>& interfaces,
-                              const std::vector<std::vector<int>>& cells);
-
 }  // namespace tspline
