@@ -5,6 +5,7 @@
 #include <map>
 #include <numeric>
 #include <set>
+#include <stdexcept>
 #include <string>
 
 #include "tspline/boundary/border_knots.h"
@@ -116,6 +117,53 @@ PatchSpace::PatchSpace(const TSplineMap& map, TMesh analysis_mesh)
 
 // ------------------------------------------------------------------ AnalysisSpace
 
+namespace {
+
+/// A patch's functions that do not vanish on its border: (function, level,
+/// tangential index per side, -1 where it vanishes).
+struct BorderFunction {
+  int a = 0, level = 0;
+  std::array<std::int64_t, 4> k{-1, -1, -1, -1};
+};
+
+std::vector<BorderFunction> border_functions(const HierarchicalBasis& b) {
+  std::vector<BorderFunction> out;
+  for (int a = 0; a < static_cast<int>(b.size()); ++a) {
+    const HierarchicalFunction& f = b.function(a);
+    if (!f.on_border) continue;
+    BorderFunction bf;
+    bf.a = a;
+    bf.level = f.level;
+    for (int side = 0; side < 4; ++side) bf.k[side] = side_index(f, side);
+    out.push_back(bf);
+  }
+  return out;
+}
+
+/// Per patch, the patches sharing a side or a corner (a layout node) with it,
+/// itself included: through the interfaces, corner side_a of patch a is corner
+/// side_b + 1 of patch b, and corner side_a + 1 of a is corner side_b of b.
+std::vector<std::vector<std::size_t>> patch_neighbours(std::size_t P, const std::vector<Interface>& interfaces) {
+  UnionFind corners(4 * P);
+  for (const Interface& f : interfaces) {
+    corners.unite(static_cast<int>(4 * f.patch_a + f.side_a), static_cast<int>(4 * f.patch_b + (f.side_b + 1) % 4));
+    corners.unite(static_cast<int>(4 * f.patch_a + (f.side_a + 1) % 4), static_cast<int>(4 * f.patch_b + f.side_b));
+  }
+  std::map<int, std::vector<std::size_t>> at_node;
+  for (std::size_t p = 0; p < P; ++p)
+    for (int k = 0; k < 4; ++k) at_node[corners.find(static_cast<int>(4 * p + k))].push_back(p);
+  std::vector<std::vector<std::size_t>> out(P);
+  for (const auto& [node, patches] : at_node)
+    for (std::size_t p : patches) out[p].insert(out[p].end(), patches.begin(), patches.end());
+  for (auto& n : out) {
+    std::sort(n.begin(), n.end());
+    n.erase(std::unique(n.begin(), n.end()), n.end());
+  }
+  return out;
+}
+
+}  // namespace
+
 AnalysisSpace::AnalysisSpace(const TSplineMap& map, TMesh analysis_mesh)
     : AnalysisSpace(AnalysisGeometry(map), [&] {
         std::vector<TMesh> m;
@@ -123,48 +171,69 @@ AnalysisSpace::AnalysisSpace(const TSplineMap& map, TMesh analysis_mesh)
         return m;
       }()) {}
 
-AnalysisSpace::AnalysisSpace(AnalysisGeometry geometry, std::vector<TMesh> meshes) : geometry_(std::move(geometry)) {
+AnalysisSpace::AnalysisSpace(AnalysisGeometry geometry, std::vector<TMesh> meshes, int rank, int processes)
+    : geometry_(std::move(geometry)), rank_(rank), processes_(processes) {
   const std::size_t P = geometry_.size();
   if (P == 0) throw InputError("analysis space: the map has no patch");
   if (meshes.size() != P)
     throw InputError("analysis space: " + std::to_string(meshes.size()) + " analysis meshes for " +
                      std::to_string(P) + " patches");
+  if (processes < 1 || rank < 0 || rank >= processes)
+    throw InputError("analysis space: process " + std::to_string(rank) + " of " + std::to_string(processes));
   for (const Interface& f : geometry_.interfaces)
     if (f.patch_a >= P || f.patch_b >= P || f.side_a < 0 || f.side_a > 3 || f.side_b < 0 || f.side_b > 3)
       throw InputError("analysis space: interface along cut " + std::to_string(f.cut) + " names a patch or side "
                        "that does not exist");
-  std::vector<std::size_t> offset(P + 1, 0);
   cell_offset_.assign(P + 1, 0);
-  interface_side_.assign(P, {0, 0, 0, 0});
+  for (std::size_t p = 0; p < P; ++p) cell_offset_[p + 1] = cell_offset_[p] + meshes[p].num_cells();
+
+  // The patches held: those of this process's block of cells and their neighbours.
+  std::vector<char> held(P, 0);
+  {
+    const auto [first, last] = block(rank_);
+    const std::vector<std::vector<std::size_t>> neighbours = patch_neighbours(P, geometry_.interfaces);
+    for (std::size_t p = 0; p < P; ++p)
+      if (cell_offset_[p] < last && first < cell_offset_[p + 1])
+        for (std::size_t q : neighbours[p]) held[q] = 1;
+  }
+  // Every patch's function count and border functions; the spaces held kept.
+  patches_.resize(P);
+  meshes_.resize(P);
+  std::vector<std::size_t> offset(P + 1, 0);
+  std::vector<std::vector<BorderFunction>> border;
+  border.resize(P);
   for (std::size_t p = 0; p < P; ++p) {
-    patches_.push_back(std::make_unique<PatchSpace>(geometry_.patch(p), std::move(meshes[p])));
-    offset[p + 1] = offset[p] + patches_[p]->num_functions();
-    cell_offset_[p + 1] = cell_offset_[p] + patches_[p]->mesh().num_cells();
+    std::shared_ptr<const PatchSpace> sp;
+    if (held[p]) {
+      sp = std::make_shared<const PatchSpace>(geometry_.patch(p), std::move(meshes[p]));
+      patches_[p] = sp;
+    } else {
+      meshes_[p] = std::move(meshes[p]);
+      sp = std::make_shared<const PatchSpace>(geometry_.patch(p), meshes_[p]);  // for its border functions only
+    }
+    offset[p + 1] = offset[p] + sp->num_functions();
+    border[p] = border_functions(sp->basis());
   }
 
   // Gluing across the interfaces: the border functions of side_b keyed by
   // (level, tangential index), each function of side_a matched to its mirror.
+  interface_side_.assign(P, {0, 0, 0, 0});
   UnionFind uf(offset[P]);
   for (const Interface& f : geometry_.interfaces) {
     interface_side_[f.patch_a][f.side_a] = interface_side_[f.patch_b][f.side_b] = 1;
     std::map<std::pair<int, std::int64_t>, int> on_b;
-    const HierarchicalBasis& bb = patches_[f.patch_b]->basis();
-    for (int a = 0; a < static_cast<int>(bb.size()); ++a) {
-      const std::int64_t k = side_index(bb.function(a), f.side_b);
-      if (k >= 0) on_b[{bb.function(a).level, k}] = a;
-    }
-    const HierarchicalBasis& ba = patches_[f.patch_a]->basis();
+    for (const BorderFunction& h : border[f.patch_b])
+      if (h.k[f.side_b] >= 0) on_b[{h.level, h.k[f.side_b]}] = h.a;
     std::size_t matched = 0;
-    for (int a = 0; a < static_cast<int>(ba.size()); ++a) {
-      const HierarchicalFunction& h = ba.function(a);
-      const std::int64_t k = side_index(h, f.side_a);
+    for (const BorderFunction& h : border[f.patch_a]) {
+      const std::int64_t k = h.k[f.side_a];
       if (k < 0) continue;
       const auto it = on_b.find({h.level, last_index(h.level) - k});
       if (it == on_b.end())
         throw NumericalError("interface along cut " + std::to_string(f.cut) + ": patch " + std::to_string(f.patch_a) +
                              " has a border function with no partner in patch " + std::to_string(f.patch_b) +
                              " (the analysis spaces are not conforming there)");
-      uf.unite(static_cast<int>(offset[f.patch_a]) + a, static_cast<int>(offset[f.patch_b]) + it->second);
+      uf.unite(static_cast<int>(offset[f.patch_a]) + h.a, static_cast<int>(offset[f.patch_b]) + it->second);
       ++matched;
     }
     if (matched != on_b.size())
@@ -178,7 +247,7 @@ AnalysisSpace::AnalysisSpace(AnalysisGeometry geometry, std::vector<TMesh> meshe
   dofs_.resize(P);
   int n = 0;
   for (std::size_t p = 0; p < P; ++p) {
-    dofs_[p].resize(patches_[p]->num_functions());
+    dofs_[p].resize(offset[p + 1] - offset[p]);
     for (std::size_t a = 0; a < dofs_[p].size(); ++a) {
       const int r = uf.find(static_cast<int>(offset[p] + a));
       if (root_id[r] < 0) root_id[r] = n++;
@@ -187,14 +256,44 @@ AnalysisSpace::AnalysisSpace(AnalysisGeometry geometry, std::vector<TMesh> meshe
   }
   num_dofs_ = static_cast<std::size_t>(n);
   dirichlet_.assign(num_dofs_, 0);
-  for (std::size_t p = 0; p < P; ++p) {
-    const HierarchicalBasis& b = patches_[p]->basis();
-    for (int a = 0; a < static_cast<int>(b.size()); ++a) {
-      if (!b.function(a).on_border) continue;
+  for (std::size_t p = 0; p < P; ++p)
+    for (const BorderFunction& h : border[p])
       for (int side = 0; side < 4; ++side)
-        if (!interface_side_[p][side] && side_index(b.function(a), side) >= 0) dirichlet_[dofs_[p][a]] = 1;
+        if (!interface_side_[p][side] && h.k[side] >= 0) dirichlet_[dofs_[p][h.a]] = 1;
+}
+
+std::shared_ptr<const AnalysisSpace> AnalysisSpace::completed() const {
+  auto out = std::shared_ptr<AnalysisSpace>(new AnalysisSpace());
+  *out = *this;  // copies the numbering, shares the spaces held
+  for (std::size_t p = 0; p < patches_.size(); ++p)
+    if (!out->patches_[p]) {
+      out->patches_[p] = std::make_shared<const PatchSpace>(map(p), std::move(out->meshes_[p]));
+      out->meshes_[p] = TMesh();
     }
-  }
+  return out;
+}
+
+bool AnalysisSpace::holds_all() const {
+  return std::all_of(patches_.begin(), patches_.end(), [](const auto& p) { return p != nullptr; });
+}
+
+const PatchSpace& AnalysisSpace::patch(std::size_t p) const {
+  if (!patches_[p])
+    throw std::logic_error("analysis space: patch " + std::to_string(p) + " is not held by process " +
+                           std::to_string(rank_));
+  return *patches_[p];
+}
+
+std::shared_ptr<const PatchSpace> AnalysisSpace::patch_space(std::size_t p) const {
+  return patches_[p] ? patches_[p] : std::make_shared<const PatchSpace>(map(p), meshes_[p]);
+}
+
+std::pair<std::size_t, std::size_t> AnalysisSpace::block(int r) const {
+  const std::size_t nc = num_cells(), Pr = static_cast<std::size_t>(processes_);
+  const auto start = [&](std::size_t q) {
+    return static_cast<std::size_t>(static_cast<std::uint64_t>(nc) * q / Pr);
+  };
+  return {start(static_cast<std::size_t>(r)), start(static_cast<std::size_t>(r) + 1)};
 }
 
 std::pair<std::size_t, int> AnalysisSpace::cell(std::size_t gc) const {
@@ -206,7 +305,7 @@ std::pair<std::size_t, int> AnalysisSpace::cell(std::size_t gc) const {
 void AnalysisSpace::cell_dofs(std::size_t gc, std::vector<int>& out) const {
   const auto [p, c] = cell(gc);
   out.clear();
-  for (int a : patches_[p]->basis().functions_on_cell(c)) out.push_back(dofs_[p][a]);
+  for (int a : patch(p).basis().functions_on_cell(c)) out.push_back(dofs_[p][a]);
 }
 
 }  // namespace tspline

@@ -43,7 +43,9 @@ AdaptiveSolveResult solve_adaptive(const AnalysisGeometry& geometry, const Poiss
   std::vector<TMesh> meshes = geometry.meshes();
   for (int k = 0; k < options.steps; ++k) {
     const auto t0 = Clock::now();
-    auto space = std::make_shared<const AnalysisSpace>(geometry, std::move(meshes));
+    auto space = std::make_shared<const AnalysisSpace>(geometry, std::move(meshes),
+                                                       options.solver ? options.solver->rank() : 0,
+                                                       options.solver ? options.solver->processes() : 1);
     if (k > 0 && space->num_dofs() > options.max_dofs) {  // before the Dirichlet projection and the assembly
       result.stop = AdaptiveSolveStop::MaxDofs;
       break;
@@ -59,7 +61,7 @@ AdaptiveSolveResult solve_adaptive(const AnalysisGeometry& geometry, const Poiss
       st.has_errors = true;
       st.errors = compute_errors(sol, problem, options.solver);
     }
-    st.max_interface_jump = interface_jump(sol);
+    st.max_interface_jump = interface_jump(sol, options.solver);
     std::vector<double> scale;
     const std::vector<double> eta = estimate_cells(sol, problem, &scale, options.solver);
     double s = 0, s_scale = 0;
@@ -76,7 +78,7 @@ AdaptiveSolveResult solve_adaptive(const AnalysisGeometry& geometry, const Poiss
     std::vector<std::vector<int>> split(space->num_patches());
     if (options.refine == AdaptiveSolveOptions::Refine::Uniform) {
       for (std::size_t p = 0; p < split.size(); ++p) {
-        split[p].resize(space->patch(p).mesh().num_cells());
+        split[p].resize(space->mesh(p).num_cells());
         for (int c = 0; c < static_cast<int>(split[p].size()); ++c) split[p][c] = c;
         st.marked += split[p].size();
       }
@@ -89,7 +91,7 @@ AdaptiveSolveResult solve_adaptive(const AnalysisGeometry& geometry, const Poiss
         by_patch[p].push_back(c);
       }
       for (std::size_t p = 0; p < split.size(); ++p)
-        if (!by_patch[p].empty()) split[p] = refinement_patch(space->patch(p).mesh(), by_patch[p]);
+        if (!by_patch[p].empty()) split[p] = refinement_patch(space->mesh(p), by_patch[p]);
     }
     for (const auto& cells : split) st.refined += cells.size();
     st.seconds = seconds_since(t0);
@@ -101,7 +103,7 @@ AdaptiveSolveResult solve_adaptive(const AnalysisGeometry& geometry, const Poiss
         break;
       }
       meshes.clear();
-      for (std::size_t p = 0; p < space->num_patches(); ++p) meshes.push_back(space->patch(p).mesh());
+      for (std::size_t p = 0; p < space->num_patches(); ++p) meshes.push_back(space->mesh(p));
       refine_conforming(meshes, geometry.interfaces, split);
     }
   }

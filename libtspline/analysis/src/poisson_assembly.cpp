@@ -58,7 +58,11 @@ Eigen::Matrix2d physical_hessian(const Eigen::Vector2d& grad_x, const Eigen::Mat
 
 SolutionValue evaluate_solution(const PoissonSolution& sol, std::size_t p, int c, const Eigen::Vector2d& uv,
                                 int order) {
-  const PatchSpace& sp = sol.space->patch(p);
+  return evaluate_solution(sol, p, sol.space->patch(p), c, uv, order);
+}
+
+SolutionValue evaluate_solution(const PoissonSolution& sol, std::size_t p, const PatchSpace& sp, int c,
+                                const Eigen::Vector2d& uv, int order) {
   const std::span<const int> dofs = sol.space->dofs(p);
   BasisValues bv;
   sp.basis().evaluate(c, uv, bv, order);
@@ -121,8 +125,11 @@ void side_quadrature(const TMesh& mesh, int c, int side, const std::vector<doubl
 }
 
 /// Coefficients of the Dirichlet DOFs: L2 projection of g onto their traces on
-/// the domain's boundary, physical arc length (see poisson_solver.h).
-void project_dirichlet(const AnalysisSpace& space, const ScalarField& g, PoissonSolution& sol) {
+/// the domain's boundary, physical arc length (see poisson_solver.h). With
+/// `distributed`, each process integrates the border edges of its share of the
+/// cells, the entries are gathered, and every process solves the (small) system.
+void project_dirichlet(const AnalysisSpace& space, const ScalarField& g, PoissonSolution& sol,
+                       const InteriorSystemSolver* distributed) {
   const int n = static_cast<int>(space.num_dofs());
   std::vector<int> bidx(n, -1);
   int nb = 0;
@@ -141,13 +148,16 @@ void project_dirichlet(const AnalysisSpace& space, const ScalarField& g, Poisson
   BasisValues bv;
   std::vector<std::pair<int, double>> active;
   std::vector<std::pair<Eigen::Vector2d, double>> points;
-  for (std::size_t p = 0; p < space.num_patches(); ++p) {
+  const int nc = static_cast<int>(space.num_cells());
+  const auto [first, last] = distributed ? distributed->cell_share(nc) : std::pair<int, int>{0, nc};
+  for (int gcell = first; gcell < last; ++gcell) {
+    const auto [p, c] = space.cell(static_cast<std::size_t>(gcell));
     const PatchSpace& sp = space.patch(p);
     const TSplineMap& map = space.map(p);
     const std::span<const int> dofs = space.dofs(p);
     for (int side = 0; side < 4; ++side) {
       if (space.is_interface_side(p, side)) continue;
-      for (int c = 0; c < static_cast<int>(sp.mesh().num_cells()); ++c) {
+      {
         side_quadrature(sp.mesh(), c, side, gp, gw, points);
         for (const auto& [uv, wt] : points) {
           const MapDerivatives d = map.derivatives(uv, 1, sp.geometry_cell(c));
@@ -163,6 +173,22 @@ void project_dirichlet(const AnalysisSpace& space, const ScalarField& g, Poisson
           }
         }
       }
+    }
+  }
+  if (distributed && distributed->processes() > 1) {  // every process gets every entry
+    std::vector<double> mine;
+    mine.reserve(3 * trip.size() + static_cast<std::size_t>(nb) + 1);
+    mine.push_back(static_cast<double>(trip.size()));
+    for (const auto& t : trip) mine.insert(mine.end(), {double(t.row()), double(t.col()), t.value()});
+    mine.insert(mine.end(), rhs.data(), rhs.data() + nb);
+    const std::vector<double> all = distributed->gather_to_all(mine);
+    trip.clear();
+    rhs.setZero();
+    for (std::size_t k = 0; k < all.size();) {  // each process's part: count, triplets, rhs
+      const auto count = static_cast<std::size_t>(all[k++]);
+      for (std::size_t t = 0; t < count; ++t, k += 3)
+        trip.emplace_back(static_cast<int>(all[k]), static_cast<int>(all[k + 1]), all[k + 2]);
+      for (int r = 0; r < nb; ++r) rhs[r] += all[k++];
     }
   }
   Eigen::SparseMatrix<double> M(nb, nb);
@@ -527,14 +553,14 @@ PoissonSolution solve_poisson(std::shared_ptr<const AnalysisSpace> space, const 
   if (!problem.f) throw InputError("Poisson problem: the source f is missing");
   if (!problem.g) throw InputError("Poisson problem: the Dirichlet data g is missing");
   PoissonSolution sol;
-  sol.space = std::move(space);
-  const AnalysisSpace& sp = *sol.space;
+  sol.space = space;
+  const AnalysisSpace& sp = *space;
   const int n = static_cast<int>(sp.num_dofs());
   sol.coefficients = Eigen::VectorXd::Zero(n);
   sol.is_boundary.assign(n, false);
 
   auto t0 = Clock::now();
-  project_dirichlet(sp, problem.g, sol);
+  project_dirichlet(sp, problem.g, sol, solver);
   sol.dirichlet_seconds = seconds_since(t0);
 
   // Interior numbering.
@@ -555,9 +581,12 @@ PoissonSolution solve_poisson(std::shared_ptr<const AnalysisSpace> space, const 
     return sol;
   }
 
+  // The built-in direct solver assembles every cell (on every process, redundantly).
+  if (!sp.holds_all()) sol.space = sp.completed();
   t0 = Clock::now();
   Eigen::VectorXd rhs;
-  const Eigen::SparseMatrix<double> K = assemble_stiffness(sp, problem.f, interior, ni, sol.coefficients, rhs);
+  const Eigen::SparseMatrix<double> K =
+      assemble_stiffness(*sol.space, problem.f, interior, ni, sol.coefficients, rhs);
   sol.assembly_seconds = seconds_since(t0);
 
   if (ni > 0) {

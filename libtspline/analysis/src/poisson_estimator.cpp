@@ -228,15 +228,25 @@ PoissonErrors compute_errors(const PoissonSolution& sol, const PoissonProblem& p
   return e;
 }
 
-double interface_jump(const PoissonSolution& sol) {
+double interface_jump(const PoissonSolution& sol, const InteriorSystemSolver* distributed) {
+  const AnalysisSpace& space = *sol.space;
+  // With several processes: the interfaces of the patches of this process's
+  // block (it holds their neighbours too), the maximum taken over the processes.
+  std::vector<char> mine(space.num_patches(), 1);
+  if (distributed) {
+    const auto [first, last] = distributed->cell_share(static_cast<int>(space.num_cells()));
+    for (std::size_t p = 0; p < mine.size(); ++p)
+      mine[p] = static_cast<int>(space.cell_offset(p)) < last && first < static_cast<int>(space.cell_offset(p + 1));
+  }
   double jump = 0.0;
-  for (const Interface& f : sol.space->geometry().interfaces)
-    for (int k = 0; k <= 32; ++k) {
+  for (const Interface& f : space.geometry().interfaces)
+    for (int k = 0; k <= 32 && mine[f.patch_a]; ++k) {
       const double t = k / 32.0;
       const double ua = evaluate_solution(sol, f.patch_a, side_point_uv(f.side_a, t), 0).u;
       const double ub = evaluate_solution(sol, f.patch_b, side_point_uv(f.side_b, reversed_param(t)), 0).u;
       jump = std::max(jump, std::abs(ua - ub));
     }
+  if (distributed) distributed->max_over_processes({&jump, 1});
   return jump;
 }
 

@@ -42,8 +42,10 @@ toolkit::io::VtuMesh solution_vtu(const PoissonSolution& sol, const PoissonProbl
   std::vector<toolkit::io::VtuMesh> parts;
   for (std::size_t p = 0; p < sol.space->num_patches(); ++p) {
     std::vector<double> uh, ue, err, cell_eta;
-    toolkit::io::VtuMesh part = cell_grid_vtu(sol.space->patch(p).mesh(), k, [&](int c, const Eigen::Vector2d& uv) {
-      const SolutionValue v = evaluate_solution(sol, p, c, uv, 0);
+    // Built here if this process does not hold it (a distributed run's rank 0), one patch at a time.
+    const std::shared_ptr<const PatchSpace> space = sol.space->patch_space(p);
+    toolkit::io::VtuMesh part = cell_grid_vtu(space->mesh(), k, [&](int c, const Eigen::Vector2d& uv) {
+      const SolutionValue v = evaluate_solution(sol, p, *space, c, uv, 0);
       uh.push_back(v.u);
       if (problem.exact) {
         const double u = problem.exact(v.x.x(), v.x.y());
@@ -96,7 +98,7 @@ json PoissonOutputWriter::add_step(const PoissonStep& st, const PoissonSolution&
 
   int max_level = 0;
   for (std::size_t p = 0; p < sol.space->num_patches(); ++p)
-    max_level = std::max(max_level, sol.space->patch(p).mesh().max_level());
+    max_level = std::max(max_level, sol.space->mesh(p).max_level());
   json rec = {{"step", st.step},
               {"dofs", st.dofs},
               {"interior_dofs", sol.interior_dofs},

@@ -160,11 +160,14 @@ std::vector<int> PetscPoissonSolver::begin(const AnalysisSpace& space, const std
   };
 
   // Owner of interior DOF i: the process whose block of cells
-  // [r nc / P, (r+1) nc / P) holds the first cell of its support.
-  std::vector<int> first_cell(static_cast<std::size_t>(ni), -1);
-  for (int c = 0; c < nc; ++c)
+  // [r nc / P, (r+1) nc / P) holds the first cell of its support. Each
+  // process finds it in its own block (whose patches it holds), the minimum
+  // over the processes is the first cell.
+  std::vector<int> first_cell(static_cast<std::size_t>(ni), std::numeric_limits<int>::max());
+  for (int c = block_start(nc, R, P); c < block_start(nc, R + 1, P); ++c)
     for (int i : rows_of(c))
-      if (i >= 0 && first_cell[i] < 0) first_cell[i] = c;
+      if (i >= 0 && first_cell[i] > c) first_cell[i] = c;
+  if (P > 1) MPI_Allreduce(MPI_IN_PLACE, first_cell.data(), ni, MPI_INT, MPI_MIN, PETSC_COMM_WORLD);
   std::vector<int> owner(static_cast<std::size_t>(ni));
   std::vector<PetscInt> count(static_cast<std::size_t>(P) + 1, 0);
   {
@@ -194,11 +197,13 @@ std::vector<int> PetscPoissonSolver::begin(const AnalysisSpace& space, const std
   // of K is sum over those cells of their element rows, so the process adds
   // them up itself and no entry is sent to another process; a cell on the
   // border of two processes' rows is computed by both (about 1 % of the cells
-  // with 2 processes at 1e6 DOFs).
+  // with 2 processes at 1e6 DOFs). Those cells lie in the patches this process
+  // holds (the patches of its block and their neighbours: analysis_space.h).
   const PetscInt nloc = m.row_end - m.row_begin;
   std::vector<std::int64_t> start(static_cast<std::size_t>(nloc) + 1, 0);  // own row -> cells (CSR)
   std::vector<int> cells_mine;
   for (int c = 0; c < nc; ++c) {
+    if (!space.holds(space.cell(static_cast<std::size_t>(c)).first)) continue;
     bool mine = false;
     for (int i : rows_of(c))
       if (i >= 0 && own(m.perm[i])) {
@@ -459,9 +464,19 @@ SolverStats PetscPoissonSolver::solve(Eigen::VectorXd& u) {
   return st;
 }
 
-std::pair<int, int> PetscPoissonSolver::cell_share(int nc) const {
-  const int P = process_count(), R = process_rank();
-  return {block_start(nc, R, P), block_start(nc, R + 1, P)};
+int PetscPoissonSolver::rank() const { return process_rank(); }
+int PetscPoissonSolver::processes() const { return process_count(); }
+
+std::vector<double> PetscPoissonSolver::gather_to_all(std::span<const double> v) const {
+  const int P = process_count();
+  if (P == 1) return {v.begin(), v.end()};
+  int mine = static_cast<int>(v.size());
+  std::vector<int> counts(static_cast<std::size_t>(P)), starts(static_cast<std::size_t>(P) + 1, 0);
+  MPI_Allgather(&mine, 1, MPI_INT, counts.data(), 1, MPI_INT, PETSC_COMM_WORLD);
+  for (int q = 0; q < P; ++q) starts[q + 1] = starts[q] + counts[q];
+  std::vector<double> all(static_cast<std::size_t>(starts[P]));
+  MPI_Allgatherv(v.data(), mine, MPI_DOUBLE, all.data(), counts.data(), starts.data(), MPI_DOUBLE, PETSC_COMM_WORLD);
+  return all;
 }
 
 void PetscPoissonSolver::sum_over_processes(std::span<double> v) const {

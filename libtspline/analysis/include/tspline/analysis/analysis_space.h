@@ -23,6 +23,17 @@
 //
 // Cells are numbered globally patch by patch: cell c of patch p is
 // cell_offset(p) + c.
+//
+// Distribution over P processes (rank r): the global cells are split into P
+// contiguous blocks, [r nc / P, (r+1) nc / P) for rank r (block()); a process
+// HOLDS the spaces (T-mesh and basis) of the patches its block touches and of
+// their neighbours (patches sharing an interface or a layout node with them:
+// the other patches of every glued DOF of its patches), not the others. Every
+// process keeps every patch's analysis T-mesh and the global numbering of
+// every function (4 bytes each); the bases of the other patches are built
+// once, for their border functions (gluing, Dirichlet DOFs), and dropped.
+// With one patch every process holds it (the rows are then split by cells:
+// petsc_solver.h).
 #include <array>
 #include <cstddef>
 #include <cstdint>
@@ -98,15 +109,31 @@ class AnalysisSpace {
   /// One patch: the space of a single map.
   AnalysisSpace(const TSplineMap& map, TMesh analysis_mesh);
   /// \param meshes per patch an analysis T-mesh refining the patch's geometry T-mesh.
+  /// \param rank, processes: this process and their number (see the file comment).
   /// \throw InputError (a mesh that does not refine its patch's, a count that
   /// does not match); NumericalError if an interface is not conforming (a
   /// border function without partner on the other side).
-  AnalysisSpace(AnalysisGeometry geometry, std::vector<TMesh> meshes);
+  AnalysisSpace(AnalysisGeometry geometry, std::vector<TMesh> meshes, int rank = 0, int processes = 1);
+
+  /// The same space with every patch held (the built ones shared).
+  std::shared_ptr<const AnalysisSpace> completed() const;
 
   const AnalysisGeometry& geometry() const { return geometry_; }
   const TSplineMap& map(std::size_t p) const { return geometry_.patch(p); }
   std::size_t num_patches() const { return patches_.size(); }
-  const PatchSpace& patch(std::size_t p) const { return *patches_[p]; }
+  /// Whether this process holds patch p's space; every patch when processes = 1.
+  bool holds(std::size_t p) const { return patches_[p] != nullptr; }
+  bool holds_all() const;
+  /// \pre holds(p).
+  const PatchSpace& patch(std::size_t p) const;
+  /// Patch p's space: the one held, or one built now (not kept).
+  std::shared_ptr<const PatchSpace> patch_space(std::size_t p) const;
+  /// Patch p's analysis T-mesh (every patch).
+  const TMesh& mesh(std::size_t p) const { return holds(p) ? patches_[p]->mesh() : meshes_[p]; }
+  /// Global cells [first, last) of the block of `rank` (of processes()).
+  std::pair<std::size_t, std::size_t> block(int rank) const;
+  int rank() const { return rank_; }
+  int processes() const { return processes_; }
 
   /// Global unknowns (glued functions, Dirichlet ones included).
   std::size_t num_dofs() const { return num_dofs_; }
@@ -126,12 +153,15 @@ class AnalysisSpace {
   /// (patch, cell of the patch) of global cell gc.
   std::pair<std::size_t, int> cell(std::size_t gc) const;
   /// Global DOFs of the functions of global cell gc, in the order of the
-  /// patch's basis().functions_on_cell (not sorted).
+  /// patch's basis().functions_on_cell (not sorted). \pre holds(its patch).
   void cell_dofs(std::size_t gc, std::vector<int>& out) const;
 
  private:
+  AnalysisSpace() = default;
   AnalysisGeometry geometry_;
-  std::vector<std::unique_ptr<PatchSpace>> patches_;
+  std::vector<std::shared_ptr<const PatchSpace>> patches_;  // null: not held
+  std::vector<TMesh> meshes_;  // the T-meshes of the patches not held (empty for the others)
+  int rank_ = 0, processes_ = 1;
   std::vector<std::vector<int>> dofs_;
   std::vector<char> dirichlet_;
   std::vector<std::array<char, 4>> interface_side_;

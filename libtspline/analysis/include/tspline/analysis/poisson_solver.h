@@ -58,6 +58,7 @@
 
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
+#include <cstdint>
 #include <functional>
 #include <memory>
 #include <span>
@@ -120,9 +121,20 @@ class InteriorSystemSolver {
   /// Solves; u receives all ni interior values (on every process). \throw
   /// NumericalError if the solve does not converge.
   virtual SolverStats solve(Eigen::VectorXd& u) = 0;
-  /// The share [first, last) of nc cells whose error and estimator terms this
-  /// process computes (compute_errors, estimate_cells); default: all of them.
-  virtual std::pair<int, int> cell_share(int nc) const { return {0, nc}; }
+  /// This process and the number of processes (default: 0 of 1); the spaces
+  /// of the adaptive loop are distributed accordingly (analysis_space.h).
+  virtual int rank() const { return 0; }
+  virtual int processes() const { return 1; }
+  /// The share [first, last) of nc cells whose error, estimator and Dirichlet
+  /// terms this process computes: AnalysisSpace::block(rank()).
+  std::pair<int, int> cell_share(int nc) const {
+    const auto share = [&](int r) {
+      return static_cast<int>(static_cast<std::int64_t>(nc) * r / processes());
+    };
+    return {share(rank()), share(rank() + 1)};
+  }
+  /// Every process's v, concatenated in rank order, on every process (collective).
+  virtual std::vector<double> gather_to_all(std::span<const double> v) const { return {v.begin(), v.end()}; }
   /// Sums (or takes the maximum of) v element-wise over the processes, in place,
   /// the result on every process (collective); default: one process, v stays.
   virtual void sum_over_processes(std::span<double> v) const { (void)v; }
@@ -169,6 +181,10 @@ SolutionValue evaluate_solution(const PoissonSolution& sol, std::size_t p, int c
                                 int order = 1);
 /// u_h at parametric point uv of patch p (the cell located first).
 SolutionValue evaluate_solution(const PoissonSolution& sol, std::size_t p, const Eigen::Vector2d& uv, int order = 0);
+/// The same with patch p's space given (AnalysisSpace::patch_space: also for
+/// a patch this process does not hold).
+SolutionValue evaluate_solution(const PoissonSolution& sol, std::size_t p, const PatchSpace& space, int c,
+                                const Eigen::Vector2d& uv, int order = 1);
 
 struct PoissonErrors {
   double l2 = 0.0;             ///< ||u - u_h||_L2
@@ -186,7 +202,8 @@ PoissonErrors compute_errors(const PoissonSolution& sol, const PoissonProblem& p
 
 /// The largest difference of u_h between the two sides of the interfaces,
 /// sampled at 33 points per cut (0 without interfaces): round-off on a
-/// conforming glued space.
-double interface_jump(const PoissonSolution& sol);
+/// conforming glued space. With `distributed` (collective then), each process
+/// samples the interfaces of the patches of its block of cells.
+double interface_jump(const PoissonSolution& sol, const InteriorSystemSolver* distributed = nullptr);
 
 }  // namespace tspline
