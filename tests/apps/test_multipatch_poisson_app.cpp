@@ -83,11 +83,8 @@ TEST_SUITE("multipatch_poisson_app") {
                           Case{"seas/comoros.txt", 2, false}}) {
       CAPTURE(c.file);
       const fs::path d = scratch("uniform");
-      const auto r = run_app("poisson " + quoted(map_of(c.file)) + " --problem sinsin --refine uniform --steps " +
-                                 std::to_string(c.steps) + " --samples 1 -q --out " + quoted(d / "out"),
-                             d);
-      CAPTURE(r.err);
-      REQUIRE(r.exit_code == 0);
+      const json rep = test_support::run_poisson(
+          map_of(c.file), "--problem sinsin --refine uniform --solver direct --steps " + std::to_string(c.steps) + " --samples 1 -q", d);
       const auto rows = test_support::read_csv(d / "out" / "convergence.csv");
       REQUIRE(rows.size() == static_cast<std::size_t>(c.steps));
       const auto [l2, h1] = rates(rows[rows.size() - 2], rows.back());
@@ -101,7 +98,6 @@ TEST_SUITE("multipatch_poisson_app") {
         CHECK(h1 >= 2.7);
         CHECK(h1 <= 4.0);
       }
-      const json rep = test_support::poisson_report(d / "out");
       CHECK(rep["geometry"]["patches"].get<std::size_t>() >= 2);
       for (const json& s : rep["steps"]) {
         CHECK(s["max_interface_jump"].get<double>() < 1e-10);
@@ -115,12 +111,8 @@ TEST_SUITE("multipatch_poisson_app") {
     // patch): on the plate that is the hole, so the marked cells ring it and
     // lie in every patch around it, across the cuts from the hole.
     const fs::path d = scratch("adaptive");
-    const auto r = run_app("poisson " + quoted(map_of("holes/plate_with_hole.txt")) +
-                               " --problem gaussian --steps 4 --samples 1 -q --out " + quoted(d / "out"),
-                           d);
-    CAPTURE(r.err);
-    REQUIRE(r.exit_code == 0);
-    const json rep = test_support::poisson_report(d / "out");
+    const json rep =
+        test_support::run_poisson(map_of("holes/plate_with_hole.txt"), "--problem gaussian --steps 4 --samples 1 -q", d);
     REQUIRE(rep["steps"].size() == 4);
     const json& first = rep["steps"][0];
     CHECK(rep["problem"]["choice"].get<std::string>().find("every patch") != std::string::npos);
@@ -149,17 +141,13 @@ TEST_SUITE("multipatch_poisson_app") {
     // that its L2 error, 1e-10 of |u| at 1e4 DOFs, is below the agreement the
     // iterative solver's automatic tolerance promises).
     const fs::path d = scratch("solvers");
-    const std::string base =
-        "poisson " + quoted(map_of("holes/plate_with_hole.txt")) + " --problem gaussian --steps 3 ";
-    const auto a = run_app(base + "-q --solver direct --out " + quoted(d / "direct"), d);
-    REQUIRE(a.exit_code == 0);
-    const json ra = test_support::poisson_report(d / "direct");
+    const fs::path plate = map_of("holes/plate_with_hole.txt");
+    const std::string base = "poisson " + quoted(plate) + " --problem gaussian --steps 3 ";
+    const json ra = test_support::run_poisson(plate, "--problem gaussian --steps 3 -q --solver direct", d, "direct");
     for (const char* pc : {"boomeramg", "gamg"}) {
       CAPTURE(pc);
-      const auto b = run_app(base + "-q --solver iterative --preconditioner " + pc + " --out " + quoted(d / pc), d);
-      CAPTURE(b.err);
-      REQUIRE(b.exit_code == 0);
-      const json rb = test_support::poisson_report(d / pc);
+      const json rb = test_support::run_poisson(
+          plate, std::string("--problem gaussian --steps 3 -q --solver iterative --preconditioner ") + pc, d, pc);
       test_support::check_same_errors(ra, rb);
       CHECK(rb["steps"][0]["solver"]["iterations"].get<int>() >= 1);
     }
@@ -182,9 +170,8 @@ TEST_SUITE("multipatch_poisson_app") {
     CHECK(fs::exists(d / "mpi" / "convergence.png"));
     // --max-dofs: the space of step 1 exceeds it, so the loop stops before assembling it.
     const std::size_t dofs0 = ra["steps"][0]["dofs"].get<std::size_t>();
-    const auto x = run_app(base + "-q --max-dofs " + std::to_string(dofs0 + 1) + " --out " + quoted(d / "max"), d);
-    REQUIRE(x.exit_code == 0);
-    const json rx = test_support::poisson_report(d / "max");
+    const json rx = test_support::run_poisson(
+        plate, "--problem gaussian --steps 3 -q --max-dofs " + std::to_string(dofs0 + 1), d, "max");
     CHECK(rx["steps"].size() == 1);
     CHECK(rx["stop_reason"].get<std::string>().find("--max-dofs") != std::string::npos);
     // render draws every patch's solution.

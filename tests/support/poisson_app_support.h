@@ -54,6 +54,15 @@ inline nlohmann::json poisson_report(const std::filesystem::path& out) {
   return nlohmann::json::parse(slurp(out / "report.json"));
 }
 
+/// `tspline poisson MAP ARGS --out DIR/OUT`, which must succeed; its report.json.
+inline nlohmann::json run_poisson(const std::filesystem::path& map, const std::string& args,
+                                  const std::filesystem::path& dir, const std::string& out = "out") {
+  const AppRun r = run_app("poisson " + quoted(map) + " " + args + " --out " + quoted(dir / out), dir);
+  CAPTURE(r.err);
+  REQUIRE(r.exit_code == 0);
+  return poisson_report(dir / out);
+}
+
 /// Every step of b has the DOFs of a and L2 and H1 errors equal to 1e-6 relative.
 inline void check_same_errors(const nlohmann::json& a, const nlohmann::json& b) {
   REQUIRE(a["steps"].size() == b["steps"].size());
