@@ -19,6 +19,7 @@
 #include "tspline/errors.h"
 #include "tspline/validity/map_quality.h"
 #include "tspline/analysis/poisson.h"
+#include "cell_tabulation.h"
 
 #include <Eigen/CholmodSupport>
 
@@ -318,30 +319,27 @@ class CellKernel {
 
   void compute(std::size_t gc) {
     const auto [p, c] = space_.cell(gc);
-    map_ = &space_.map(p);
-    sp_ = &space_.patch(p);
+    const TSplineMap& map = space_.map(p);
+    const PatchSpace& sp = space_.patch(p);
     const std::span<const int> dofs = space_.dofs(p);
-    const HierarchicalBasis& basis = sp_->basis();
-    const TMesh& mesh = sp_->mesh();
-    const Eigen::Vector2d lo = mesh.cell_min(c), hi = mesh.cell_max(c);
-    ids = basis.functions_on_cell(c);
+    const TMesh& mesh = sp.mesh();
+    box_quadrature(mesh.cell_min(c), mesh.cell_max(c), 4, qp_, map.basis(), sp.geometry_cell(c));
+    cell_.set(map, sp, c, qp_, 1);
+    ids = cell_.ids;
     const std::size_t nf = ids.size();
     const auto n = static_cast<Eigen::Index>(nf);
     Kloc.setZero(n, n);
     floc.setZero(n);
-    gcell_ = sp_->geometry_cell(c);
-    box_quadrature(lo, hi, 4, qp_, map_->basis(), gcell_);
-    tabulate_factors();
     gx_.resize(nf);
     gy_.resize(nf);
     R_.resize(nf);
     for (std::size_t q = 0; q < qp_.size(); ++q) {
-      const MapDerivatives d = geometry_at(q);
+      const MapDerivatives d = cell_.geometry(q);
       const double w = qp_[q].weight * std::abs(d.J.determinant());
       const Eigen::Matrix2d JinvT = d.J.inverse().transpose();
       for (std::size_t k = 0; k < nf; ++k) {
         // R = N(x) M(y), grad_xi R = (N'(x) M(y), N(x) M'(y)); physical gradient J^{-T} grad_xi R.
-        const TensorFactors::Factor a = analysis_.x(qx_[q], k), b = analysis_.y(qy_[q], k);
+        const detail::Factor &a = cell_.x(q, k), &b = cell_.y(q, k);
         const double r_xi = a.d * b.v, r_eta = a.v * b.d;
         R_[k] = a.v * b.v;
         gx_[k] = JinvT(0, 0) * r_xi + JinvT(0, 1) * r_eta;
@@ -377,113 +375,8 @@ class CellKernel {
   const ScalarField& f_;
   const std::vector<int>& interior_;
   const Eigen::VectorXd& coefficients_;
-  const TSplineMap* map_ = nullptr;  // the current cell's patch
-  const PatchSpace* sp_ = nullptr;
   std::vector<QuadraturePoint> qp_;
-
-  // Tensor-product tabulation (see TensorFactors): the analysis functions and
-  // the geometry's blending functions on the cell, at its quadrature points.
-  void tabulate_factors() {
-    xs_.clear();
-    ys_.clear();
-    qx_.resize(qp_.size());
-    qy_.resize(qp_.size());
-    for (std::size_t q = 0; q < qp_.size(); ++q) {
-      qx_[q] = index_of(xs_, qp_[q].uv.x());
-      qy_[q] = index_of(ys_, qp_[q].uv.y());
-    }
-    const HierarchicalBasis& basis = sp_->basis();
-    analysis_.build(ids.size(), [&](std::size_t k) -> const auto& { return basis.function(ids[k]).knots_xi; },
-                    [&](std::size_t k) -> const auto& { return basis.function(ids[k]).knots_eta; }, xs_, ys_);
-    const TSplineBasis& gb = map_->basis();
-    const std::vector<int>& gids = gb.functions_on_cell(gcell_);
-    geometry_.build(gids.size(), [&](std::size_t k) -> const auto& { return gb.function(gids[k]).knots_xi; },
-                    [&](std::size_t k) -> const auto& { return gb.function(gids[k]).knots_eta; }, xs_, ys_);
-  }
-
-  /// S and J at quadrature point q from the tabulated blending functions N_a
-  /// of the geometry cell: R_a = N_a / W, W = sum_b N_b, grad R_a = (grad N_a -
-  /// R_a grad W) / W (the formulas of TSplineBasis::evaluate, order 1).
-  MapDerivatives geometry_at(std::size_t q) const {
-    const std::vector<int>& gids = map_->basis().functions_on_cell(gcell_);
-    const std::vector<Eigen::Vector2d>& P = map_->control_points();
-    double W = 0, Wx = 0, Wy = 0;
-    Eigen::Vector2d x = Eigen::Vector2d::Zero(), dx = x, dy = x;  // sums of N P, N_xi P, N_eta P
-    for (std::size_t k = 0; k < gids.size(); ++k) {
-      const TensorFactors::Factor a = geometry_.x(qx_[q], k), b = geometry_.y(qy_[q], k);
-      const double n = a.v * b.v, nx = a.d * b.v, ny = a.v * b.d;
-      W += n;
-      Wx += nx;
-      Wy += ny;
-      x += n * P[gids[k]];
-      dx += nx * P[gids[k]];
-      dy += ny * P[gids[k]];
-    }
-    if (!(W > 0.0)) throw std::logic_error("Poisson assembly: the blending functions vanish at a quadrature point");
-    // S = x / W; dS/dxi = (dx - S Wx) / W, dS/deta = (dy - S Wy) / W.
-    MapDerivatives d;
-    d.x = x / W;
-    d.J.col(0) = (dx - d.x * Wx) / W;
-    d.J.col(1) = (dy - d.x * Wy) / W;
-    return d;
-  }
-
-  template <class List, class T>
-  static std::size_t index_of(List& list, const T& value) {
-    for (std::size_t i = 0; i < list.size(); ++i)
-      if (list[i] == value) return i;
-    list.push_back(value);
-    return list.size() - 1;
-  }
-
-  // Every function here (analysis or geometry) is a product N[knots_xi](x)
-  // N[knots_eta](y). The functions of a cell share few distinct knot vectors
-  // (4 per direction and level for the analysis functions), and the quadrature
-  // points of the cell's pieces lie on few distinct x and y lines. So each
-  // distinct factor is evaluated (cubic_bspline, as the bases do) once per
-  // distinct coordinate, instead of twice per function and point.
-  class TensorFactors {
-   public:
-    struct Factor {
-      double v = 0.0, d = 0.0;  // value and first derivative
-    };
-    template <class KnotsX, class KnotsY>
-    void build(std::size_t nf, KnotsX knots_x, KnotsY knots_y, const std::vector<double>& xs,
-               const std::vector<double>& ys) {
-      knx_.clear();
-      kny_.clear();
-      kx_.resize(nf);
-      ky_.resize(nf);
-      for (std::size_t k = 0; k < nf; ++k) {
-        kx_[k] = index_of(knx_, knots_x(k));
-        ky_[k] = index_of(kny_, knots_y(k));
-      }
-      tabulate(knx_, xs, ux_);
-      tabulate(kny_, ys, uy_);
-    }
-    /// Factor in x of function k at distinct coordinate i (and in y).
-    Factor x(std::size_t i, std::size_t k) const { return ux_[i * knx_.size() + kx_[k]]; }
-    Factor y(std::size_t i, std::size_t k) const { return uy_[i * kny_.size() + ky_[k]]; }
-
-   private:
-    static void tabulate(const std::vector<std::array<double, 5>>& knots, const std::vector<double>& ts,
-                         std::vector<Factor>& out) {
-      out.resize(ts.size() * knots.size());
-      for (std::size_t i = 0; i < ts.size(); ++i)
-        for (std::size_t j = 0; j < knots.size(); ++j) {
-          Factor& u = out[i * knots.size() + j];
-          u.v = cubic_bspline(knots[j], ts[i], &u.d);
-        }
-    }
-    std::vector<std::array<double, 5>> knx_, kny_;  // distinct knot vectors in x and y
-    std::vector<std::size_t> kx_, ky_;              // per function: its factors
-    std::vector<Factor> ux_, uy_;                   // [coordinate][factor]
-  };
-
-  int gcell_ = -1;                    // the geometry cell of the analysis cell
-  std::vector<double> xs_, ys_;       // distinct quadrature coordinates
-  std::vector<std::size_t> qx_, qy_;  // per quadrature point: its coordinates
-  TensorFactors analysis_, geometry_;
+  detail::CellTabulation cell_;
   std::vector<double> gx_, gy_, R_;
 };
 

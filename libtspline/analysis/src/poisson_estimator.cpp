@@ -15,6 +15,7 @@
 #include "tspline/errors.h"
 #include "tspline/validity/map_quality.h"
 #include "tspline/analysis/poisson.h"
+#include "cell_tabulation.h"
 
 namespace tspline {
 
@@ -27,12 +28,9 @@ Eigen::Vector2d exact_gradient(const PoissonProblem& p, double x, double y) {
 }
 
 /// u_h and the map at the quadrature points of one analysis cell, from
-/// tabulated univariate factors: the same values as evaluate_solution() (up to
-/// the order of the additions), without evaluating both bases at every point.
-/// Every function here, analysis or geometry, is a product N[kx](x) N[ky](y);
-/// a cell's functions share few distinct knot vectors and its quadrature points
-/// lie on few distinct x and y lines, so each distinct factor is evaluated once
-/// per distinct coordinate (as the assembly's CellKernel does).
+/// tabulated univariate factors (cell_tabulation.h): the same values as
+/// evaluate_solution() (up to the order of the additions), without evaluating
+/// both bases at every point.
 class CellEvaluator {
  public:
   explicit CellEvaluator(const PoissonSolution& sol) : sol_(sol) {}
@@ -40,70 +38,16 @@ class CellEvaluator {
   /// Tabulates cell c of patch p at the points qp, derivatives up to `order` (1 or 2).
   void set_cell(std::size_t p, int c, const std::vector<QuadraturePoint>& qp, int order) {
     order_ = order;
-    map_ = &sol_.space->map(p);
-    const PatchSpace& sp = sol_.space->patch(p);
+    cell_.set(sol_.space->map(p), sol_.space->patch(p), c, qp, order);
     const std::span<const int> dofs = sol_.space->dofs(p);
-    xs_.clear();
-    ys_.clear();
-    qx_.resize(qp.size());
-    qy_.resize(qp.size());
-    for (std::size_t q = 0; q < qp.size(); ++q) {
-      qx_[q] = index_of(xs_, qp[q].uv.x());
-      qy_[q] = index_of(ys_, qp[q].uv.y());
-    }
-    const HierarchicalBasis& basis = sp.basis();
-    ids_ = basis.functions_on_cell(c);
-    coef_.resize(ids_.size());
-    for (std::size_t k = 0; k < ids_.size(); ++k) coef_[k] = sol_.coefficients[dofs[ids_[k]]];
-    analysis_.build(
-        ids_.size(), [&](std::size_t k) -> const auto& { return basis.function(ids_[k]).knots_xi; },
-        [&](std::size_t k) -> const auto& { return basis.function(ids_[k]).knots_eta; }, xs_, ys_, order);
-    const TSplineBasis& gb = map_->basis();
-    gids_ = &gb.functions_on_cell(sp.geometry_cell(c));
-    geometry_.build(
-        gids_->size(), [&](std::size_t k) -> const auto& { return gb.function((*gids_)[k]).knots_xi; },
-        [&](std::size_t k) -> const auto& { return gb.function((*gids_)[k]).knots_eta; }, xs_, ys_, order);
+    coef_.resize(cell_.ids.size());
+    for (std::size_t k = 0; k < cell_.ids.size(); ++k) coef_[k] = sol_.coefficients[dofs[cell_.ids[k]]];
   }
 
   /// evaluate_solution(sol, p, c, qp[q].uv, order) of the current cell.
   SolutionValue at(std::size_t q) const {
     const bool d2 = order_ >= 2;
-    // S = A / W with A = sum N_a P_a, W = sum N_a (TSplineBasis: R_a = N_a / W);
-    // differentiating A = S W: S_i = (A_i - S W_i) / W,
-    // S_ij = (A_ij - S_i W_j - S_j W_i - S W_ij) / W.
-    const std::vector<Eigen::Vector2d>& P = map_->control_points();
-    double W = 0, Wx = 0, Wy = 0, Wxx = 0, Wxy = 0, Wyy = 0;
-    Eigen::Vector2d A = Eigen::Vector2d::Zero(), Ax = A, Ay = A, Axx = A, Axy = A, Ayy = A;
-    for (std::size_t k = 0; k < gids_->size(); ++k) {
-      const Factor a = geometry_.x(qx_[q], k), b = geometry_.y(qy_[q], k);
-      const Eigen::Vector2d& p = P[(*gids_)[k]];
-      const double n = a.v * b.v, nx = a.d * b.v, ny = a.v * b.d;
-      W += n;
-      Wx += nx;
-      Wy += ny;
-      A += n * p;
-      Ax += nx * p;
-      Ay += ny * p;
-      if (d2) {
-        const double nxx = a.dd * b.v, nxy = a.d * b.d, nyy = a.v * b.dd;
-        Wxx += nxx;
-        Wxy += nxy;
-        Wyy += nyy;
-        Axx += nxx * p;
-        Axy += nxy * p;
-        Ayy += nyy * p;
-      }
-    }
-    if (!(W > 0.0)) throw std::logic_error("Poisson errors: the blending functions vanish at a quadrature point");
-    MapDerivatives d;
-    d.x = A / W;
-    d.J.col(0) = (Ax - d.x * Wx) / W;
-    d.J.col(1) = (Ay - d.x * Wy) / W;
-    if (d2) {
-      d.xixi = (Axx - 2.0 * d.J.col(0) * Wx - d.x * Wxx) / W;
-      d.xieta = (Axy - d.J.col(0) * Wy - d.J.col(1) * Wx - d.x * Wxy) / W;
-      d.etaeta = (Ayy - 2.0 * d.J.col(1) * Wy - d.x * Wyy) / W;
-    }
+    const MapDerivatives d = cell_.geometry(q);
     // u_h = sum c_a X_a(x) Y_a(y) (hierarchical B-splines are not normalized).
     SolutionValue out;
     out.x = d.x;
@@ -111,7 +55,7 @@ class CellEvaluator {
     Eigen::Vector2d g_xi = Eigen::Vector2d::Zero();
     Eigen::Matrix2d h_xi = Eigen::Matrix2d::Zero();
     for (std::size_t k = 0; k < coef_.size(); ++k) {
-      const Factor a = analysis_.x(qx_[q], k), b = analysis_.y(qy_[q], k);
+      const detail::Factor &a = cell_.x(q, k), &b = cell_.y(q, k);
       const double ca = coef_[k];
       out.u += ca * a.v * b.v;
       g_xi += ca * Eigen::Vector2d(a.d * b.v, a.v * b.d);
@@ -128,58 +72,10 @@ class CellEvaluator {
   }
 
  private:
-  struct Factor {
-    double v = 0.0, d = 0.0, dd = 0.0;  // value, first and second derivative
-  };
-  template <class List, class T>
-  static std::size_t index_of(List& list, const T& value) {
-    for (std::size_t i = 0; i < list.size(); ++i)
-      if (list[i] == value) return i;
-    list.push_back(value);
-    return list.size() - 1;
-  }
-  class TensorFactors {
-   public:
-    template <class KnotsX, class KnotsY>
-    void build(std::size_t nf, KnotsX knots_x, KnotsY knots_y, const std::vector<double>& xs,
-               const std::vector<double>& ys, int order) {
-      knx_.clear();
-      kny_.clear();
-      kx_.resize(nf);
-      ky_.resize(nf);
-      for (std::size_t k = 0; k < nf; ++k) {
-        kx_[k] = index_of(knx_, knots_x(k));
-        ky_[k] = index_of(kny_, knots_y(k));
-      }
-      tabulate(knx_, xs, ux_, order);
-      tabulate(kny_, ys, uy_, order);
-    }
-    Factor x(std::size_t i, std::size_t k) const { return ux_[i * knx_.size() + kx_[k]]; }
-    Factor y(std::size_t i, std::size_t k) const { return uy_[i * kny_.size() + ky_[k]]; }
-
-   private:
-    static void tabulate(const std::vector<std::array<double, 5>>& knots, const std::vector<double>& ts,
-                         std::vector<Factor>& out, int order) {
-      out.resize(ts.size() * knots.size());
-      for (std::size_t i = 0; i < ts.size(); ++i)
-        for (std::size_t j = 0; j < knots.size(); ++j) {
-          Factor& u = out[i * knots.size() + j];
-          u.v = cubic_bspline(knots[j], ts[i], &u.d, order >= 2 ? &u.dd : nullptr);
-        }
-    }
-    std::vector<std::array<double, 5>> knx_, kny_;
-    std::vector<std::size_t> kx_, ky_;
-    std::vector<Factor> ux_, uy_;
-  };
-
   const PoissonSolution& sol_;
-  const TSplineMap* map_ = nullptr;  // the current cell's patch
   int order_ = 1;
-  std::span<const int> ids_;
-  const std::vector<int>* gids_ = nullptr;
-  std::vector<double> coef_, xs_, ys_;
-  std::vector<std::size_t> qx_, qy_;
-  TensorFactors analysis_, geometry_;
+  detail::CellTabulation cell_;
+  std::vector<double> coef_;
 };
 
 }  // namespace
