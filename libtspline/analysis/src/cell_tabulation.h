@@ -113,39 +113,31 @@ class CellTabulation {
   /// differentiating A = S W: S_i = (A_i - S W_i) / W,
   /// S_ij = (A_ij - S_i W_j - S_j W_i - S W_ij) / W.
   MapDerivatives geometry(std::size_t q) const {
-    const bool d2 = order_ >= 2;
+    // Derivatives of N_a (and sums) in the order 1, x, y, xx, xy, yy.
+    const std::size_t nd = order_ >= 2 ? 6 : 3;
     const std::vector<Eigen::Vector2d>& P = map_->control_points();
-    double W = 0, Wx = 0, Wy = 0, Wxx = 0, Wxy = 0, Wyy = 0;
-    Eigen::Vector2d A = Eigen::Vector2d::Zero(), Ax = A, Ay = A, Axx = A, Axy = A, Ayy = A;
+    std::array<double, 6> Ws{};
+    std::array<Eigen::Vector2d, 6> As;
+    for (Eigen::Vector2d& v : As) v.setZero();
     for (std::size_t k = 0; k < gids_->size(); ++k) {
       const Factor &a = geometry_.x(qx_[q], k), &b = geometry_.y(qy_[q], k);
+      const std::array<double, 6> n{a.v * b.v, a.d * b.v, a.v * b.d, a.dd * b.v, a.d * b.d, a.v * b.dd};
       const Eigen::Vector2d& p = P[(*gids_)[k]];
-      const double n = a.v * b.v, nx = a.d * b.v, ny = a.v * b.d;
-      W += n;
-      Wx += nx;
-      Wy += ny;
-      A += n * p;
-      Ax += nx * p;
-      Ay += ny * p;
-      if (d2) {
-        const double nxx = a.dd * b.v, nxy = a.d * b.d, nyy = a.v * b.dd;
-        Wxx += nxx;
-        Wxy += nxy;
-        Wyy += nyy;
-        Axx += nxx * p;
-        Axy += nxy * p;
-        Ayy += nyy * p;
+      for (std::size_t i = 0; i < nd; ++i) {
+        Ws[i] += n[i];
+        As[i] += n[i] * p;
       }
     }
+    const double W = Ws[0], Wx = Ws[1], Wy = Ws[2], Wxx = Ws[3], Wxy = Ws[4], Wyy = Ws[5];
     if (!(W > 0.0)) throw std::logic_error("Poisson: the blending functions vanish at a quadrature point");
     MapDerivatives d;
-    d.x = A / W;
-    d.J.col(0) = (Ax - d.x * Wx) / W;
-    d.J.col(1) = (Ay - d.x * Wy) / W;
-    if (d2) {
-      d.xixi = (Axx - 2.0 * d.J.col(0) * Wx - d.x * Wxx) / W;
-      d.xieta = (Axy - d.J.col(0) * Wy - d.J.col(1) * Wx - d.x * Wxy) / W;
-      d.etaeta = (Ayy - 2.0 * d.J.col(1) * Wy - d.x * Wyy) / W;
+    d.x = As[0] / W;
+    d.J.col(0) = (As[1] - d.x * Wx) / W;
+    d.J.col(1) = (As[2] - d.x * Wy) / W;
+    if (nd == 6) {
+      d.xixi = (As[3] - 2.0 * d.J.col(0) * Wx - d.x * Wxx) / W;
+      d.xieta = (As[4] - d.J.col(0) * Wy - d.J.col(1) * Wx - d.x * Wxy) / W;
+      d.etaeta = (As[5] - 2.0 * d.J.col(1) * Wy - d.x * Wyy) / W;
     }
     return d;
   }

@@ -27,6 +27,12 @@ Eigen::Vector2d exact_gradient(const PoissonProblem& p, double x, double y) {
   return {(p.exact(x + h, y) - p.exact(x - h, y)) / (2 * h), (p.exact(x, y + h) - p.exact(x, y - h)) / (2 * h)};
 }
 
+/// This process's share of the cells: all of them, or the distributed solver's.
+std::pair<int, int> cell_share(const AnalysisSpace& space, const InteriorSystemSolver* distributed) {
+  const int nc = static_cast<int>(space.num_cells());
+  return distributed ? distributed->cell_share(nc) : std::pair<int, int>{0, nc};
+}
+
 /// u_h and the map at the quadrature points of one analysis cell, from
 /// tabulated univariate factors (cell_tabulation.h): the same values as
 /// evaluate_solution() (up to the order of the additions), without evaluating
@@ -35,13 +41,19 @@ class CellEvaluator {
  public:
   explicit CellEvaluator(const PoissonSolution& sol) : sol_(sol) {}
 
-  /// Tabulates cell c of patch p at the points qp, derivatives up to `order` (1 or 2).
-  void set_cell(std::size_t p, int c, const std::vector<QuadraturePoint>& qp, int order) {
+  /// Tabulates global cell gc at n x n Gauss points per piece (box_quadrature),
+  /// derivatives up to `order` (1 or 2); returns the points.
+  const std::vector<QuadraturePoint>& set_cell(std::size_t gc, int n, int order) {
     order_ = order;
-    cell_.set(sol_.space->map(p), sol_.space->patch(p), c, qp, order);
+    const auto [p, c] = sol_.space->cell(gc);
+    const PatchSpace& sp = sol_.space->patch(p);
+    const TSplineMap& map = sol_.space->map(p);
+    box_quadrature(sp.mesh().cell_min(c), sp.mesh().cell_max(c), n, qp_, map.basis(), sp.geometry_cell(c));
+    cell_.set(map, sp, c, qp_, order);
     const std::span<const int> dofs = sol_.space->dofs(p);
     coef_.resize(cell_.ids.size());
     for (std::size_t k = 0; k < cell_.ids.size(); ++k) coef_[k] = sol_.coefficients[dofs[cell_.ids[k]]];
+    return qp_;
   }
 
   /// evaluate_solution(sol, p, c, qp[q].uv, order) of the current cell.
@@ -74,6 +86,7 @@ class CellEvaluator {
  private:
   const PoissonSolution& sol_;
   int order_ = 1;
+  std::vector<QuadraturePoint> qp_;
   detail::CellTabulation cell_;
   std::vector<double> coef_;
 };
@@ -83,18 +96,12 @@ class CellEvaluator {
 PoissonErrors compute_errors(const PoissonSolution& sol, const PoissonProblem& problem,
                              const InteriorSystemSolver* distributed) {
   if (!problem.exact) throw InputError("Poisson errors: no exact solution given");
-  const AnalysisSpace& space = *sol.space;
-  std::vector<QuadraturePoint> qp;
   PoissonErrors e;
   double l2 = 0, h1 = 0, l2u = 0, h1u = 0;
-  const int nc = static_cast<int>(space.num_cells());
-  const auto [first, last] = distributed ? distributed->cell_share(nc) : std::pair<int, int>{0, nc};
+  const auto [first, last] = cell_share(*sol.space, distributed);
   CellEvaluator cell(sol);
   for (int gc = first; gc < last; ++gc) {
-    const auto [p, c] = space.cell(static_cast<std::size_t>(gc));
-    const TMesh& mesh = space.patch(p).mesh();
-    box_quadrature(mesh.cell_min(c), mesh.cell_max(c), 6, qp, space.map(p).basis(), space.patch(p).geometry_cell(c));
-    cell.set_cell(p, c, qp, 1);
+    const std::vector<QuadraturePoint>& qp = cell.set_cell(static_cast<std::size_t>(gc), 6, 1);
     for (std::size_t iq = 0; iq < qp.size(); ++iq) {
       const QuadraturePoint& q = qp[iq];
       const SolutionValue v = cell.at(iq);
@@ -149,11 +156,9 @@ double interface_jump(const PoissonSolution& sol, const InteriorSystemSolver* di
 std::vector<double> estimate_cells(const PoissonSolution& sol, const PoissonProblem& problem,
                                    std::vector<double>* eta_scale, const InteriorSystemSolver* distributed) {
   const AnalysisSpace& space = *sol.space;
-  std::vector<QuadraturePoint> qp;
   std::vector<double> eta(space.num_cells(), 0.0);
   if (eta_scale) eta_scale->assign(space.num_cells(), 0.0);
-  const int nc = static_cast<int>(space.num_cells());
-  const auto [first, last] = distributed ? distributed->cell_share(nc) : std::pair<int, int>{0, nc};
+  const auto [first, last] = cell_share(space, distributed);
   CellEvaluator cell(sol);
   for (int gc = first; gc < last; ++gc) {
     const auto [p, c] = space.cell(static_cast<std::size_t>(gc));
@@ -167,8 +172,7 @@ std::vector<double> estimate_cells(const PoissonSolution& sol, const PoissonProb
     const Eigen::Vector2d p01 = map.derivatives({lo.x(), hi.y()}, 0, g).x;
     const double h = std::max((p11 - p00).norm(), (p01 - p10).norm());
     double s = 0, scale = 0;
-    box_quadrature(lo, hi, 4, qp, map.basis(), g);
-    cell.set_cell(p, c, qp, 2);
+    const std::vector<QuadraturePoint>& qp = cell.set_cell(static_cast<std::size_t>(gc), 4, 2);
     for (std::size_t iq = 0; iq < qp.size(); ++iq) {
       const QuadraturePoint& q = qp[iq];
       const SolutionValue v = cell.at(iq);
