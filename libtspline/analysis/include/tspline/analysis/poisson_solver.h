@@ -10,8 +10,8 @@
 // Analysis space (analysis_space.h): on a map of 1 to n patches, cubic
 // hierarchical B-splines (hierarchical_basis.h) per patch on an ANALYSIS
 // T-mesh, glued C0 across the interfaces (one unknown per glued pair). The
-// analysis T-mesh starts equal to the geometry's T-mesh and is refined
-// independently; the geometry map S stays the one of the parameterization, so
+// analysis T-meshes start as the geometry's T-meshes refined to their Bezier
+// elements (AnalysisGeometry::meshes) and are refined independently; the geometry map S stays the one of the parameterization, so
 // the method is NOT isoparametric (as in the paper). A single map is the case
 // of one patch; there is no other path.
 // Deviation from the paper (which uses the T-spline blending functions of the
