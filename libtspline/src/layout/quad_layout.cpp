@@ -398,6 +398,7 @@ QuadLayout build_quad_layout(const Domain& d, const QuadLayoutOptions& o) {
     violations(m, true);
     if (split_marked()) {
       out.stats.repair_rounds = ++repairs;
+      out.stats.optimization_level = level = 2;  // the new mesh is optimized in full
       continue;
     }
 
@@ -426,32 +427,38 @@ QuadLayout build_quad_layout(const Domain& d, const QuadLayoutOptions& o) {
           const double sn = cross(a, b) / (a.norm() * b.norm());
           const bool fine = level == 0 ? sn > 1e-3 : sn > 0.0175 && (a.dot(b) > 0.0 || sn > 0.174);
           if (!fine)
-            throw InputError("a patch corner outside 1-170 degrees at " + std::to_string(v[c].x()) + ", " +
-                             std::to_string(v[c].y()));
+            throw InputError("a patch corner outside 1-170 degrees near (" + std::to_string(v[c].x()) + ", " +
+                             std::to_string(v[c].y()) + ")");
         }
     } catch (const InputError& e) {
       if (debugging()) std::fprintf(stderr, "layout rejected at level %d: %s\n", level, e.what());
-      if (level > 0) {
+      if (level == 2) {
         // The optimization left a corner flat or reflex, or the cuts crossing
         // (a tangled start near rings much closer than the patch size): the
-        // same mesh, optimized less (level 2: rotations and node optimization;
-        // 1: node optimization; 0: the mesher's nodes).
-        out.stats.optimization_level = --level;
+        // same mesh without edge rotations.
+        out.stats.optimization_level = level = 1;
         continue;
       }
-      // Even the mesher's own layout fails (its cuts cross where the true
-      // rings are far from their chords): ring nodes more near the place, and again.
+      // Ring nodes more near the place, and a new mesh optimized in full;
+      // once the repairs are used up, the mesher's own nodes (level 0) are the
+      // last try (its cuts may cross where the true rings are far from their chords).
       const std::string what = e.what();
       const std::size_t at = what.find("near (");
-      if (at == std::string::npos || repairs >= o.max_repair_rounds) throw NumericalError("no valid quad layout: " + what);
-      char* end = nullptr;
-      const double px = std::strtod(what.c_str() + at + 6, &end);
-      const double py = end && *end == ',' ? std::strtod(end + 1, nullptr) : 0.0;
-      mark_nearest_piece(Eigen::Vector2d(px, py));
-      split_marked();
-      out.stats.repair_rounds = ++repairs;
-      out.stats.optimization_level = level = 2;  // the new mesh is optimized again
-      continue;
+      if (at != std::string::npos && repairs < o.max_repair_rounds) {
+        char* end = nullptr;
+        const double px = std::strtod(what.c_str() + at + 6, &end);
+        const double py = end && *end == ',' ? std::strtod(end + 1, nullptr) : 0.0;
+        mark_nearest_piece(Eigen::Vector2d(px, py));
+        split_marked();
+        out.stats.repair_rounds = ++repairs;
+        out.stats.optimization_level = level = 2;
+        continue;
+      }
+      if (level == 1) {
+        out.stats.optimization_level = level = 0;
+        continue;
+      }
+      throw NumericalError("no valid quad layout: " + what);
     }
     QuadLayoutStats& st = out.stats;
     st.patches = out.layout.patches.size();
