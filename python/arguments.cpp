@@ -161,8 +161,14 @@ DomainArgument domain_from_python(const py::object& domain, const tspline::io::D
   if (py::hasattr(domain, "__geo_interface__")) {
     tspline::io::DomainReadOptions o = options;
     if (!o.crs && py::hasattr(domain, "crs") && !domain.attr("crs").is_none()) o.crs = crs_text(domain.attr("crs"));
-    if (!o.crs) o.planar = true;
-    return from_geojson(domain.attr("__geo_interface__"), o, type_name_of(domain) + " (__geo_interface__)");
+    const bool without_crs = !o.crs && !o.planar;
+    if (without_crs) o.planar = true;
+    DomainArgument d = from_geojson(domain.attr("__geo_interface__"), o, type_name_of(domain) + " (__geo_interface__)");
+    if (without_crs) {  // not GeoJSON's WGS 84: the object has none
+      d.domain.description["crs"] = nullptr;
+      d.domain.description["units"] = "no CRS: planar, as given (crs= names one)";
+    }
+    return d;
   }
   if (options.layer || options.feature || options.polygon_index)
     throw tspline::InputError("layer, feature and polygon apply to a file or GeoJSON, not to an array of vertices");

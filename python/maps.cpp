@@ -4,6 +4,7 @@
 #include "maps.h"
 
 #include <pybind11/stl.h>
+#include <pybind11/stl/filesystem.h>
 
 #include <algorithm>
 #include <chrono>
@@ -109,7 +110,7 @@ Map load(const py::object& path_obj) {
   m.interfaces = file->interfaces;
   m.cuts = file->cuts;
   m.version = file->version;
-  m.source = *path;
+  m.source = file->source;  // the input the file records, so that save_tspline writes the file again
   m.report = to_python(json{{"input", *path}, {"version", file->version}, {"patches_count", file->patches.size()}});
   m.file = std::move(file);
   return m;
@@ -196,25 +197,26 @@ py::dict check(const Map& m, int depth, std::size_t max_listed) {
 }
 
 /// The T-spline file alone: version 1 for a single-patch map, 2 for a layout.
-void save_tspline(const Map& m, const std::string& path) {
+void save_tspline(const Map& m, const std::filesystem::path& file) {
+  const std::string path = file.string();
   if (m.version == 1) return tspline::io::write_tspline_file(path, *m.maps.front(), m.metas.front());
   tspline::io::write_multipatch_file(path, m.maps, m.metas, m.interfaces, m.cuts, m.source);
 }
 
-void save(const Map& m, const std::string& dir) {
+void save(const Map& m, const std::filesystem::path& dir) {
   if (!m.run)
     throw tspline::InputError("save: a map read by tspline.load has no parameterization to write (report, T-mesh "
                               "files); save_tspline(path) writes its T-spline file, save_vtk_bezier(path) its cells");
   py::gil_scoped_release release;
-  tspline_app::write_param_run(*m.run, dir);
+  tspline_app::write_param_run(*m.run, dir.string());
 }
 
 /// `tspline export --vtk-bezier`: every patch's Bezier cells in one file.
-void save_vtk_bezier(const Map& m, const std::string& path) {
+void save_vtk_bezier(const Map& m, const std::filesystem::path& path) {
   py::gil_scoped_release release;
   std::vector<toolkit::io::VtuMesh> parts;
   for (const tspline::TSplineMap* map : m.maps) parts.push_back(tspline::io::bezier_vtu(*map));
-  toolkit::io::write_vtu(path, tspline::io::merge_patches(parts));
+  toolkit::io::write_vtu(path.string(), tspline::io::merge_patches(parts));
 }
 
 /// The domain polygon as closed line cells (boundary.vtu's lines).
@@ -226,7 +228,7 @@ toolkit::io::VtuMesh polygon_lines(const tspline::Polygon& p) {
   return out;
 }
 
-py::dict render(const Map& m, const std::string& path, const std::string& view, std::pair<int, int> size,
+py::dict render(const Map& m, const std::filesystem::path& path, const std::string& view, std::pair<int, int> size,
                 int samples) {
   tspline::io::RenderOptions o;
   o.view = tspline::io::parse_render_view(view);
@@ -243,7 +245,7 @@ py::dict render(const Map& m, const std::string& path, const std::string& view, 
     }
     s = tspline::io::render_map({tspline::io::merge_patches(surface), tspline::io::merge_patches(boundary),
                                  tspline::io::merge_patches(net)},
-                                path, o);
+                                path.string(), o);
   }
   return py::dict("min"_a = s.min, "max"_a = s.max);
 }

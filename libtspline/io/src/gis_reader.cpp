@@ -202,7 +202,9 @@ DomainInput read_geojson_domain(const std::string& geojson, const DomainReadOpti
   std::unique_ptr<GDALDataset, DatasetCloser> ds(static_cast<GDALDataset*>(
       GDALOpenEx(mem.c_str(), GDAL_OF_VECTOR | GDAL_OF_READONLY, drivers, nullptr, nullptr)));
   if (!ds) throw InputError(name + ": not GeoJSON that GDAL reads" + QuietGdal::last());
-  return read_dataset(*ds, name, options);
+  DomainInput in = read_dataset(*ds, name, options);
+  in.description["layer"] = nullptr;  // GDAL's name of the in-memory file
+  return in;
 }
 
 namespace {
