@@ -7,14 +7,14 @@
 #include <vector>
 
 #include "commands.h"
-#include "tspline/errors.h"
 #include "toolkit/io/atomic_file.h"
 #include "toolkit/io/vtu_writer.h"
+#include "tspline/errors.h"
 #include "tspline/io/bezier_export.h"
 #include "tspline/io/bezier_vtu.h"
-#include "tspline/io/multipatch_output.h"
 #include "tspline/io/msh_export.h"
 #include "tspline/io/multipatch_file.h"
+#include "tspline/io/multipatch_output.h"
 #include "tspline/io/tspline_file.h"
 
 namespace tspline_app {

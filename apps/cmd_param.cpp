@@ -36,7 +36,9 @@ int param_command(const std::string& input, const std::string& out_dir, const Pa
     progress.event({{"event", "iteration"}, {"iteration", it}, {"cells", cells}, {"functions", functions}});
     progress.progress("adaptive rounds", it + 1, settings.adaptive.max_adapt + 1);
   };
-  hooks.on_patch = [&](std::size_t p, int round) { progress.event({{"event", "patch"}, {"patch", p}, {"round", round}}); };
+  hooks.on_patch = [&](std::size_t p, int round) {
+    progress.event({{"event", "patch"}, {"patch", p}, {"round", round}});
+  };
   const ParamRun run =
       tspline_app::run_param(tspline::io::read_domain(input, settings.domain), input, settings, hooks, t0);
   const tspline::AdaptiveOptions& adaptive = settings.adaptive;
@@ -100,7 +102,6 @@ int param_command(const std::string& input, const std::string& out_dir, const Pa
   return 0;
 }
 
-
 /// What `tspline param` takes besides the table's options.
 struct ParamArgs {
   std::string input, out_dir;
@@ -115,9 +116,11 @@ void add_param_command(CLI::App& app, CommandAction& action) {
   CLI::App* param = app.add_subcommand(
       "param", "Parameterize the domain bounded by a polygon: adapted T-mesh, Coons start, untangling and smoothing, "
       "cubic T-spline fit, Jacobian check and adaptive refinement");
-  param->add_option("DOMAIN", args->input,
-                    "Domain file: text polygon ('x y' per line, '#' comments, planar) or any polygon layer GDAL reads "
-                    "(Shapefile, GeoPackage, KML, GML, GeoJSON, ...; longitude/latitude are projected to metres)")
+  param
+      ->add_option(
+          "DOMAIN", args->input,
+          "Domain file: text polygon ('x y' per line, '#' comments, planar) or any polygon layer GDAL reads "
+          "(Shapefile, GeoPackage, KML, GML, GeoJSON, ...; longitude/latitude are projected to metres)")
       ->required();
   param->add_option("--out", args->out_dir, "Output directory (created if missing)")->required();
   add_param_options(*param, settings);  // the table shared with the Python module (param_options.h)
@@ -127,7 +130,8 @@ void add_param_command(CLI::App& app, CommandAction& action) {
                   "iteration, result) instead of text");
   param->callback([&action, args, settings] {
     action = [args, settings] {
-      return param_command(args->input, args->out_dir, *settings, output_mode(args->quiet, args->json_events));
+      return param_command(args->input, args->out_dir, *settings,
+                           output_mode(args->quiet, args->json_events));
     };
   });
 }

@@ -52,13 +52,14 @@ int run_smooth(const SmoothArgs& a) {
   const nlohmann::json j = meshopt_app::smooth_model(a, on_sweep);
   const nlohmann::json& elements = j["elements"];
   const std::string vtu = j["outputs"]["vtu"];
-  std::cout << "meshopt smooth: " << j["surfaces"] << " surfaces, " << j["nodes"] << " nodes (" << j["free_nodes"]
-            << " free), " << elements["triangles"] << " triangles, " << elements["quadrangles"] << " quadrangles\n"
+  std::cout << "meshopt smooth: " << j["surfaces"] << " surfaces, " << j["nodes"] << " nodes ("
+            << j["free_nodes"] << " free), " << elements["triangles"] << " triangles, "
+            << elements["quadrangles"] << " quadrangles\n"
             << line("before", j["before"]) << "\n"
             << line("after", j["after"]) << "\n"
-            << j["sweeps"] << " sweeps" << (j["converged"].get<bool>() ? " (converged)" : " (not converged)") << ", "
-            << j["seconds"].get<double>() << " s\nwrote " << a.out << (vtu.empty() ? "" : ", " + vtu) << ", "
-            << j["outputs"]["report"].get<std::string>() << std::endl;
+            << j["sweeps"] << " sweeps" << (j["converged"].get<bool>() ? " (converged)" : " (not converged)")
+            << ", " << j["seconds"].get<double>() << " s\nwrote " << a.out << (vtu.empty() ? "" : ", " + vtu)
+            << ", " << j["outputs"]["report"].get<std::string>() << std::endl;
   const std::size_t tangled = j["after"]["tangled"];
   if (tangled > 0) {
     std::cerr << "error: " << tangled << " elements are still tangled" << std::endl;

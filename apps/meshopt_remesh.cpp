@@ -36,10 +36,14 @@ nlohmann::json statistics_json(const meshopt::RemeshStatistics& s) {
   return {{"vertices", s.vertices},
           {"triangles", s.triangles},
           {"length6d_over_L",
-           {{"min", s.length_ratio_min}, {"mean", s.length_ratio_mean}, {"max", s.length_ratio_max},
+           {{"min", s.length_ratio_min},
+            {"mean", s.length_ratio_mean},
+            {"max", s.length_ratio_max},
             {"histogram", histogram_json(s.length_ratio)}}},
           {"min_angle6d_degrees",
-           {{"min", s.min_angle_min}, {"mean", s.min_angle_mean}, {"histogram", histogram_json(s.min_angle_degrees)}}},
+           {{"min", s.min_angle_min},
+            {"mean", s.min_angle_mean},
+            {"histogram", histogram_json(s.min_angle_degrees)}}},
           {"aspect_ratio3d", {{"min", s.quality_min}, {"mean", s.quality_mean}}}};
 }
 
@@ -57,7 +61,8 @@ Deviation deviation(const std::vector<double>& d) {
 }
 
 void write_vtu(const std::string& path, const meshopt::RemeshMesh& m, double length, double s,
-               const meshopt::gmsh_io::CurvatureAlignment& align, const meshopt::gmsh_io::CentroidProjection& centroids) {
+               const meshopt::gmsh_io::CurvatureAlignment& align,
+               const meshopt::gmsh_io::CentroidProjection& centroids) {
   const std::vector<int>& faces = centroids.face;
   toolkit::io::VtuMesh v;
   for (const meshopt::RemeshVertex& x : m.vertices) v.points3d.push_back(x.x);
@@ -85,17 +90,20 @@ nlohmann::json remesh_model(const RemeshArgs& a, tspline_app::Progress& out) {
   namespace fs = std::filesystem;
   if (!(a.max_deviation >= 0.0) || !std::isfinite(a.max_deviation))
     throw toolkit::InputError("--max-deviation must be positive");
-  if (a.length == 0.0 && a.max_deviation == 0.0) throw toolkit::InputError("give --length or --max-deviation");
+  if (a.length == 0.0 && a.max_deviation == 0.0)
+    throw toolkit::InputError("give --length or --max-deviation");
   if (a.length != 0.0 && (!(a.length > 0.0) || !std::isfinite(a.length)))
     throw toolkit::InputError("--length must be positive");
   if (a.anisotropy != -1.0 && (!(a.anisotropy >= 0.0) || !std::isfinite(a.anisotropy)))
     throw toolkit::InputError("--anisotropy must be >= 0");
   if (!(a.feature_angle >= 0.0 && a.feature_angle <= 180.0))
     throw toolkit::InputError("--feature-angle must be in [0, 180] degrees");
-  if (!(a.min_angle >= 0.0 && a.min_angle < 60.0)) throw toolkit::InputError("--min-angle must be in [0, 60) degrees");
+  if (!(a.min_angle >= 0.0 && a.min_angle < 60.0))
+    throw toolkit::InputError("--min-angle must be in [0, 60) degrees");
   if (a.rounds < 0) throw toolkit::InputError("--rounds must be >= 0");
   if (fs::path(a.out).extension() != ".msh") throw toolkit::InputError("--out must end in .msh");
-  const std::string report = a.report.empty() ? fs::path(a.out).replace_extension(".json").string() : a.report;
+  const std::string report =
+      a.report.empty() ? fs::path(a.out).replace_extension(".json").string() : a.report;
   for (const std::string& f : {a.out, a.vtu, report})
     if (!f.empty()) toolkit::io::ensure_writable_directory(fs::absolute(f).parent_path().string());
 
@@ -156,7 +164,9 @@ nlohmann::json remesh_model(const RemeshArgs& a, tspline_app::Progress& out) {
   const auto euler_after = mesh.euler_characteristics();
   nlohmann::json euler = nlohmann::json::array();
   bool topology_kept = euler_before == euler_after;
-  for (const auto& [p, chi] : euler_after) euler.push_back({{"patch", p}, {"before", euler_before.count(p) ? euler_before.at(p) : 0}, {"after", chi}});
+  for (const auto& [p, chi] : euler_after)
+    euler.push_back(
+        {{"patch", p}, {"before", euler_before.count(p) ? euler_before.at(p) : 0}, {"after", chi}});
   const std::size_t non_manifold = mesh.non_manifold_edges();
   const nlohmann::json j = {
       {"model", a.model},
@@ -177,7 +187,8 @@ nlohmann::json remesh_model(const RemeshArgs& a, tspline_app::Progress& out) {
         {"max_relative", dev.max / geometry.features().diagonal},
         {"mean_relative", dev.mean / geometry.features().diagonal},
         {"diagonal", geometry.features().diagonal}}},
-      {"topology", {{"euler_characteristics", euler}, {"kept", topology_kept}, {"non_manifold_edges", non_manifold}}},
+      {"topology",
+       {{"euler_characteristics", euler}, {"kept", topology_kept}, {"non_manifold_edges", non_manifold}}},
       {"operations",
        {{"splits", rep.splits},
         {"collapses", rep.collapses},

@@ -34,8 +34,8 @@ nlohmann::json smooth_model(const SmoothArgs& args, const SweepProgress& on_swee
 
 struct RemeshArgs {
   std::string model, out, mesh, vtu, report;
-  double length = 0.0;       ///< 0: derived from max_deviation (see meshopt_remesh.cpp)
-  double anisotropy = -1.0;  ///< < 0: the default (see meshopt_remesh.cpp)
+  double length = 0.0;         ///< 0: derived from max_deviation (see meshopt_remesh.cpp)
+  double anisotropy = -1.0;    ///< < 0: the default (see meshopt_remesh.cpp)
   double max_deviation = 0.0;  ///< 0: no cap on the chordal deviation
   double feature_angle = 30.0;
   double min_angle = 20.0;

@@ -69,8 +69,8 @@ void check_choice(const std::vector<std::string>& choices, const std::string& te
 
 void check_range(const std::pair<double, double>& range, double v) {
   if (!(v >= range.first && v <= range.second))
-    throw InputError(number_text(v) + " is not in [" + number_text(range.first) + ", " + number_text(range.second) +
-                     "]");
+    throw InputError(number_text(v) + " is not in [" + number_text(range.first) + ", " +
+                     number_text(range.second) + "]");
 }
 
 // ------------------------------------------------------------ table builders
@@ -91,7 +91,7 @@ ParamOption option(std::string name, OptionKind kind, std::string help, Setter s
 /// A number option on one field; `field(s)` is that field of s (const or not).
 template <class T, class Field>
 ParamOption number(std::string name, std::string help, Field field) {
-  constexpr OptionKind kind = std::is_floating_point_v<T>    ? OptionKind::Real
+  constexpr OptionKind kind = std::is_floating_point_v<T>      ? OptionKind::Real
                               : std::is_same_v<T, std::size_t> ? OptionKind::Count
                                                                : OptionKind::Integer;
   auto set = [field](ParamSettings& s, const std::string& text) {
@@ -102,7 +102,8 @@ ParamOption number(std::string name, std::string help, Field field) {
     else
       field(s) = parse_int(text);
   };
-  return option(std::move(name), kind, std::move(help), set, [field](const ParamSettings& s) { return json(field(s)); });
+  return option(std::move(name), kind, std::move(help), set,
+                [field](const ParamSettings& s) { return json(field(s)); });
 }
 
 /// The setter with the entry's choices and range checked first.
@@ -118,15 +119,18 @@ std::vector<ParamOption> make_table() {
   std::vector<ParamOption> t;
   t.push_back(option(
       "layout", OptionKind::Text,
-      "auto: one patch where a first try is certified and good over the whole map (scaled Jacobian >= 0.3, J_r >= "
-      "0.1), an automatic quad layout otherwise and always for domains with holes; single: one patch (no holes); "
+      "auto: one patch where a first try is certified and good over the whole map (scaled Jacobian >= 0.3, "
+      "J_r >= "
+      "0.1), an automatic quad layout otherwise and always for domains with holes; single: one patch (no "
+      "holes); "
       "quad: the automatic quad layout",
       [](ParamSettings& s, const std::string& v) { s.choice.layout = tspline::parse_layout_mode(v); },
       [](const ParamSettings& s) { return json(tspline::layout_mode_name(s.choice.layout)); }));
   t.back().choices = {"auto", "single", "quad"};
   t.push_back(option(
       "cuts", OptionKind::Text,
-      "The layout given by hand: cuts into four-sided patches as polylines ('x y' per line, cuts separated by blank "
+      "The layout given by hand: cuts into four-sided patches as polylines ('x y' per line, cuts separated "
+      "by blank "
       "lines; ends on rings or at ends of other cuts); default: --layout",
       [](ParamSettings& s, const std::string& v) { s.cuts_file = v; },
       [](const ParamSettings& s) { return json(s.cuts_file); }));
@@ -138,21 +142,26 @@ std::vector<ParamOption> make_table() {
       [](ParamSettings& s, const std::string& v) { s.opt.corners = parse_corners(v); },
       [](const ParamSettings& s) { return s.opt.corners ? json(*s.opt.corners) : json(); }));
   t.back().show_default = false;
-  t.push_back(number<int>("corner-trials",
-                          "Automatic corners: run this many of the best choices and keep the one with the fewest "
-                          "inverted cells, then the best min + mean quality (1: no trials)",
-                          [](auto& s) -> auto& { return s.opt.corner_trials; }));
+  t.push_back(number<int>(
+      "corner-trials",
+      "Automatic corners: run this many of the best choices and keep the one with the fewest "
+      "inverted cells, then the best min + mean quality (1: no trials)",
+      [](auto& s) -> auto& { return s.opt.corner_trials; }));
   t.push_back(option(
       "tol", OptionKind::Real,
-      "Boundary tolerance epsilon as an absolute AREA (units^2): a boundary cell is refined while a polygon vertex "
+      "Boundary tolerance epsilon as an absolute AREA (units^2): a boundary cell is refined while a polygon "
+      "vertex "
       "forms with its edge a triangle larger than epsilon (Brovka 2013 Sect. 3)",
       [](ParamSettings& s, const std::string& v) { s.opt.tolerance_absolute = parse_real(v); },
-      [](const ParamSettings& s) { return s.opt.tolerance_absolute ? json(*s.opt.tolerance_absolute) : json(); }));
+      [](const ParamSettings& s) {
+        return s.opt.tolerance_absolute ? json(*s.opt.tolerance_absolute) : json();
+      }));
   t.back().show_default = false;
-  t.push_back(number<double>("tol-rel",
-                             "Boundary tolerance relative to the squared bounding-box diagonal, used when --tol is "
-                             "not given",
-                             [](auto& s) -> auto& { return s.opt.tolerance_relative; }));
+  t.push_back(number<double>(
+      "tol-rel",
+      "Boundary tolerance relative to the squared bounding-box diagonal, used when --tol is "
+      "not given",
+      [](auto& s) -> auto& { return s.opt.tolerance_relative; }));
   t.push_back(option(
       "init-level", OptionKind::Integer,
       "Initial uniform level L in [0, 10]: 2^L x 2^L cells (patches of a quad layout: 2 unless given)",
@@ -162,15 +171,17 @@ std::vector<ParamOption> make_table() {
       },
       [](const ParamSettings& s) {
         return json{{"initial_level", s.opt.initial_level},
-                    {"patch_initial_level", s.choice.patch_initial_level ? json(*s.choice.patch_initial_level)
-                                                                         : json()}};
+                    {"patch_initial_level",
+                     s.choice.patch_initial_level ? json(*s.choice.patch_initial_level) : json()}};
       }));
-  t.push_back(number<int>("max-level", "Maximum refinement level of any cell",
-                          [](auto& s) -> auto& { return s.opt.max_level; }));
-  t.push_back(number<int>("max-sweeps", "Maximum Gauss-Seidel sweeps of the optimization",
-                          [](auto& s) -> auto& { return s.opt.smoothing.max_sweeps; }));
-  t.push_back(number<double>("omega", "Over-relaxation factor in [1, 2) of the node updates (1: plain Gauss-Seidel)",
-                             [](auto& s) -> auto& { return s.opt.smoothing.over_relaxation; }));
+  t.push_back(number<int>(
+      "max-level", "Maximum refinement level of any cell", [](auto& s) -> auto& { return s.opt.max_level; }));
+  t.push_back(number<int>(
+      "max-sweeps", "Maximum Gauss-Seidel sweeps of the optimization",
+      [](auto& s) -> auto& { return s.opt.smoothing.max_sweeps; }));
+  t.push_back(number<double>(
+      "omega", "Over-relaxation factor in [1, 2) of the node updates (1: plain Gauss-Seidel)",
+      [](auto& s) -> auto& { return s.opt.smoothing.over_relaxation; }));
   t.push_back(number<double>(
       "sweep-tol", "Stop when the largest node move relative to its local edge length is below this",
       [](auto& s) -> auto& { return s.opt.smoothing.relative_displacement_tolerance; }));
@@ -179,10 +190,13 @@ std::vector<ParamOption> make_table() {
       "GIS file (or GeoJSON) with several polygons (in the layer or the --feature): which one (0-based, file "
       "order); default the largest",
       [](ParamSettings& s, const std::string& v) { s.domain.polygon_index = parse_count(v); },
-      [](const ParamSettings& s) { return s.domain.polygon_index ? json(*s.domain.polygon_index) : json(); }));
+      [](const ParamSettings& s) {
+        return s.domain.polygon_index ? json(*s.domain.polygon_index) : json();
+      }));
   t.back().show_default = false;
   t.push_back(option(
-      "layer", OptionKind::Text, "GIS file: layer name or 0-based index; default the first layer with polygons",
+      "layer", OptionKind::Text,
+      "GIS file: layer name or 0-based index; default the first layer with polygons",
       [](ParamSettings& s, const std::string& v) { s.domain.layer = v; },
       [](const ParamSettings& s) { return s.domain.layer ? json(*s.domain.layer) : json(); }));
   t.back().show_default = false;
@@ -192,18 +206,22 @@ std::vector<ParamOption> make_table() {
       [](const ParamSettings& s) { return s.domain.feature ? json(*s.domain.feature) : json(); }));
   t.back().show_default = false;
   t.push_back(option(
-      "planar", OptionKind::Flag, "Keep the coordinates as they are (no projection of longitude/latitude to metres)",
+      "planar", OptionKind::Flag,
+      "Keep the coordinates as they are (no projection of longitude/latitude to metres)",
       [](ParamSettings& s, const std::string&) { s.domain.planar = true; },
       [](const ParamSettings& s) { return json(s.domain.planar); }));
-  t.push_back(number<double>("min-jacobian",
-                             "delta of Sect. 6.2: refine the cells where the mean ratio Jacobian J_r = 2 det J / "
-                             "|J|^2 is below it at some of the 4x4 Gauss points",
-                             [](auto& s) -> auto& { return s.adaptive.min_jacobian; }));
-  t.push_back(number<int>("max-adapt", "Adaptive refinement rounds at most",
-                          [](auto& s) -> auto& { return s.adaptive.max_adapt; }));
+  t.push_back(number<double>(
+      "min-jacobian",
+      "delta of Sect. 6.2: refine the cells where the mean ratio Jacobian J_r = 2 det J / "
+      "|J|^2 is below it at some of the 4x4 Gauss points",
+      [](auto& s) -> auto& { return s.adaptive.min_jacobian; }));
+  t.push_back(number<int>(
+      "max-adapt", "Adaptive refinement rounds at most",
+      [](auto& s) -> auto& { return s.adaptive.max_adapt; }));
   t.push_back(option(
       "max-cells", OptionKind::Count,
-      "The T-mesh never goes beyond this many cells (boundary refinement, repair, adaptive refinement); a polygon "
+      "The T-mesh never goes beyond this many cells (boundary refinement, repair, adaptive refinement); a "
+      "polygon "
       "that needs more stops with a message",
       [](ParamSettings& s, const std::string& v) {
         s.adaptive.max_cells = parse_count(v);
@@ -223,20 +241,22 @@ std::vector<ParamOption> make_table() {
       "Minimizer of the control-point untangling and smoothing: 'lbfgs' or 'newton' (projected Newton with "
       "CHOLMOD: fewer iterations, each a sparse Cholesky; slower on the benchmarks)",
       [](ParamSettings& s, const std::string& v) {
-        s.adaptive.untangling.optimizer = v == "lbfgs" ? tspline::MapOptimizer::LBFGS : tspline::MapOptimizer::Newton;
+        s.adaptive.untangling.optimizer =
+            v == "lbfgs" ? tspline::MapOptimizer::LBFGS : tspline::MapOptimizer::Newton;
       },
       [](const ParamSettings& s) {
         return json(s.adaptive.untangling.optimizer == tspline::MapOptimizer::LBFGS ? "lbfgs" : "newton");
       }));
   t.back().choices = {"newton", "lbfgs"};
-  t.push_back(number<int>("cert-depth",
-                          "Certification of det J > 0 on every Bezier element: de Casteljau subdivision levels at "
-                          "most (an element still undecided there is refined like one with J_r below "
-                          "--min-jacobian)",
-                          [](auto& s) -> auto& { return s.adaptive.certification.max_depth; }));
+  t.push_back(number<int>(
+      "cert-depth",
+      "Certification of det J > 0 on every Bezier element: de Casteljau subdivision levels at "
+      "most (an element still undecided there is refined like one with J_r below "
+      "--min-jacobian)",
+      [](auto& s) -> auto& { return s.adaptive.certification.max_depth; }));
   t.back().range = {{0.0, 20.0}};
-  t.push_back(number<int>("samples", "surface.vtu: k x k sub-quads per T-mesh cell",
-                          [](auto& s) -> auto& { return s.samples; }));
+  t.push_back(number<int>(
+      "samples", "surface.vtu: k x k sub-quads per T-mesh cell", [](auto& s) -> auto& { return s.samples; }));
   t.back().range = {{1.0, 64.0}};
   for (ParamOption& o : t) o.set = validated(o);  // choices and range before anything is set
   return t;

@@ -9,11 +9,15 @@ namespace {
 
 const char* type_name(OptionKind kind) {
   switch (kind) {
-    case OptionKind::Integer: return "INT";
-    case OptionKind::Count: return "UINT";
-    case OptionKind::Real: return "FLOAT";
+    case OptionKind::Integer:
+      return "INT";
+    case OptionKind::Count:
+      return "UINT";
+    case OptionKind::Real:
+      return "FLOAT";
     case OptionKind::Flag:
-    case OptionKind::Text: break;
+    case OptionKind::Text:
+      break;
   }
   return "TEXT";
 }
@@ -24,7 +28,8 @@ void add_param_options(CLI::App& cmd, const std::shared_ptr<ParamSettings>& sett
   for (const ParamOption& o : param_options()) {
     const std::string flag = "--" + o.name;
     if (o.kind == OptionKind::Flag) {
-      cmd.add_flag_callback(flag, [&o, settings, flag] { o.apply(*settings, "true", flag); }, o.help);
+      cmd.add_flag_callback(
+          flag, [&o, settings, flag] { o.apply(*settings, "true", flag); }, o.help);
       continue;
     }
     CLI::Option* opt = cmd.add_option_function<std::string>(

@@ -45,8 +45,9 @@ json multipatch_report(const ParamRun& run) {
                                 {"seconds", s.seconds}};
   }
   if (P.rejected_single)
-    report["layout"]["single_patch_first_try"] = {{"min_scaled_jacobian_dense", P.rejected_single->min_scaled},
-                                                  {"min_mean_ratio_dense", P.rejected_single->min_mean_ratio}};
+    report["layout"]["single_patch_first_try"] = {
+        {"min_scaled_jacobian_dense", P.rejected_single->min_scaled},
+        {"min_mean_ratio_dense", P.rejected_single->min_mean_ratio}};
   return report;
 }
 
@@ -69,7 +70,8 @@ std::vector<const tspline::TSplineMap*> ParamRun::maps() const {
 }
 
 bool ParamRun::certified_valid() const {
-  return result.patches ? result.patches->certified_valid() : result.single && result.single->certified_valid();
+  return result.patches ? result.patches->certified_valid()
+                        : result.single && result.single->certified_valid();
 }
 
 ParamRun run_param(tspline::io::DomainInput domain, std::string source, const ParamSettings& settings,
@@ -89,8 +91,9 @@ ParamRun run_param(tspline::io::DomainInput domain, std::string source, const Pa
   const tspline::io::DomainInput& in = run.domain;
   const bool several = !in.holes.empty() || choice.cuts || choice.layout == tspline::LayoutMode::Quad;
   if (opt.corners && several)
-    throw tspline::InputError("--corners applies to a single patch; a layout of several patches has its corners "
-                              "at the patch corners (use --layout single on a domain without holes)");
+    throw tspline::InputError(
+        "--corners applies to a single patch; a layout of several patches has its corners "
+        "at the patch corners (use --layout single on a domain without holes)");
   // A domain with holes: every ring is cleaned here with the run's boundary
   // tolerance (needles narrower than epsilon / diagonal go, one note per
   // cleaned ring); the pipeline's own validate_domain then finds nothing more.
@@ -98,11 +101,13 @@ ParamRun run_param(tspline::io::DomainInput domain, std::string source, const Pa
   tspline::Domain rings{in.outer, in.holes};
   if (!in.holes.empty()) {
     tspline::DomainCleaningOptions how;
-    how.needle_width = tspline::needle_width_for_ring(in.outer, opt.tolerance_absolute, opt.tolerance_relative);
+    how.needle_width =
+        tspline::needle_width_for_ring(in.outer, opt.tolerance_absolute, opt.tolerance_relative);
     how.notes = &run.cleaning_notes;
     auto report_notes = [&] {
       for (const std::string& note : run.cleaning_notes)
-        tspline::report_step(opt.progress, "cleaning", "note: " + note, -1, tspline::ProgressEvent::Kind::Note);
+        tspline::report_step(opt.progress, "cleaning", "note: " + note, -1,
+                             tspline::ProgressEvent::Kind::Note);
     };
     try {
       rings = tspline::validate_domain(rings, how);
@@ -114,8 +119,8 @@ ParamRun run_param(tspline::io::DomainInput domain, std::string source, const Pa
   }
   run.result = tspline::parameterize_domain(
       rings, opt, settings.adaptive, choice,
-      [&](int it, const tspline::TMesh& mesh, const std::vector<Eigen::Vector2d>&, const tspline::TSplineMap& map,
-          const std::vector<tspline::CellMapQuality>& cells) {
+      [&](int it, const tspline::TMesh& mesh, const std::vector<Eigen::Vector2d>&,
+          const tspline::TSplineMap& map, const std::vector<tspline::CellMapQuality>& cells) {
         if (it == 0) run.iterations.clear();  // a new run (auto's first try was run again, or dropped)
         run.iterations.push_back({it, map, cells});
         if (hooks.on_iteration) hooks.on_iteration(it, mesh.num_cells(), map.basis().size());

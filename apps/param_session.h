@@ -25,8 +25,8 @@ struct ParamIteration {
 };
 
 struct ParamRun {
-  std::string source;  ///< what report.json calls the input (its path, or "array", ...)
-  tspline::io::DomainInput domain;  ///< as read (description: format, CRS, projection, holes)
+  std::string source;                       ///< what report.json calls the input (its path, or "array", ...)
+  tspline::io::DomainInput domain;          ///< as read (description: format, CRS, projection, holes)
   std::vector<std::string> cleaning_notes;  ///< what the cleaning of the rings removed (domains with holes)
   tspline::DomainParameterization result;
   std::vector<ParamIteration> iterations;  ///< the single patch's adaptive rounds (empty for several patches)

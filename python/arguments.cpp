@@ -13,7 +13,9 @@ using namespace pybind11::literals;
 using tspline_app::OptionKind;
 using tspline_app::ParamOption;
 
-std::string type_name_of(const py::handle& v) { return py::str(py::type::of(v).attr("__name__")).cast<std::string>(); }
+std::string type_name_of(const py::handle& v) {
+  return py::str(py::type::of(v).attr("__name__")).cast<std::string>();
+}
 
 [[noreturn]] void wrong_type(const ParamOption& o, const char* expected, const py::handle& v) {
   throw py::type_error(o.python_name() + ": expected " + expected + ", got " + type_name_of(v));
@@ -109,8 +111,10 @@ std::vector<Array> rings_of(const py::object& domain) {
     for (const py::handle& r : a) rings.push_back(py::cast<Array>(r));
   } else {
     if (!py::isinstance<py::sequence>(domain) || py::isinstance<py::str>(domain))
-      throw py::type_error("domain: expected a path, an (n, 2) array, a list of rings, a GeoJSON dict or an object "
-                           "with __geo_interface__, got " + type_name_of(domain));
+      throw py::type_error(
+          "domain: expected a path, an (n, 2) array, a list of rings, a GeoJSON dict or an object "
+          "with __geo_interface__, got " +
+          type_name_of(domain));
     for (const py::handle& r : domain) rings.push_back(py::cast<Array>(r));
   }
   if (rings.empty()) throw tspline::InputError("domain: no rings");
@@ -120,12 +124,14 @@ std::vector<Array> rings_of(const py::object& domain) {
 /// GeoJSON coordinates of a ring (closed, as RFC 7946 requires).
 py::list geojson_ring(const Array& ring) {
   py::list coords;
-  for (std::size_t i = 0; i < rows_of(ring, "ring"); ++i) coords.append(py::make_tuple(ring.at(i, 0), ring.at(i, 1)));
+  for (std::size_t i = 0; i < rows_of(ring, "ring"); ++i)
+    coords.append(py::make_tuple(ring.at(i, 0), ring.at(i, 1)));
   if (py::len(coords) > 0) coords.append(coords[0]);
   return coords;
 }
 
-DomainArgument from_geojson(const py::object& geojson, tspline::io::DomainReadOptions options, const std::string& name) {
+DomainArgument from_geojson(const py::object& geojson, tspline::io::DomainReadOptions options,
+                            const std::string& name) {
   const std::string text = py::module_::import("json").attr("dumps")(geojson).cast<std::string>();
   return {tspline::io::read_geojson_domain(text, options, name), name};
 }
@@ -141,7 +147,8 @@ tspline_app::ParamSettings settings_from_keywords(const py::dict& keywords, std:
       continue;
     }
     const ParamOption* o = tspline_app::find_param_option(name);
-    if (!o || o->python_name() != name) throw py::type_error("parameterize: unknown keyword argument '" + name + "'");
+    if (!o || o->python_name() != name)
+      throw py::type_error("parameterize: unknown keyword argument '" + name + "'");
     if (value.is_none()) continue;  // the default
     if (name == "cuts" && !path_of(value) && !py::isinstance<py::str>(value)) {
       s.choice.cuts = cuts_from_python(value);
@@ -160,10 +167,12 @@ DomainArgument domain_from_python(const py::object& domain, const tspline::io::D
   // planar coordinates unless crs= names theirs.
   if (py::hasattr(domain, "__geo_interface__")) {
     tspline::io::DomainReadOptions o = options;
-    if (!o.crs && py::hasattr(domain, "crs") && !domain.attr("crs").is_none()) o.crs = crs_text(domain.attr("crs"));
+    if (!o.crs && py::hasattr(domain, "crs") && !domain.attr("crs").is_none())
+      o.crs = crs_text(domain.attr("crs"));
     const bool without_crs = !o.crs && !o.planar;
     if (without_crs) o.planar = true;
-    DomainArgument d = from_geojson(domain.attr("__geo_interface__"), o, type_name_of(domain) + " (__geo_interface__)");
+    DomainArgument d =
+        from_geojson(domain.attr("__geo_interface__"), o, type_name_of(domain) + " (__geo_interface__)");
     if (without_crs) {  // not GeoJSON's WGS 84: the object has none
       d.domain.description["crs"] = nullptr;
       d.domain.description["units"] = "no CRS: planar, as given (crs= names one)";
@@ -171,7 +180,8 @@ DomainArgument domain_from_python(const py::object& domain, const tspline::io::D
     return d;
   }
   if (options.layer || options.feature || options.polygon_index)
-    throw tspline::InputError("layer, feature and polygon apply to a file or GeoJSON, not to an array of vertices");
+    throw tspline::InputError(
+        "layer, feature and polygon apply to a file or GeoJSON, not to an array of vertices");
   const std::vector<Array> rings = rings_of(domain);
   if (options.crs && !options.planar) {  // in a CRS: projected as GIS data are
     py::list coordinates;
@@ -185,7 +195,10 @@ DomainArgument domain_from_python(const py::object& domain, const tspline::io::D
   d.source = rings.size() > 1 ? "rings" : "array";
   d.domain.outer = polygon_of(rings.front(), "domain");
   for (std::size_t h = 1; h < rings.size(); ++h) d.domain.holes.push_back(polygon_of(rings[h], "hole"));
-  d.domain.description = {{"format", d.source}, {"crs", nullptr}, {"projection", nullptr}, {"units", "as given"},
+  d.domain.description = {{"format", d.source},
+                          {"crs", nullptr},
+                          {"projection", nullptr},
+                          {"units", "as given"},
                           {"holes", d.domain.holes.size()}};
   return d;
 }

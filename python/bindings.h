@@ -6,8 +6,8 @@
 
 #include <Eigen/Core>
 #include <cstddef>
-#include <optional>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <string>
 
 namespace tspline_python {

@@ -5,10 +5,11 @@
 //   tspline.NumericalError (Error, ArithmeticError) toolkit::NumericalError: a numerical step failed
 // with the messages of the command line. Ctrl-C during a run raises
 // KeyboardInterrupt, as anywhere in Python.
+#include "toolkit/errors.h"
+
 #include <Python.h>
 
 #include "bindings.h"
-#include "toolkit/errors.h"
 
 namespace tspline_python {
 namespace {
@@ -30,13 +31,15 @@ void bind_errors(py::module_& m) {
   static PyObject *error, *input_error, *io_error, *numerical_error;
   error = new_exception(m, "Error", py::make_tuple(py::handle(PyExc_Exception)),
                         "Any error that the tspline library reports.");
-  input_error = new_exception(m, "InputError", py::make_tuple(py::handle(error), py::handle(PyExc_ValueError)),
-                              "Invalid input or options (a domain that is not a simple polygon, an option out of "
-                              "range, a malformed file); the command line's exit code 1.");
+  input_error =
+      new_exception(m, "InputError", py::make_tuple(py::handle(error), py::handle(PyExc_ValueError)),
+                    "Invalid input or options (a domain that is not a simple polygon, an option out of "
+                    "range, a malformed file); the command line's exit code 1.");
   io_error = new_exception(m, "IoError", py::make_tuple(py::handle(error), py::handle(PyExc_OSError)),
                            "A file could not be read or written; the command line's exit code 2.");
-  numerical_error = new_exception(m, "NumericalError", py::make_tuple(py::handle(error), py::handle(PyExc_ArithmeticError)),
-                                  "A numerical step failed (e.g. a singular system); the command line's exit code 3.");
+  numerical_error =
+      new_exception(m, "NumericalError", py::make_tuple(py::handle(error), py::handle(PyExc_ArithmeticError)),
+                    "A numerical step failed (e.g. a singular system); the command line's exit code 3.");
   py::register_exception_translator([](std::exception_ptr p) {
     try {
       if (p) std::rethrow_exception(p);

@@ -111,7 +111,8 @@ Map load(const py::object& path_obj) {
   m.cuts = file->cuts;
   m.version = file->version;
   m.source = file->source;  // the input the file records, so that save_tspline writes the file again
-  m.report = to_python(json{{"input", *path}, {"version", file->version}, {"patches_count", file->patches.size()}});
+  m.report =
+      to_python(json{{"input", *path}, {"version", file->version}, {"patches_count", file->patches.size()}});
   m.file = std::move(file);
   return m;
 }
@@ -144,14 +145,16 @@ py::list interfaces_of(const Map& m) {
   py::list out;
   for (const tspline::Interface& f : m.interfaces)
     out.append(py::dict("patch_a"_a = f.patch_a, "side_a"_a = tspline::io::side_name(f.side_a),
-                        "patch_b"_a = f.patch_b, "side_b"_a = tspline::io::side_name(f.side_b), "cut"_a = f.cut));
+                        "patch_b"_a = f.patch_b, "side_b"_a = tspline::io::side_name(f.side_b),
+                        "cut"_a = f.cut));
   return out;
 }
 
 /// `tspline check` as a dict: per patch the certificate of det J > 0 and the
 /// whole-map quality bounds; the largest gap between the two images of a cut.
 py::dict check(const Map& m, int depth, std::size_t max_listed) {
-  if (depth < 0 || depth > 20) throw tspline::InputError("depth: " + std::to_string(depth) + " is not in [0, 20]");
+  if (depth < 0 || depth > 20)
+    throw tspline::InputError("depth: " + std::to_string(depth) + " is not in [0, 20]");
   json patches = json::array();
   bool all = true;
   double gap = 0.0;
@@ -166,34 +169,37 @@ py::dict check(const Map& m, int depth, std::size_t max_listed) {
       for (std::size_t k = 0; k < c.failures.size() && k < max_listed; ++k) {
         const tspline::CertificationFailure& f = c.failures[k];
         const bool invalid = f.certificate.status == tspline::ElementStatus::Invalid;
-        failures.push_back({{"cell", f.cell},
-                            {"element", f.element},
-                            {"lo", {f.lo.x(), f.lo.y()}},
-                            {"hi", {f.hi.x(), f.hi.y()}},
-                            {"status", invalid ? "invalid" : "undecided"},
-                            {"negative_at", invalid ? json{f.certificate.negative_at.x(), f.certificate.negative_at.y()}
-                                                    : json()},
-                            {"negative_det", invalid ? json(f.certificate.negative_det) : json()}});
+        failures.push_back(
+            {{"cell", f.cell},
+             {"element", f.element},
+             {"lo", {f.lo.x(), f.lo.y()}},
+             {"hi", {f.hi.x(), f.hi.y()}},
+             {"status", invalid ? "invalid" : "undecided"},
+             {"negative_at",
+              invalid ? json{f.certificate.negative_at.x(), f.certificate.negative_at.y()} : json()},
+             {"negative_det", invalid ? json(f.certificate.negative_det) : json()}});
       }
       auto finite = [](double v) { return std::isfinite(v) ? json(v) : json(); };
-      patches.push_back({{"cells", map->mesh().num_cells()},
-                         {"elements", c.elements},
-                         {"certified", c.certified},
-                         {"invalid", c.invalid},
-                         {"undecided", c.undecided},
-                         {"certified_valid", c.certified_valid()},
-                         {"min_relative_det_lower_bound", finite(c.min_relative_lower_bound)},
-                         {"min_det_lower_bound", finite(c.min_det_lower_bound)},
-                         {"max_depth_used", c.max_depth_used},
-                         {"whole_map", tspline::io::whole_map_quality_json(tspline::certified_map_quality(*map, qo), qo)},
-                         {"failures", std::move(failures)},
-                         {"seconds", c.seconds}});
+      patches.push_back(
+          {{"cells", map->mesh().num_cells()},
+           {"elements", c.elements},
+           {"certified", c.certified},
+           {"invalid", c.invalid},
+           {"undecided", c.undecided},
+           {"certified_valid", c.certified_valid()},
+           {"min_relative_det_lower_bound", finite(c.min_relative_lower_bound)},
+           {"min_det_lower_bound", finite(c.min_det_lower_bound)},
+           {"max_depth_used", c.max_depth_used},
+           {"whole_map", tspline::io::whole_map_quality_json(tspline::certified_map_quality(*map, qo), qo)},
+           {"failures", std::move(failures)},
+           {"seconds", c.seconds}});
       all = all && c.certified_valid();
     }
     for (const tspline::Interface& f : m.interfaces)
       gap = std::max(gap, tspline::interface_gap(*m.maps[f.patch_a], f.side_a, *m.maps[f.patch_b], f.side_b));
   }
-  return to_python(json{{"certified_valid", all}, {"patches", std::move(patches)}, {"max_interface_gap", gap}});
+  return to_python(
+      json{{"certified_valid", all}, {"patches", std::move(patches)}, {"max_interface_gap", gap}});
 }
 
 /// The T-spline file alone: version 1 for a single-patch map, 2 for a layout.
@@ -205,8 +211,9 @@ void save_tspline(const Map& m, const std::filesystem::path& file) {
 
 void save(const Map& m, const std::filesystem::path& dir) {
   if (!m.run)
-    throw tspline::InputError("save: a map read by tspline.load has no parameterization to write (report, T-mesh "
-                              "files); save_tspline(path) writes its T-spline file, save_vtk_bezier(path) its cells");
+    throw tspline::InputError(
+        "save: a map read by tspline.load has no parameterization to write (report, T-mesh "
+        "files); save_tspline(path) writes its T-spline file, save_vtk_bezier(path) its cells");
   py::gil_scoped_release release;
   tspline_app::write_param_run(*m.run, dir.string());
 }
@@ -228,12 +235,13 @@ toolkit::io::VtuMesh polygon_lines(const tspline::Polygon& p) {
   return out;
 }
 
-py::dict render(const Map& m, const std::filesystem::path& path, const std::string& view, std::pair<int, int> size,
-                int samples) {
+py::dict render(const Map& m, const std::filesystem::path& path, const std::string& view,
+                std::pair<int, int> size, int samples) {
   tspline::io::RenderOptions o;
   o.view = tspline::io::parse_render_view(view);
   o.width = size.first, o.height = size.second;
-  if (samples < 1 || samples > 64) throw tspline::InputError("samples: " + std::to_string(samples) + " is not in [1, 64]");
+  if (samples < 1 || samples > 64)
+    throw tspline::InputError("samples: " + std::to_string(samples) + " is not in [1, 64]");
   tspline::io::RenderSummary s;
   {
     py::gil_scoped_release release;
@@ -255,16 +263,23 @@ py::list param_options_list() {
   for (const tspline_app::ParamOption& o : tspline_app::param_options()) {
     const char* kind = "str";
     switch (o.kind) {
-      case tspline_app::OptionKind::Flag: kind = "bool"; break;
+      case tspline_app::OptionKind::Flag:
+        kind = "bool";
+        break;
       case tspline_app::OptionKind::Integer:
-      case tspline_app::OptionKind::Count: kind = "int"; break;
-      case tspline_app::OptionKind::Real: kind = "float"; break;
-      case tspline_app::OptionKind::Text: break;
+      case tspline_app::OptionKind::Count:
+        kind = "int";
+        break;
+      case tspline_app::OptionKind::Real:
+        kind = "float";
+        break;
+      case tspline_app::OptionKind::Text:
+        break;
     }
     py::object range = o.range ? py::object(py::make_tuple(o.range->first, o.range->second)) : py::none();
-    out.append(py::dict("name"_a = o.python_name(), "cli"_a = "--" + o.name, "type"_a = kind, "help"_a = o.help,
-                        "default"_a = to_python(o.get(tspline_app::ParamSettings{})), "choices"_a = o.choices,
-                        "range"_a = range));
+    out.append(py::dict("name"_a = o.python_name(), "cli"_a = "--" + o.name, "type"_a = kind,
+                        "help"_a = o.help, "default"_a = to_python(o.get(tspline_app::ParamSettings{})),
+                        "choices"_a = o.choices, "range"_a = range));
   }
   return out;
 }
@@ -284,22 +299,28 @@ py::object settings_of_arguments(const std::vector<std::string>& args) {
 void bind_maps(py::module_& m) {
   py::class_<Map, std::shared_ptr<Map>>(
       m, "Map",
-      "A T-spline map onto a domain: of the unit square (one patch), or of one unit square per patch of a quad "
+      "A T-spline map onto a domain: of the unit square (one patch), or of one unit square per patch of a "
+      "quad "
       "layout, continuous across the interfaces. From tspline.parameterize or tspline.load.")
       .def_readonly("certified_valid", &Map::certified_valid,
                     "bool: det J > 0 certified on every Bezier element of every patch")
-      .def_readonly("report", &Map::report,
-                    "dict: report.json of the parameterization (as `tspline param` writes it); for a loaded map "
-                    "{'input', 'version', 'patches_count'}")
+      .def_readonly(
+          "report", &Map::report,
+          "dict: report.json of the parameterization (as `tspline param` writes it); for a loaded map "
+          "{'input', 'version', 'patches_count'}")
       .def_readonly("source", &Map::source, "str: the input (path, 'array', 'rings', 'GeoJSON dict', ...)")
-      .def_readonly("version", &Map::version, "int: the T-spline file format version (1: one patch, 2: a layout)")
-      .def_property_readonly("patches", [](const Map& x) { return x.maps.size(); }, "int: number of patches")
-      .def_property_readonly("interfaces", &interfaces_of,
-                             "list of dicts {patch_a, side_a, patch_b, side_b, cut}: the cuts between patches; side "
-                             "t of patch_a meets side 1 - t of patch_b ('bottom', 'right', 'top', 'left')")
-      .def_property_readonly("layout", [](const Map& x) { return x.run ? x.run->result.layout : std::string("file"); },
-                             "str: 'single', 'quad', 'cuts' or 'automatic cuts' (how the layout was chosen: "
-                             "report['layout']); 'file' for a loaded map")
+      .def_readonly("version", &Map::version,
+                    "int: the T-spline file format version (1: one patch, 2: a layout)")
+      .def_property_readonly(
+          "patches", [](const Map& x) { return x.maps.size(); }, "int: number of patches")
+      .def_property_readonly(
+          "interfaces", &interfaces_of,
+          "list of dicts {patch_a, side_a, patch_b, side_b, cut}: the cuts between patches; side "
+          "t of patch_a meets side 1 - t of patch_b ('bottom', 'right', 'top', 'left')")
+      .def_property_readonly(
+          "layout", [](const Map& x) { return x.run ? x.run->result.layout : std::string("file"); },
+          "str: 'single', 'quad', 'cuts' or 'automatic cuts' (how the layout was chosen: "
+          "report['layout']); 'file' for a loaded map")
       .def_property_readonly(
           "cells",
           [](const Map& x) {
@@ -317,30 +338,37 @@ void bind_maps(py::module_& m) {
           },
           "int: blending functions over all patches")
       .def("evaluate", &evaluate, py::arg("uv"), py::arg("patch") = 0,
-           "evaluate(uv, patch=0) -> xy. uv: #uv by 2 float64 array of parameters in [0,1]^2 of patch `patch`; "
+           "evaluate(uv, patch=0) -> xy. uv: #uv by 2 float64 array of parameters in [0,1]^2 of patch "
+           "`patch`; "
            "xy: #uv by 2 float64 array, S(uv) (as `tspline eval --patch`).")
       .def("jacobian", &jacobian, py::arg("uv"), py::arg("patch") = 0,
            "jacobian(uv, patch=0) -> J. uv: #uv by 2 float64 array; J: #uv by 2 by 2 float64 array, "
            "J[k, r, c] = d x_r / d xi_c at uv[k] (columns dS/dxi, dS/deta).")
-      .def("check", &check, py::arg("depth") = 8, py::arg("max_listed") = 20,
-           "check(depth=8, max_listed=20) -> dict. `tspline check`: det J > 0 certified on every Bezier element "
-           "(de Casteljau subdivision, at most `depth` levels), per patch ('patches': elements, certified, "
-           "invalid, undecided, bounds of det J, 'whole_map' certified bounds of J_r and the scaled Jacobian, "
-           "'failures' (at most max_listed)); 'certified_valid'; 'max_interface_gap'.")
+      .def(
+          "check", &check, py::arg("depth") = 8, py::arg("max_listed") = 20,
+          "check(depth=8, max_listed=20) -> dict. `tspline check`: det J > 0 certified on every Bezier "
+          "element "
+          "(de Casteljau subdivision, at most `depth` levels), per patch ('patches': elements, certified, "
+          "invalid, undecided, bounds of det J, 'whole_map' certified bounds of J_r and the scaled Jacobian, "
+          "'failures' (at most max_listed)); 'certified_valid'; 'max_interface_gap'.")
       .def("save", &save, py::arg("dir"),
            "save(dir): writes the files of `tspline param` into the folder dir (created if missing): "
            "tspline.json, surface.vtu, surface_bezier.vtu, control_net.vtu, parametric_tmesh.vtu, "
            "physical_tmesh.vtu, boundary.vtu, report.json (and adapt.pvd for one patch).")
       .def("save_tspline", &save_tspline, py::arg("path"),
-           "save_tspline(path): the T-spline file alone (docs/tspline_format.md; version 1 for one patch, 2 for a "
+           "save_tspline(path): the T-spline file alone (docs/tspline_format.md; version 1 for one patch, 2 "
+           "for a "
            "layout); tspline.load reads it back bit for bit.")
       .def("save_vtk_bezier", &save_vtk_bezier, py::arg("path"),
-           "save_vtk_bezier(path): the map exactly as rational bicubic Bezier cells for ParaView (a .vtu file, "
+           "save_vtk_bezier(path): the map exactly as rational bicubic Bezier cells for ParaView (a .vtu "
+           "file, "
            "as `tspline export --vtk-bezier`; README, 'The exact map in ParaView').")
-      .def("render", &render, py::arg("path"), py::arg("view") = "jacobian", py::arg("size") = std::pair<int, int>{1200, 900},
-           py::arg("samples") = 4,
-           "render(path, view='jacobian', size=(1200, 900), samples=4) -> dict {min, max}: a picture (PNG, SVG or "
-           "PDF by the extension) as `tspline render`: view 'jacobian' (J_r), 'tmesh', 'control-net' or 'layout'; "
+      .def("render", &render, py::arg("path"), py::arg("view") = "jacobian",
+           py::arg("size") = std::pair<int, int>{1200, 900}, py::arg("samples") = 4,
+           "render(path, view='jacobian', size=(1200, 900), samples=4) -> dict {min, max}: a picture (PNG, "
+           "SVG or "
+           "PDF by the extension) as `tspline render`: view 'jacobian' (J_r), 'tmesh', 'control-net' or "
+           "'layout'; "
            "samples: k x k sub-quads per cell.")
       .def(
           "poisson",
@@ -349,19 +377,23 @@ void bind_maps(py::module_& m) {
           },
           "poisson(**options) -> Solution: tspline.poisson(self, **options).");
 
-  m.def("parameterize", &parameterize, py::arg("domain"),
-        "parameterize(domain, *, crs=None, **options) -> Map, as `tspline param`.\n\n"
-        "domain: a path (text polygon with optional holes, or any GIS polygon layer); an #V by 2 float array of "
-        "polygon vertices; a list of rings (#V_k by 2 arrays: the outer ring, then the holes); a GeoJSON dict "
-        "(geometry, Feature or FeatureCollection; longitude/latitude, projected to metres, as a .geojson file); "
-        "or an object with __geo_interface__ (shapely Polygon / MultiPolygon with interiors, GeoPandas "
-        "GeoSeries / GeoDataFrame: their own .crs if they have one, else planar).\n"
-        "crs: the coordinates' CRS (e.g. 'EPSG:4326', a pyproj.CRS): geographic ones are projected to metres "
-        "(Lambert azimuthal equal-area at the centroid), as GIS files are. planar=True keeps coordinates as given.\n"
-        "options: those of `tspline param`, '-' written '_' (tspline.param_options() lists them with their "
-        "defaults and help): layout, cuts (a path or a list of #P by 2 polylines), corners, tol, tol_rel, "
-        "init_level, max_adapt, ... Raises tspline.InputError for invalid domains or option values, "
-        "tspline.IoError for unreadable files, TypeError for unknown keywords.");
+  m.def(
+      "parameterize", &parameterize, py::arg("domain"),
+      "parameterize(domain, *, crs=None, **options) -> Map, as `tspline param`.\n\n"
+      "domain: a path (text polygon with optional holes, or any GIS polygon layer); an #V by 2 float array "
+      "of "
+      "polygon vertices; a list of rings (#V_k by 2 arrays: the outer ring, then the holes); a GeoJSON dict "
+      "(geometry, Feature or FeatureCollection; longitude/latitude, projected to metres, as a .geojson "
+      "file); "
+      "or an object with __geo_interface__ (shapely Polygon / MultiPolygon with interiors, GeoPandas "
+      "GeoSeries / GeoDataFrame: their own .crs if they have one, else planar).\n"
+      "crs: the coordinates' CRS (e.g. 'EPSG:4326', a pyproj.CRS): geographic ones are projected to metres "
+      "(Lambert azimuthal equal-area at the centroid), as GIS files are. planar=True keeps coordinates as "
+      "given.\n"
+      "options: those of `tspline param`, '-' written '_' (tspline.param_options() lists them with their "
+      "defaults and help): layout, cuts (a path or a list of #P by 2 polylines), corners, tol, tol_rel, "
+      "init_level, max_adapt, ... Raises tspline.InputError for invalid domains or option values, "
+      "tspline.IoError for unreadable files, TypeError for unknown keywords.");
   m.def("param_options", &param_options_list,
         "param_options() -> list of dicts {name, cli, type, help, default, choices, range}: the options of "
         "tspline.parameterize, one table with `tspline param`.");

@@ -13,10 +13,10 @@
 namespace tspline_python {
 
 struct Map {
-  std::shared_ptr<const tspline_app::ParamRun> run;        ///< tspline.parameterize (else null)
-  std::shared_ptr<const tspline::io::LoadedMaps> file;     ///< tspline.load (else null)
-  std::vector<const tspline::TSplineMap*> maps;            ///< one per patch, owned by `run` or `file`
-  std::vector<tspline::io::TSplineFileMeta> metas;         ///< per patch: source, boundary polygon, corners
+  std::shared_ptr<const tspline_app::ParamRun> run;     ///< tspline.parameterize (else null)
+  std::shared_ptr<const tspline::io::LoadedMaps> file;  ///< tspline.load (else null)
+  std::vector<const tspline::TSplineMap*> maps;         ///< one per patch, owned by `run` or `file`
+  std::vector<tspline::io::TSplineFileMeta> metas;      ///< per patch: source, boundary polygon, corners
   std::vector<tspline::Interface> interfaces;
   std::vector<tspline::Cut> cuts;
   int version = 1;  ///< of its T-spline file: 1 for one patch, 2 for a multi-patch layout

@@ -6,8 +6,10 @@
 
 PYBIND11_MODULE(tspline, m) {
   m.doc() =
-      "T-spline parameterization of 2D domains (one patch or a quad layout of many), isogeometric Poisson solver "
-      "and mesh optimization: a thin binding of libtspline, with the options, files and messages of the tspline "
+      "T-spline parameterization of 2D domains (one patch or a quad layout of many), isogeometric Poisson "
+      "solver "
+      "and mesh optimization: a thin binding of libtspline, with the options, files and messages of the "
+      "tspline "
       "program. Errors: tspline.Error and its subclasses InputError (a ValueError), IoError (an OSError), "
       "NumericalError (an ArithmeticError).";
   tspline_python::bind_errors(m);

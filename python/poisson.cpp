@@ -1,6 +1,8 @@
 // tspline.poisson and tspline.Solution: the adaptive IGA Poisson solver
 // (tspline/analysis/poisson.h) on every map, one patch or many, as `tspline
 // poisson` with the direct solver.
+#include "tspline/analysis/poisson.h"
+
 #include <pybind11/functional.h>
 #include <pybind11/stl.h>
 
@@ -9,7 +11,6 @@
 #include "expression.h"
 #include "maps.h"
 #include "tspline/analysis/manufactured_problems.h"
-#include "tspline/analysis/poisson.h"
 #include "tspline/errors.h"
 
 namespace tspline_python {
@@ -22,7 +23,8 @@ using namespace pybind11::literals;
 tspline::ScalarField field(const char* name, const py::object& f) {
   if (f.is_none()) return {};
   if (py::isinstance<py::str>(f)) return tspline_app::make_field(name, f.cast<std::string>());
-  if (!PyCallable_Check(f.ptr())) throw py::type_error(std::string(name) + ": expected a string or a callable");
+  if (!PyCallable_Check(f.ptr()))
+    throw py::type_error(std::string(name) + ": expected a string or a callable");
   auto fn = std::make_shared<py::function>(f.cast<py::function>());
   return [fn](double x, double y) {
     py::gil_scoped_acquire gil;
@@ -49,8 +51,9 @@ py::dict step_dict(const tspline::PoissonStep& s) {
   return py::dict("step"_a = s.step, "dofs"_a = s.dofs, "cells"_a = s.cells, "eta"_a = s.eta,
                   "l2"_a = s.has_errors ? py::cast(s.errors.l2) : py::none(),
                   "h1"_a = s.has_errors ? py::cast(s.errors.h1) : py::none(), "solver"_a = s.solver.kind,
-                  "relative_residual"_a = s.solver.relative_residual, "seconds"_a = s.seconds, "marked"_a = s.marked,
-                  "refined"_a = s.refined, "max_interface_jump"_a = s.max_interface_jump);
+                  "relative_residual"_a = s.solver.relative_residual, "seconds"_a = s.seconds,
+                  "marked"_a = s.marked, "refined"_a = s.refined,
+                  "max_interface_jump"_a = s.max_interface_jump);
 }
 
 std::shared_ptr<Solution> poisson(const py::object& map, const py::object& f, const py::object& g,
@@ -67,7 +70,8 @@ std::shared_ptr<Solution> poisson(const py::object& map, const py::object& f, co
     const tspline::ManufacturedProblem mp =
         tspline::manufactured_problem(problem_name.cast<std::string>(), out->geometry);
     problem = mp.problem;
-    out->problem = py::dict("name"_a = mp.name, "u"_a = mp.u, "f"_a = mp.f, "g"_a = mp.g, "choice"_a = mp.choice);
+    out->problem =
+        py::dict("name"_a = mp.name, "u"_a = mp.u, "f"_a = mp.f, "g"_a = mp.g, "choice"_a = mp.choice);
   } else {
     problem.f = field("f", f);
     problem.g = field("g", g);
@@ -100,7 +104,8 @@ py::array_t<double> evaluate_solution(const Solution& s, const Array& uv, std::s
   const std::size_t n = rows_of(uv, "uv");
   py::array_t<double> out(static_cast<py::ssize_t>(n));
   double* o = out.mutable_data();
-  for (std::size_t i = 0; i < n; ++i) o[i] = tspline::evaluate_solution(s.solution, patch, checked_uv(uv, i)).u;
+  for (std::size_t i = 0; i < n; ++i)
+    o[i] = tspline::evaluate_solution(s.solution, patch, checked_uv(uv, i)).u;
   return out;
 }
 
@@ -111,24 +116,31 @@ void bind_poisson(py::module_& m) {
       .def_readonly("steps", &Solution::steps,
                     "list of dicts, one per solve: step, dofs, cells, eta, l2, h1 (None without an exact "
                     "solution), solver, seconds, marked, refined, max_interface_jump")
-      .def_readonly("problem", &Solution::problem, "dict of the built-in problem (name, u, f, g, choice), or None")
+      .def_readonly("problem", &Solution::problem,
+                    "dict of the built-in problem (name, u, f, g, choice), or None")
       .def_readonly("map", &Solution::map, "tspline.Map: the geometry")
-      .def_property_readonly("dofs", [](const Solution& s) { return s.solution.space ? s.solution.space->num_dofs() : 0; },
-                             "int: degrees of freedom of the last step")
-      .def_property_readonly("patches", [](const Solution& s) { return s.geometry.size(); }, "int: patches")
+      .def_property_readonly(
+          "dofs", [](const Solution& s) { return s.solution.space ? s.solution.space->num_dofs() : 0; },
+          "int: degrees of freedom of the last step")
+      .def_property_readonly(
+          "patches", [](const Solution& s) { return s.geometry.size(); }, "int: patches")
       .def("evaluate", &evaluate_solution, py::arg("uv"), py::arg("patch") = 0,
-           "evaluate(uv, patch=0) -> u. uv: #uv by 2 float64 array in the parameter square of patch `patch`; u: "
+           "evaluate(uv, patch=0) -> u. uv: #uv by 2 float64 array in the parameter square of patch `patch`; "
+           "u: "
            "#uv float64 array, u_h(S_patch(uv)).");
 
-  m.def("poisson", &poisson, py::arg("map"), py::arg("f") = py::none(), py::arg("g") = py::none(),
-        py::arg("exact") = py::none(), py::arg("problem") = py::none(), py::arg("steps") = 5,
-        py::arg("refine") = "adaptive", py::arg("gamma") = 0.5, py::arg("max_dofs") = 200000,
-        "poisson(map, f=None, g=None, exact=None, problem=None, steps=5, refine='adaptive', gamma=0.5, "
-        "max_dofs=200000) -> Solution. Adaptive (or uniform) IGA solve of -Laplace u = f, u = g on the boundary, "
-        "as `tspline poisson --solver direct`. map: a tspline.Map of any number of patches, or the path of a "
-        "T-spline file. f, g, exact: expressions in x, y (as tspline poisson --f) or callables f(x, y) -> float; "
-        "or problem='sinsin', 'polynomial' or 'gaussian' (tspline poisson --problem: g and the exact solution "
-        "given, scaled to the domain).");
+  m.def(
+      "poisson", &poisson, py::arg("map"), py::arg("f") = py::none(), py::arg("g") = py::none(),
+      py::arg("exact") = py::none(), py::arg("problem") = py::none(), py::arg("steps") = 5,
+      py::arg("refine") = "adaptive", py::arg("gamma") = 0.5, py::arg("max_dofs") = 200000,
+      "poisson(map, f=None, g=None, exact=None, problem=None, steps=5, refine='adaptive', gamma=0.5, "
+      "max_dofs=200000) -> Solution. Adaptive (or uniform) IGA solve of -Laplace u = f, u = g on the "
+      "boundary, "
+      "as `tspline poisson --solver direct`. map: a tspline.Map of any number of patches, or the path of a "
+      "T-spline file. f, g, exact: expressions in x, y (as tspline poisson --f) or callables f(x, y) -> "
+      "float; "
+      "or problem='sinsin', 'polynomial' or 'gaussian' (tspline poisson --problem: g and the exact solution "
+      "given, scaled to the domain).");
 }
 
 }  // namespace tspline_python

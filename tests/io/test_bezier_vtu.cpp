@@ -7,7 +7,6 @@
 // agrees with certify_map; `tspline param` and `tspline export --vtk-bezier`
 // write it for every patch.
 #include <doctest/doctest.h>
-
 #include <vtkCell.h>
 #include <vtkCellData.h>
 #include <vtkCellType.h>
@@ -24,6 +23,7 @@
 #include <set>
 
 #include "separable_maps.h"  // (before perturbed_map.h, which uses it)
+
 #include "perturbed_map.h"
 #include "test_support.h"
 #include "toolkit/io/vtu_writer.h"
@@ -55,15 +55,17 @@ Eigen::Vector2d vtk_point(vtkUnstructuredGrid* g, vtkGenericCell* cell, vtkIdTyp
 }
 
 /// A point array of cell c interpolated with VTK's weights.
-double interpolate(vtkUnstructuredGrid* g, vtkGenericCell* cell, const char* name, const std::vector<double>& weights) {
+double interpolate(vtkUnstructuredGrid* g, vtkGenericCell* cell, const char* name,
+                   const std::vector<double>& weights) {
   vtkDataArray* a = g->GetPointData()->GetArray(name);
   double v = 0.0;
-  for (vtkIdType k = 0; k < cell->GetNumberOfPoints(); ++k) v += weights[k] * a->GetTuple1(cell->GetPointId(k));
+  for (vtkIdType k = 0; k < cell->GetNumberOfPoints(); ++k)
+    v += weights[k] * a->GetTuple1(cell->GetPointId(k));
   return v;
 }
 
 struct CellCheck {
-  double max_position_error = 0.0;  ///< / diameter, at random points
+  double max_position_error = 0.0;     ///< / diameter, at random points
   double max_jr_error_at_nodes = 0.0;  ///< at the 4 x 4 equispaced points
   double max_jr_error_between = 0.0;   ///< at random points
 };
@@ -86,22 +88,28 @@ CellCheck check_cells(vtkUnstructuredGrid* g, const tspline::TSplineMap& map, in
     REQUIRE(g->GetCellType(c) == VTK_BEZIER_QUADRILATERAL);
     const Eigen::Vector2d a(lo->GetTuple3(c)[0], lo->GetTuple3(c)[1]);
     const Eigen::Vector2d b(hi->GetTuple3(c)[0], hi->GetTuple3(c)[1]);
-    auto uv_of = [&](double s, double t) { return Eigen::Vector2d(a + Eigen::Vector2d(s, t).cwiseProduct(b - a)); };
+    auto uv_of = [&](double s, double t) {
+      return Eigen::Vector2d(a + Eigen::Vector2d(s, t).cwiseProduct(b - a));
+    };
     for (int k = 0; k < 4; ++k) {
       const double s = u01(rng), t = u01(rng);
       const Eigen::Vector2d x = vtk_point(g, cell, c, s, t, w);
-      out.max_position_error = std::max(out.max_position_error, (x - map.point(uv_of(s, t))).norm() / diameter);
+      out.max_position_error =
+          std::max(out.max_position_error, (x - map.point(uv_of(s, t))).norm() / diameter);
       const double jr = tspline::mean_ratio_jacobian(map.derivatives(uv_of(s, t), 1, -1).J);
-      out.max_jr_error_between = std::max(out.max_jr_error_between, std::abs(interpolate(g, cell, "mean_ratio_jacobian", w) - jr));
+      out.max_jr_error_between =
+          std::max(out.max_jr_error_between, std::abs(interpolate(g, cell, "mean_ratio_jacobian", w) - jr));
     }
     for (int j = 0; j < 4; ++j)
       for (int i = 0; i < 4; ++i) {
         vtk_point(g, cell, c, i / 3.0, j / 3.0, w);
         // The element's own polynomial at its border (one-sided), as the file was made.
         const double jr = tspline::mean_ratio_jacobian(
-            map.derivatives(uv_of(i / 3.0, j / 3.0), 1, static_cast<int>(g->GetCellData()->GetArray("cell")->GetTuple1(c))).J);
-        out.max_jr_error_at_nodes =
-            std::max(out.max_jr_error_at_nodes, std::abs(interpolate(g, cell, "mean_ratio_jacobian", w) - jr));
+            map.derivatives(uv_of(i / 3.0, j / 3.0), 1,
+                            static_cast<int>(g->GetCellData()->GetArray("cell")->GetTuple1(c)))
+                .J);
+        out.max_jr_error_at_nodes = std::max(out.max_jr_error_at_nodes,
+                                             std::abs(interpolate(g, cell, "mean_ratio_jacobian", w) - jr));
       }
   }
   return out;
@@ -139,8 +147,9 @@ TEST_SUITE("bezier_vtu") {
     REQUIRE(g->GetCellData()->GetHigherOrderDegrees() != nullptr);
     CHECK(g->GetCellData()->GetHigherOrderDegrees()->GetTuple3(0)[0] == 3);
     const CellCheck r = check_cells(g, map, 0, 10.0 * std::sqrt(2.0));
-    MESSAGE("max |S_vtk - S| / diameter " << r.max_position_error << "; J_r: at the nodes " << r.max_jr_error_at_nodes
-                                          << ", between " << r.max_jr_error_between);
+    MESSAGE("max |S_vtk - S| / diameter " << r.max_position_error << "; J_r: at the nodes "
+                                          << r.max_jr_error_at_nodes << ", between "
+                                          << r.max_jr_error_between);
     CHECK(r.max_position_error <= 1e-12);
     CHECK(r.max_jr_error_at_nodes <= 1e-12);
     CHECK(r.max_jr_error_between <= 0.05);  // an interpolant of J_r, not J_r itself
@@ -150,7 +159,8 @@ TEST_SUITE("bezier_vtu") {
     const tspline::TSplineMap map = test_support::perturbed_map(7, 0.35);  // folds
     const tspline::MapCertification c = tspline::certify_map(map);
     REQUIRE(!c.failures.empty());
-    for (const tspline::MapCertification* given : {static_cast<const tspline::MapCertification*>(nullptr), &c}) {
+    for (const tspline::MapCertification* given :
+         {static_cast<const tspline::MapCertification*>(nullptr), &c}) {
       const toolkit::io::VtuMesh mesh = tspline::io::bezier_vtu(map, given);
       const std::vector<int>& certified = mesh.cell_ints.at("certified");
       REQUIRE(certified.size() == c.elements);
@@ -159,7 +169,8 @@ TEST_SUITE("bezier_vtu") {
     }
   }
 
-  TEST_CASE("tspline param writes surface_bezier.vtu for every patch; tspline export --vtk-bezier the same cells") {
+  TEST_CASE(
+      "tspline param writes surface_bezier.vtu for every patch; tspline export --vtk-bezier the same cells") {
     const fs::path d = test_support::scratch_dir("bezier_vtu", "app");
     const auto p = test_support::run_app(
         "param " + test_support::quoted(fs::path(TSPLINE_TEST_DATA_DIR) / "holes" / "plate_with_hole.txt") +
@@ -181,15 +192,17 @@ TEST_SUITE("bezier_vtu") {
       std::size_t elements = 0;
       for (std::size_t q = 0; q < maps.patches.size(); ++q) {
         elements += tspline::BezierExtraction(maps.patches[q].map.basis()).elements().size();
-        CHECK(check_cells(g, maps.patches[q].map, static_cast<int>(q), 4.0 * std::sqrt(2.0)).max_position_error <= 1e-12);
+        CHECK(check_cells(g, maps.patches[q].map, static_cast<int>(q), 4.0 * std::sqrt(2.0))
+                  .max_position_error <= 1e-12);
       }
       CHECK(g->GetNumberOfCells() == static_cast<vtkIdType>(elements));
       vtkDataArray* certified = g->GetCellData()->GetArray("certified");
       REQUIRE(certified);
       CHECK(certified->GetRange()[0] == 1.0);  // a certified map: every element
     }
-    const auto bad = test_support::run_app(
-        "export " + test_support::quoted(d / "nonesuch.json") + " --vtk-bezier " + test_support::quoted(d / "x.vtu"), d);
+    const auto bad = test_support::run_app("export " + test_support::quoted(d / "nonesuch.json") +
+                                               " --vtk-bezier " + test_support::quoted(d / "x.vtu"),
+                                           d);
     CHECK(bad.exit_code == 2);
     CHECK(!fs::exists(d / "x.vtu"));
   }

@@ -156,7 +156,8 @@ vtkNew<vtkUnstructuredGrid> build_grid(const VtuMesh& mesh) {
   for (const auto& [name, v] : mesh.point_scalars) pd->AddArray(make_double_array(name, v));
   for (const auto& [name, v] : mesh.point_ints) pd->AddArray(make_int_array(name, v));
   for (const auto& [name, v] : mesh.point_vectors) pd->AddArray(make_vector_array(name, v));
-  if (!mesh.rational_weights.empty()) pd->SetActiveAttribute(mesh.rational_weights.c_str(), vtkDataSetAttributes::RATIONALWEIGHTS);
+  if (!mesh.rational_weights.empty())
+    pd->SetActiveAttribute(mesh.rational_weights.c_str(), vtkDataSetAttributes::RATIONALWEIGHTS);
   vtkCellData* cd = grid->GetCellData();
   for (const auto& [name, v] : mesh.cell_scalars) cd->AddArray(make_double_array(name, v));
   for (const auto& [name, v] : mesh.cell_ints) cd->AddArray(make_int_array(name, v));

@@ -43,9 +43,9 @@ int vtk_bezier_quad_index(int i, int j) {
   // vtkHigherOrderQuadrilateral::PointIndexFromIJK for order (3, 3).
   const bool ib = i == 0 || i == 3, jb = j == 0 || j == 3;
   if (ib && jb) return i ? (j ? 2 : 1) : (j ? 3 : 0);  // corners
-  if (jb) return 4 + (i - 1) + (j ? 4 : 0);             // edges along s: t = 0, then t = 1
-  if (ib) return 4 + (j - 1) + (i ? 2 : 6);             // edges along t: s = 1, then s = 0
-  return 12 + (i - 1) + 2 * (j - 1);                    // interior
+  if (jb) return 4 + (i - 1) + (j ? 4 : 0);            // edges along s: t = 0, then t = 1
+  if (ib) return 4 + (j - 1) + (i ? 2 : 6);            // edges along t: s = 1, then s = 0
+  return 12 + (i - 1) + 2 * (j - 1);                   // interior
 }
 
 toolkit::io::VtuMesh bezier_vtu(const TSplineMap& map, const MapCertification* certification,
@@ -69,7 +69,8 @@ toolkit::io::VtuMesh bezier_vtu(const TSplineMap& map, const MapCertification* c
     Eigen::Matrix<double, 16, 3> H = Eigen::Matrix<double, 16, 3>::Zero();
     for (std::size_t r = 0; r < el.functions.size(); ++r) {
       const Eigen::Vector2d& p = P[el.functions[r]];
-      for (int k = 0; k < 16; ++k) H.row(k) += el.C(static_cast<Eigen::Index>(r), k) * Eigen::RowVector3d(p.x(), p.y(), 1.0);
+      for (int k = 0; k < 16; ++k)
+        H.row(k) += el.C(static_cast<Eigen::Index>(r), k) * Eigen::RowVector3d(p.x(), p.y(), 1.0);
     }
     Matrix4 w;  // w(i, j) of B_i(s) B_j(t)
     for (int j = 0; j < 4; ++j)

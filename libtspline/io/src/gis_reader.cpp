@@ -276,7 +276,8 @@ DomainInput read_dataset(GDALDataset& dataset, const std::string& path, const Do
   OGRSpatialReference given_srs;
   if (options.crs) {  // the caller's CRS instead of the layer's
     if (given_srs.SetFromUserInput(options.crs->c_str()) != OGRERR_NONE)
-      throw InputError(path + ": crs '" + *options.crs + "' is not a CRS that GDAL knows" + QuietGdal::last());
+      throw InputError(path + ": crs '" + *options.crs + "' is not a CRS that GDAL knows" +
+                       QuietGdal::last());
     layer_srs = &given_srs;
   }
   if (layer_srs) d["crs"] = layer_srs->GetName() ? layer_srs->GetName() : "unnamed";

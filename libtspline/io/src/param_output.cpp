@@ -1,5 +1,6 @@
 #include "tspline/io/param_output.h"
 
+#include <Eigen/LU>
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -10,18 +11,16 @@
 #include <stdexcept>
 #include <utility>
 
-#include <Eigen/LU>
-
 #include "toolkit/io/atomic_file.h"
 #include "tspline/io/bezier_vtu.h"
 #include "tspline/io/cell_grid.h"
 #include "tspline/io/front_output.h"
+#include "tspline/io/output_files.h"
 #include "tspline/io/tspline_file.h"
 #include "tspline/spline/bezier_extraction.h"
 #include "tspline/validity/map_certification.h"
 #include "tspline/validity/map_quality.h"
 #include "tspline/validity/map_quality_bounds.h"
-#include "tspline/io/output_files.h"
 
 namespace tspline::io {
 

@@ -272,7 +272,8 @@ void draw_map_view(Canvas& img, RenderView view, const MapMeshes& maps, const st
       break;
     }
     case RenderView::Solution:
-    case RenderView::Auto: break;
+    case RenderView::Auto:
+      break;
   }
   summary.source = source;
 }
@@ -306,7 +307,8 @@ RenderSummary render_png(const std::string& dir_name, const std::string& png_pat
     } else {
       maps.surface = read_output(source, param);
       const fs::path bfile = dir / output_files::kBoundary;
-      if (summary.view == RenderView::TMesh && fs::is_regular_file(bfile, ec)) maps.boundary = toolkit::io::read_vtu(bfile.string());
+      if (summary.view == RenderView::TMesh && fs::is_regular_file(bfile, ec))
+        maps.boundary = toolkit::io::read_vtu(bfile.string());
     }
     toolkit::io::write_atomic(png_path, [&](const std::string& tmp) {
       Canvas img(format, tmp, options.width, options.height);
@@ -348,7 +350,8 @@ RenderSummary render_map(const MapMeshes& meshes, const std::string& path, const
     throw InputError("view 'solution' draws the output folder of `tspline poisson`, not a map");
   const ImageFormat format = image_format_of(path);
   check_size(options);
-  MapMeshes maps{as_read_back(meshes.surface), as_read_back(meshes.boundary), as_read_back(meshes.control_net)};
+  MapMeshes maps{as_read_back(meshes.surface), as_read_back(meshes.boundary),
+                 as_read_back(meshes.control_net)};
   toolkit::io::write_atomic(path, [&](const std::string& tmp) {
     Canvas img(format, tmp, options.width, options.height);
     draw_map_view(img, summary.view, maps, summary.view == RenderView::ControlNet ? "control net" : "surface",

@@ -20,13 +20,12 @@ inline constexpr std::string_view kPhysicalTMesh = "physical_tmesh.vtu";
 inline constexpr std::string_view kBoundary = "boundary.vtu";
 inline constexpr std::string_view kReport = "report.json";         ///< written last: the run's summary
 /// What `tspline param` writes (single patch), in the order of its summary line.
-inline constexpr std::array<std::string_view, 9> kParam = {kTSpline,          kSurface,      kBezierSurface,
-                                                           kControlNet,       kAdaptSeries,  kParametricTMesh,
-                                                           kPhysicalTMesh,    kBoundary,     kReport};
+inline constexpr std::array<std::string_view, 9> kParam = {kTSpline,       kSurface,     kBezierSurface,
+                                                           kControlNet,    kAdaptSeries, kParametricTMesh,
+                                                           kPhysicalTMesh, kBoundary,    kReport};
 /// What `tspline param` writes for a map of several patches (no adapt.pvd).
-inline constexpr std::array<std::string_view, 8> kMultipatchParam = {kTSpline,         kSurface,       kBezierSurface,
-                                                                     kControlNet,      kParametricTMesh,
-                                                                     kPhysicalTMesh,   kBoundary,      kReport};
+inline constexpr std::array<std::string_view, 8> kMultipatchParam = {
+    kTSpline, kSurface, kBezierSurface, kControlNet, kParametricTMesh, kPhysicalTMesh, kBoundary, kReport};
 
 // tspline poisson
 inline constexpr std::string_view kConvergenceCsv = "convergence.csv";
