@@ -141,6 +141,14 @@ py::array_t<double> jacobian(const Map& m, const Array& uv, std::size_t patch) {
   return out;
 }
 
+/// The sum of count(patch map) over the patches.
+template <class Count>
+std::size_t sum_over_patches(const Map& m, Count count) {
+  std::size_t n = 0;
+  for (const tspline::TSplineMap* p : m.maps) n += count(*p);
+  return n;
+}
+
 py::list interfaces_of(const Map& m) {
   py::list out;
   for (const tspline::Interface& f : m.interfaces)
@@ -324,23 +332,16 @@ void bind_maps(py::module_& m) {
       .def_property_readonly(
           "cells",
           [](const Map& x) {
-            std::size_t n = 0;
-            for (const auto* p : x.maps) n += p->mesh().num_cells();
-            return n;
+            return sum_over_patches(x, [](const auto& p) { return p.mesh().num_cells(); });
           },
           "int: T-mesh cells over all patches")
       .def_property_readonly(
           "functions",
-          [](const Map& x) {
-            std::size_t n = 0;
-            for (const auto* p : x.maps) n += p->basis().size();
-            return n;
-          },
+          [](const Map& x) { return sum_over_patches(x, [](const auto& p) { return p.basis().size(); }); },
           "int: blending functions over all patches")
       .def("evaluate", &evaluate, py::arg("uv"), py::arg("patch") = 0,
            "evaluate(uv, patch=0) -> xy. uv: #uv by 2 float64 array of parameters in [0,1]^2 of patch "
-           "`patch`; "
-           "xy: #uv by 2 float64 array, S(uv) (as `tspline eval --patch`).")
+           "`patch`; xy: #uv by 2 float64 array, S(uv) (as `tspline eval --patch`).")
       .def("jacobian", &jacobian, py::arg("uv"), py::arg("patch") = 0,
            "jacobian(uv, patch=0) -> J. uv: #uv by 2 float64 array; J: #uv by 2 by 2 float64 array, "
            "J[k, r, c] = d x_r / d xi_c at uv[k] (columns dS/dxi, dS/deta).")

@@ -65,13 +65,7 @@ toolkit::io::VtuMesh bezier_vtu(const TSplineMap& map, const MapCertification* c
   std::vector<int> cell, level, patch;
   for (std::size_t e = 0; e < elements.size(); ++e) {
     const BezierElement& el = elements[e];
-    // Homogeneous Bezier points (bezier_export.cpp): X_k = sum_a C(a,k) P_a, w_k = sum_a C(a,k).
-    Eigen::Matrix<double, 16, 3> H = Eigen::Matrix<double, 16, 3>::Zero();
-    for (std::size_t r = 0; r < el.functions.size(); ++r) {
-      const Eigen::Vector2d& p = P[el.functions[r]];
-      for (int k = 0; k < 16; ++k)
-        H.row(k) += el.C(static_cast<Eigen::Index>(r), k) * Eigen::RowVector3d(p.x(), p.y(), 1.0);
-    }
+    const Eigen::Matrix<double, 16, 3> H = homogeneous_bezier_points(el, P);  // (X_k, w_k), k = i + 4 j
     Matrix4 w;  // w(i, j) of B_i(s) B_j(t)
     for (int j = 0; j < 4; ++j)
       for (int i = 0; i < 4; ++i) w(i, j) = H(i + 4 * j, 2);
