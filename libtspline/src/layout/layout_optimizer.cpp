@@ -202,9 +202,19 @@ LayoutOptimizationReport optimize_layout_nodes(LayoutMesh& m, const LayoutQualit
   };
   bool untangling = false;
   int quality_sweeps = 0;
+  double best_worst = -2.0;  // the worst J_r of the quality sweeps, and when it last rose
+  int best_sweep = 0;
+  double worst_tangled = -2.0;  // the worst corner of the tangled sweeps, and when it last rose
+  int last_rise = 0;
   for (int sweep = 0; sweep < o.max_sweeps; ++sweep) {
     const double w = worst_sin();
     const bool tangled = w <= 0.0;
+    if (tangled) {
+      // Untangling that no longer raises the worst corner is stuck (a
+      // topological defect, a flat single-quad corner: the caller's business).
+      if (w > worst_tangled + 1e-6) worst_tangled = w, last_rise = sweep;
+      if (sweep - last_rise >= 6) break;
+    }
     p = tangled ? 1.0 : o.power;
     eps_rel = tangled ? std::max(1e-4, 2.0 * -w) : 1e-4;
     if (untangling && !tangled)  // the steps were made for the other energy
@@ -246,6 +256,12 @@ LayoutOptimizationReport optimize_layout_nodes(LayoutMesh& m, const LayoutQualit
     }
     report.sweeps = sweep + 1;
     if (gain < o.tolerance && !tangled) break;
+    if (!tangled) {
+      // The worst corner is what counts: stop when it has not risen for a while.
+      const double f = worst().mean_ratio;
+      if (f > best_worst + 1e-3 * std::abs(best_worst)) best_worst = f, best_sweep = sweep;
+      if (sweep - best_sweep >= o.stall_sweeps) break;
+    }
   }
   report.after = worst();
   return report;

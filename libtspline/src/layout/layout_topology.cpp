@@ -55,34 +55,33 @@ double corner_sj(const Eigen::Vector2d& p, const Eigen::Vector2d& next, const Ei
 
 }  // namespace
 
-std::size_t pillow_flat_rings(LayoutMesh& m, const LayoutRings& R) {
+std::vector<char> rings_with_flat_corners(const LayoutMesh& m, const LayoutQuality& Q) {
+  const LayoutTopology t(m);
+  std::vector<char> flat(Q.rings().curves.size(), 0);
+  for (std::size_t v = 0; v < m.size(); ++v) {
+    if (m.ring[v] < 0 || t.valence(static_cast<int>(v)) != 1) continue;
+    const auto [q, j] = t.corners_of(static_cast<int>(v)).front();
+    // Flat: an obtuse corner with sin below 1/2 (above 150 degrees), at any of
+    // the scales the corner is measured at; or reflex.
+    for (const double scale : LayoutQuality::corner_scales) {
+      const auto [e1, e2] = Q.corner_vectors(m, t, q, j, scale);
+      const double sn = corner_sj(Eigen::Vector2d::Zero(), e1, e2);
+      if (sn < 0.0 || (sn <= 0.5 && e1.dot(e2) < 0.0)) flat[m.ring[v]] = 1;
+    }
+  }
+  return flat;
+}
+
+std::size_t pillow_rings(LayoutMesh& m, const std::vector<char>& pillow) {
   std::vector<std::array<int, 4>>& quads = m.quads;
   std::vector<Eigen::Vector2d>& x = m.x;
   std::vector<int>& ring = m.ring;
   std::vector<double>& arc = m.arc;
-  const std::vector<RingCurve>& rings = R.curves;
   std::vector<std::vector<int>> quads_of(x.size());
   for (std::size_t q = 0; q < quads.size(); ++q)
     for (int j = 0; j < 4; ++j) quads_of[quads[q][j]].push_back(static_cast<int>(q));
-  auto flat_or_reflex = [](const Eigen::Vector2d& p, const Eigen::Vector2d& next, const Eigen::Vector2d& prev) {
-    const double sv = corner_sj(p, next, prev);
-    return sv < 0.0 || (sv <= 0.5 && (next - p).dot(prev - p) < 0.0);
-  };
-  std::vector<char> pillow(rings.size(), 0);
-  for (std::size_t v = 0; v < x.size(); ++v) {
-    if (ring[v] < 0 || quads_of[v].size() != 1) continue;
-    std::array<int, 4> q = quads[quads_of[v][0]];
-    while (q[0] != static_cast<int>(v)) std::rotate(q.begin(), q.begin() + 1, q.end());
-    const int a = q[1], b = q[3];
-    const RingCurve& rc = rings[ring[v]];
-    const double delta = 1e-6 * std::min((x[a] - x[v]).norm(), (x[b] - x[v]).norm());
-    const double dir = R.direction(ring[v]);
-    if (flat_or_reflex(x[v], x[a], x[b]) ||
-        flat_or_reflex(x[v], rc.point(arc[v] + dir * delta), rc.point(arc[v] - dir * delta)))
-      pillow[ring[v]] = 1;
-  }
   std::size_t count = 0;
-  for (std::size_t r = 0; r < rings.size(); ++r) count += pillow[r];
+  for (const char p : pillow) count += p;
   if (count == 0) return 0;
   // Edges along the ring, as directed in their quad.
   const LayoutTopology t(m);
@@ -137,6 +136,7 @@ LayoutRotationReport rotate_layout_edges(LayoutMesh& m, const LayoutQuality& Q, 
       double best = -1e300;
       LayoutMesh best_mesh;
       int best_other = -1;
+      std::vector<int> best_free;
       double before = 0.0;
       for (int j = 0; j < 4; ++j) {
         if (t.on_ring(q, j)) continue;
@@ -174,12 +174,13 @@ LayoutRotationReport rotate_layout_edges(LayoutMesh& m, const LayoutQuality& Q, 
           const double after = region_figure(c, ct, Q, free);
           if (std::getenv("TSPLINE_LAYOUT_DEBUG") && f0 < 0.01)
             std::fprintf(stderr, "   rotation of quad %d edge %d (%d-%d) r %d: %.3g -> %.3g\n", q, j, h[0], h[3], r, before, after);
-          if (after > best) best = after, best_mesh = std::move(c), best_other = b;
+          if (after > best) best = after, best_mesh = std::move(c), best_other = b, best_free = free;
         }
       }
       if (best_other >= 0 && best > before + 1e-3) {
         m = std::move(best_mesh);
         touched[q] = touched[best_other] = 1;
+        report.moved.insert(report.moved.end(), best_free.begin(), best_free.end());
         t = LayoutTopology(m);
         ++kept;
       }
@@ -187,6 +188,8 @@ LayoutRotationReport rotate_layout_edges(LayoutMesh& m, const LayoutQuality& Q, 
     report.kept += kept;
     if (kept == 0) break;
   }
+  std::sort(report.moved.begin(), report.moved.end());
+  report.moved.erase(std::unique(report.moved.begin(), report.moved.end()), report.moved.end());
   return report;
 }
 

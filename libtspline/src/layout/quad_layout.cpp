@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <limits>
+#include <numbers>
 #include <set>
 #include <sstream>
 
@@ -55,32 +56,79 @@ void dump(const LayoutMesh& m, int round, const char* stage) {
   }
 }
 
-// The node optimization of one layout mesh: K* untangling, then the corners
-// as the patch maps see them, then (level 2) edge rotations where quads stay
-// poor, each followed by the node optimization again.
-void optimize_layout(LayoutMesh& m, const LayoutRings& R, const LayoutQuality& Q, const LayoutAdmissible& admissible,
-                     int level, QuadLayoutStats& st) {
-  if (level < 1) return;
-  smooth_layout_kstar(m, R);
-  LayoutOptimizationReport rep = optimize_layout_nodes(m, Q, admissible);
+// Debugging: the worst quads, corner by corner.
+void print_worst(const LayoutMesh& m, const LayoutQuality& Q, int count) {
+  const LayoutTopology t(m);
+  std::vector<std::pair<double, int>> f;
+  for (std::size_t q = 0; q < m.quads.size(); ++q)
+    f.push_back({layout_quad_figure(m, t, Q, static_cast<int>(q)), static_cast<int>(q)});
+  std::sort(f.begin(), f.end());
+  for (int k = 0; k < count && k < static_cast<int>(f.size()); ++k) {
+    const int q = f[k].second;
+    std::fprintf(stderr, "  worst quad %d (%.3g):", q, f[k].first);
+    for (int j = 0; j < 4; ++j) {
+      const int v = m.quads[q][j];
+      const LayoutCornerQuality c = Q.corner(m, t, q, j);
+      std::fprintf(stderr, " [node %d ring %d (%.4f, %.4f) valence %zu: J_r %.3g SJ %.3g; side kinks %.3g shape %.3g]", v,
+                   m.ring[v], m.x[v].x(), m.x[v].y(), t.valence(v), c.mean_ratio, c.scaled_jacobian,
+                   Q.side_kinks(m, t, q, j), Q.side_shape(m, t, q, j));
+    }
+    std::fprintf(stderr, "\n");
+  }
+}
+
+void report_optimization(const LayoutOptimizationReport& rep, QuadLayoutStats& st) {
   st.optimization_sweeps += rep.sweeps;
   if (debugging())
     std::fprintf(stderr, "layout optimization: J_r %.4g -> %.4g, SJ %.4g -> %.4g, %d sweeps, %zu moves\n",
                  rep.before.mean_ratio, rep.after.mean_ratio, rep.before.scaled_jacobian, rep.after.scaled_jacobian,
                  rep.sweeps, rep.moves);
-  if (level < 2) return;
-  for (int pass = 0; pass < 2; ++pass) {
-    const LayoutRotationReport rr = rotate_layout_edges(m, Q, admissible);
+}
+
+// The layout mesh optimized for its patch maps (level 0: as the mesher made
+// it; 1: node optimization; 2: and edge rotations where quads stay poor):
+//  1. K* untangling of the inner nodes, then a short node optimization;
+//  2. edge rotations, which also walk flat single-quad ring corners away;
+//  3. rings that still have a flat single-quad corner are pillowed;
+//  4. the node optimization in full, then rotations and the optimization
+//     again while rotations are kept.
+// `start` becomes the mesh the checks fall back to (the mesher's nodes, after
+// any pillowing).
+void optimize_layout(LayoutMesh& m, LayoutMesh& start, const LayoutRings& R, const LayoutQuality& Q,
+                     const LayoutAdmissible& admissible, int level, QuadLayoutStats& st) {
+  st.rotations = 0;
+  st.optimization_sweeps = 0;
+  st.pillowed_rings = 0;
+  auto rotate = [&]() {
+    LayoutRotationReport rr = rotate_layout_edges(m, Q, admissible);
     st.rotations += rr.kept;
     if (debugging()) std::fprintf(stderr, "layout rotations: %zu tried, %zu kept\n", rr.tried, rr.kept);
-    if (rr.kept == 0) break;
-    rep = optimize_layout_nodes(m, Q, admissible);
-    st.optimization_sweeps += rep.sweeps;
-    if (debugging())
-      std::fprintf(stderr, "layout optimization: J_r %.4g -> %.4g, SJ %.4g -> %.4g, %d sweeps, %zu moves\n",
-                   rep.before.mean_ratio, rep.after.mean_ratio, rep.before.scaled_jacobian,
-                   rep.after.scaled_jacobian, rep.sweeps, rep.moves);
+    return rr;
+  };
+  if (level >= 1) {
+    smooth_layout_kstar(m, R);
+    LayoutOptimizationOptions quick;
+    quick.max_sweeps = 8;
+    report_optimization(optimize_layout_nodes(m, Q, admissible, {}, quick), st);
+    if (level >= 2) rotate();
   }
+  const std::vector<char> flat = rings_with_flat_corners(m, Q);
+  st.pillowed_rings = static_cast<std::size_t>(std::count(flat.begin(), flat.end(), 1));
+  if (st.pillowed_rings > 0) {
+    if (level == 0) m = start;
+    pillow_rings(m, flat);
+    start = m;
+    if (level >= 1) smooth_layout_kstar(m, R);
+  }
+  if (level < 1) return;
+  report_optimization(optimize_layout_nodes(m, Q, admissible), st);
+  for (int pass = 0; pass < 2 && level >= 2; ++pass) {
+    // Around the rotations kept (the rest of the layout is as optimized as it gets).
+    const LayoutRotationReport rr = rotate();
+    if (rr.kept == 0) break;
+    report_optimization(optimize_layout_nodes(m, Q, admissible, rr.moved), st);
+  }
+  if (debugging()) print_worst(m, Q, 4);
 }
 
 }  // namespace
@@ -200,6 +248,29 @@ QuadLayout build_quad_layout(const Domain& d, const QuadLayoutOptions& o) {
           }
         }
     }
+    // The straight ring must turn where the true ring turns: at every node, the
+    // chord to a neighbour and the ring's own direction on the scale of a fifth
+    // of that piece within 35 degrees (else the mesher sees a blunt corner where
+    // the coast has a sharp tip, and gives it too few quads).
+    for (std::size_t r = 0; r < rings.size(); ++r) {
+      const std::size_t n = nodes[r].size();
+      if (n < 3) continue;
+      const double L = rings[r].length();
+      for (std::size_t k = 0; k < n; ++k) {
+        const double s = nodes[r][k];
+        for (const int side : {1, -1}) {
+          const std::size_t other = side > 0 ? (k + 1) % n : (k + n - 1) % n;
+          double len = side > 0 ? nodes[r][other] - s : s - nodes[r][other];
+          if (len <= 0.0) len += L;
+          const Eigen::Vector2d p = rings[r].point(s);
+          const Eigen::Vector2d chord = straight[r][other] - p;
+          const Eigen::Vector2d near = rings[r].point(s + side * 0.2 * len) - p;
+          const double angle = std::abs(std::atan2(cross(chord, near), chord.dot(near)));
+          if (angle > 35.0 * std::numbers::pi / 180.0 && len > 4.0 * no.min_size * 1e-3)
+            to_split[r].insert(side > 0 ? k : other);
+        }
+      }
+    }
     if (split_marked()) {
       out.stats.repair_rounds = ++repairs;
       continue;
@@ -236,12 +307,14 @@ QuadLayout build_quad_layout(const Domain& d, const QuadLayoutOptions& o) {
       m.arc[n] = rings[m.ring[n]].snap_to_vertex(a + qm.t[n] * (b - a), 0.01 * (b - a));
       m.x[n] = rings[m.ring[n]].point(m.arc[n]);
     }
-    out.stats.pillowed_rings = pillow_flat_rings(m, R);
-    const LayoutMesh start = m;  // the mesher's nodes, on the true rings
+    LayoutMesh start = m;  // the mesher's nodes, on the true rings
     dump(m, round, "before");
-    out.stats.rotations = 0;
-    out.stats.optimization_sweeps = 0;
-    optimize_layout(m, R, quality, admissible, level, out.stats);
+    const auto t_opt = std::chrono::steady_clock::now();
+    optimize_layout(m, start, R, quality, admissible, level, out.stats);
+    if (debugging())
+      std::fprintf(stderr, "layout round %d: mesh %zu quads at %.2f s, optimized in %.2f s\n", round, m.quads.size(),
+                   std::chrono::duration<double>(t_opt - t0).count(),
+                   std::chrono::duration<double>(std::chrono::steady_clock::now() - t_opt).count());
     dump(m, round, "after");
 
     // Checks on the true geometry: inner nodes inside, cuts off the rings. The

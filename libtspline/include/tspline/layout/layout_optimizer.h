@@ -29,6 +29,8 @@ struct LayoutOptimizationOptions {
   double power = 4.0;
   /// Stop when a sweep lowers no node's local energy by more than this, relatively.
   double tolerance = 1e-4;
+  /// ... or when the worst corner's J_r has not risen by 0.1 % for this many sweeps.
+  int stall_sweeps = 8;
   int ring_samples = 24;  ///< uniform samples of a ring node's reach (plus its vertices, at most max_ring_vertices)
   int max_ring_vertices = 160;
 };

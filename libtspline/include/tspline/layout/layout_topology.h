@@ -13,6 +13,7 @@
 // nodes keep valence >= 3, and no edge is doubled.
 #include <cstddef>
 #include <functional>
+#include <vector>
 
 #include "tspline/layout/layout_mesh.h"
 #include "tspline/layout/layout_quality.h"
@@ -29,18 +30,21 @@ struct LayoutRotationOptions {
 
 struct LayoutRotationReport {
   std::size_t tried = 0, kept = 0;
+  std::vector<int> moved;  ///< the nodes re-optimized around kept rotations
 };
 
-/// A ring node that is the corner of one quad only, where the ring is nearly
-/// straight (inner angle above 150 degrees, between the chords to the quad's
-/// neighbours or between the ring's own edges at the node) or reflex, would be
-/// a patch corner of about 180 degrees or more: no map is valid there (det J
-/// at a corner of the square is the cross product of the two boundary
-/// tangents). Such a ring is pillowed: every node of it moves inside, a copy
-/// takes its place on the ring, and each quad edge along the ring gets a new
-/// quad between the two (a conforming layer; every ring node then has two
-/// quads). Returns the rings pillowed.
-std::size_t pillow_flat_rings(LayoutMesh& m, const LayoutRings& rings);
+/// The rings with a ring node that is the corner of one quad only where the
+/// ring is nearly straight (inner angle above 150 degrees at any of the
+/// corner's scales, layout_quality.h) or reflex: a patch corner of about 180
+/// degrees or more, where no map is valid (det J at a corner of the square is
+/// the cross product of the two boundary tangents).
+std::vector<char> rings_with_flat_corners(const LayoutMesh& m, const LayoutQuality& quality);
+
+/// Pillows the rings marked: every node of such a ring moves a third of the
+/// way inside, a copy takes its place on the ring, and each quad edge along
+/// the ring gets a new quad between the two (a conforming layer; every ring
+/// node then has two quads). Returns the rings pillowed.
+std::size_t pillow_rings(LayoutMesh& m, const std::vector<char>& rings);
 
 /// The figure of quad q used to rank layouts: min(J_r, side shape) over its corners and sides.
 double layout_quad_figure(const LayoutMesh& m, const LayoutTopology& t, const LayoutQuality& Q, int q);
