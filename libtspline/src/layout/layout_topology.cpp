@@ -1,7 +1,6 @@
 #include "tspline/layout/layout_topology.h"
 
 #include <algorithm>
-#include <cstdio>
 #include <cstdlib>
 #include <array>
 #include <utility>
@@ -129,6 +128,7 @@ LayoutRotationReport rotate_layout_edges(LayoutMesh& m, const LayoutQuality& Q, 
     }
     if (bad.empty()) break;
     std::sort(bad.begin(), bad.end());
+    if (bad.size() > o.max_quads) bad.resize(o.max_quads);
     std::vector<char> touched(m.quads.size(), 0);
     std::size_t kept = 0;
     for (const auto& [f0, q] : bad) {
@@ -172,8 +172,6 @@ LayoutRotationReport rotate_layout_edges(LayoutMesh& m, const LayoutQuality& Q, 
           for (const int n : free) valid = valid && admissible(c, ct, n);
           if (!valid) continue;
           const double after = region_figure(c, ct, Q, free);
-          if (std::getenv("TSPLINE_LAYOUT_DEBUG") && f0 < 0.01)
-            std::fprintf(stderr, "   rotation of quad %d edge %d (%d-%d) r %d: %.3g -> %.3g\n", q, j, h[0], h[3], r, before, after);
           if (after > best) best = after, best_mesh = std::move(c), best_other = b, best_free = free;
         }
       }

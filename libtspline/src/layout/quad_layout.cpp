@@ -248,26 +248,38 @@ QuadLayout build_quad_layout(const Domain& d, const QuadLayoutOptions& o) {
           }
         }
     }
-    // The straight ring must turn where the true ring turns: at every node, the
-    // chord to a neighbour and the ring's own direction on the scale of a fifth
-    // of that piece within 35 degrees (else the mesher sees a blunt corner where
-    // the coast has a sharp tip, and gives it too few quads).
+    // At a sharp tip of the coast (the domain's angle there below 60 or above
+    // 300 degrees on the scale of a fifth of the pieces next to the node) the
+    // straight ring must be as sharp: the chord to a neighbour and the ring's
+    // own direction within 35 degrees; else the mesher sees a blunt corner where
+    // the coast has a tip, and gives it too few quads (a reflex tip of 340
+    // degrees split in two corners of 170 degrees).
     for (std::size_t r = 0; r < rings.size(); ++r) {
       const std::size_t n = nodes[r].size();
       if (n < 3) continue;
       const double L = rings[r].length();
       for (std::size_t k = 0; k < n; ++k) {
         const double s = nodes[r][k];
-        for (const int side : {1, -1}) {
-          const std::size_t other = side > 0 ? (k + 1) % n : (k + n - 1) % n;
-          double len = side > 0 ? nodes[r][other] - s : s - nodes[r][other];
-          if (len <= 0.0) len += L;
-          const Eigen::Vector2d p = rings[r].point(s);
-          const Eigen::Vector2d chord = straight[r][other] - p;
-          const Eigen::Vector2d near = rings[r].point(s + side * 0.2 * len) - p;
-          const double angle = std::abs(std::atan2(cross(chord, near), chord.dot(near)));
-          if (angle > 35.0 * std::numbers::pi / 180.0 && len > 4.0 * no.min_size * 1e-3)
-            to_split[r].insert(side > 0 ? k : other);
+        const Eigen::Vector2d p = rings[r].point(s);
+        double len[2];
+        Eigen::Vector2d near[2], chord[2];
+        for (const int side : {0, 1}) {
+          const std::size_t other = side == 0 ? (k + 1) % n : (k + n - 1) % n;
+          len[side] = side == 0 ? nodes[r][other] - s : s - nodes[r][other];
+          if (len[side] <= 0.0) len[side] += L;
+          chord[side] = straight[r][other] - p;
+          near[side] = rings[r].point(s + (side == 0 ? 1.0 : -1.0) * 0.2 * len[side]) - p;
+        }
+        // The domain's angle at the node from the forward to the backward direction
+        // (the domain on the left of the outer ring, on the right of holes).
+        double phi = std::atan2(cross(near[0], near[1]), near[0].dot(near[1]));
+        if (R.direction(static_cast<int>(r)) < 0.0) phi = -phi;
+        if (phi < 0.0) phi += 2.0 * std::numbers::pi;
+        if (phi > std::numbers::pi / 3.0 && phi < 5.0 * std::numbers::pi / 3.0) continue;
+        for (const int side : {0, 1}) {
+          const double angle = std::abs(std::atan2(cross(chord[side], near[side]), chord[side].dot(near[side])));
+          if (angle > 35.0 * std::numbers::pi / 180.0 && len[side] > 2.0 * no.min_size)
+            to_split[r].insert(side == 0 ? k : (k + n - 1) % n);
         }
       }
     }

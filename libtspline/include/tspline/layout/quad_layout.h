@@ -59,7 +59,9 @@ struct QuadLayoutStats {
   std::size_t rotations = 0;       ///< edge rotations kept
   int optimization_sweeps = 0;     ///< node optimization sweeps, all passes
   /// The worst patch corner as the patch maps see it (layout_quality.h): J_r
-  /// and the scaled Jacobian there, upper bounds of the map's whole-map figures.
+  /// and the scaled Jacobian there. A prediction, not a bound: the certified
+  /// whole-map figures of the report are the ones to trust (measured within a
+  /// few percent of these at the worst patch when the patch's sides are smooth).
   double corner_mean_ratio = 1.0, corner_scaled_jacobian = 1.0;
   double min_size = 0.0, max_size = 0.0;     ///< of the size field, absolute
   double seconds = 0.0;
