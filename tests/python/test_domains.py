@@ -1,9 +1,10 @@
 """tspline.parameterize on domains with holes given as Python objects (rings,
 a shapely polygon, a GeoJSON dict in longitude/latitude, a shapely polygon in
-longitude/latitude with crs=) against `tspline param` on the domain's file:
-the same certified multi-patch map, every patch equal to `tspline eval` to
-round-off. (The layouts are the layout builder's and may change: the tests
-compare the module with the program, not with patch counts.)"""
+longitude/latitude with crs=, an object with its own .crs as GeoPandas gives
+it) against `tspline param` on the domain's file: the same certified
+multi-patch map, every patch equal to `tspline eval` to round-off. (The
+layouts are the layout builder's and may change: the tests compare the module
+with the program, not with patch counts.)"""
 import json
 
 import numpy as np
@@ -111,3 +112,33 @@ def test_planar_keeps_a_geojson_dict_as_given(plate_cli):
     far = {"type": "Polygon", "coordinates": [[[100 * x, 100 * y] for x, y in ring] for ring in doc["coordinates"]]}
     with pytest.raises(tspline.InputError, match="longitude/latitude.*--planar"):
         tspline.parameterize(far)
+
+
+class WGS84:
+    """What pyproj.CRS offers the module: to_wkt() (here WGS 84 as OGC WKT 1, longitude first)."""
+
+    def to_wkt(self):
+        return ('GEOGCS["WGS 84",DATUM["WGS_1984",SPHEROID["WGS 84",6378137,298.257223563]],'
+                'PRIMEM["Greenwich",0],UNIT["degree",0.0174532925199433]]')
+
+
+class GeoSeriesLike:
+    """What a GeoPandas GeoSeries / GeoDataFrame offers: __geo_interface__ (a
+    FeatureCollection) and .crs (a pyproj.CRS, or None)."""
+
+    def __init__(self, collection, crs):
+        self.__geo_interface__ = collection
+        self.crs = crs
+
+
+def test_an_object_in_its_own_crs_as_geopandas_gives_it(plate_lonlat_cli, plate_cli):
+    doc = json.loads(PLATE_LONLAT.read_text())
+    m = tspline.parameterize(GeoSeriesLike(doc, WGS84()))
+    check_same_as_cli(m, plate_lonlat_cli)
+    assert m.report["input_geometry"]["units"] == "m"
+    # Without a CRS (.crs None) the coordinates are planar, as given: the plate's text file.
+    outer, hole = text_rings(PLATE)
+    planar = {"type": "Polygon", "coordinates": [outer.tolist(), hole.tolist()]}
+    check_same_as_cli(tspline.parameterize(GeoSeriesLike(planar, None)), plate_cli)
+    with pytest.raises(TypeError, match="crs: expected a str"):
+        tspline.parameterize(GeoSeriesLike(planar, 4326))
