@@ -116,6 +116,33 @@ TEST_SUITE("layout_quality") {
     }
   }
 
+  TEST_CASE("side shape: the width a coast bulging into the patch leaves, over the straight patch's") {
+    // A 2 x 1 rectangle whose bottom rises to (1, d) inside: at the vertex the patch
+    // is 1 - d wide where the straight patch is 1.
+    for (const double d : {0.2, 0.6}) {
+      const tspline::LayoutRings ring = one_ring({V(0, 0), V(1, d), V(2, 0), V(2, 1), V(0, 1)});
+      const tspline::LayoutMesh m =
+          ring_mesh(ring.curves[0], {V(0, 0), V(2, 0), V(2, 1), V(0, 1)}, {}, {{0, 1, 2, 3}});
+      const tspline::LayoutTopology t(m);
+      const tspline::LayoutQuality Q(ring);
+      CHECK(Q.side_shape(m, t, 0, 0) == doctest::Approx(1.0 - d));
+      CHECK(Q.side_shape(m, t, 0, 1) == 1.0);  // straight
+    }
+    // A wedge-shaped patch, 4 long, 2 wide at x = 0 and 1 wide at x = 4, whose bottom
+    // rises by 0.5 at x = 3: the width there is 1.25 - 0.5 of 1.25.
+    const tspline::LayoutRings wedge = one_ring({V(0, 0), V(3, 0.5), V(4, 0), V(4, 1), V(0, 2)});
+    const tspline::LayoutMesh w = ring_mesh(wedge.curves[0], {V(0, 0), V(4, 0), V(4, 1), V(0, 2)}, {}, {{0, 1, 2, 3}});
+    const tspline::LayoutQuality WQ(wedge);
+    // (Measured perpendicular to the opposite side: both widths scale alike.)
+    CHECK(WQ.side_shape(w, tspline::LayoutTopology(w), 0, 0) == doctest::Approx(0.75 / 1.25));
+    // A coast bulging out of the patch by d_out over a chord c: 1 - d_out / (2 c).
+    const tspline::LayoutRings outward = one_ring({V(0, 0), V(1, -0.5), V(2, 0), V(2, 1), V(0, 1)});
+    const tspline::LayoutMesh o =
+        ring_mesh(outward.curves[0], {V(0, 0), V(2, 0), V(2, 1), V(0, 1)}, {}, {{0, 1, 2, 3}});
+    CHECK(tspline::LayoutQuality(outward).side_shape(o, tspline::LayoutTopology(o), 0, 0) ==
+          doctest::Approx(1.0 - 0.5 * 0.5 / 2.0));
+  }
+
   TEST_CASE("node optimization: a displaced centre and a displaced ring node go back to the square grid") {
     const tspline::LayoutRings ring = one_ring({V(0, 0), V(1, 0), V(1, 1), V(0, 1)});
     const tspline::LayoutQuality Q(ring);

@@ -88,7 +88,8 @@ std::size_t pillow_rings(LayoutMesh& m, const std::vector<char>& pillow) {
   for (std::size_t q = 0; q < quads.size(); ++q)
     for (int j = 0; j < 4; ++j) {
       const int v = quads[q][j], w = quads[q][(j + 1) % 4];
-      if (t.on_ring(static_cast<int>(q), j) && ring[v] >= 0 && pillow[ring[v]]) along.push_back({v, w});
+      if (t.on_ring(static_cast<int>(q), j) && ring[v] >= 0 && ring[w] == ring[v] && pillow[ring[v]])
+        along.push_back({v, w});
     }
   const std::size_t n0 = x.size();
   std::vector<int> copy(n0, -1);
@@ -142,6 +143,8 @@ LayoutRotationReport rotate_layout_edges(LayoutMesh& m, const LayoutQuality& Q, 
         if (t.on_ring(q, j)) continue;
         const auto [b, k] = t.across(q, j);
         if (b < 0 || touched[b]) continue;
+        // Only between quads that run along their shared edge in opposite directions.
+        if (m.quads[b][k] != m.quads[q][(j + 1) % 4]) continue;
         // The hexagon, counter-clockwise, the shared edge h0-h3.
         const std::array<int, 4>& A = m.quads[q];
         const std::array<int, 4>& B = m.quads[b];

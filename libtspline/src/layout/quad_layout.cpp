@@ -8,6 +8,7 @@
 #include <limits>
 #include <numbers>
 #include <set>
+#include <unordered_map>
 #include <sstream>
 
 #include "tspline/errors.h"
@@ -307,6 +308,34 @@ QuadLayout build_quad_layout(const Domain& d, const QuadLayoutOptions& o) {
       split_marked();
       out.stats.repair_rounds = ++repairs;
       continue;
+    }
+    // The mesh must tile the straight domain: every edge used by two quads in
+    // opposite directions, or by one quad along a ring (between nodes of that
+    // ring). Gmsh can mesh a sliver inside a hole, or lose a ring node's curve
+    // where straight pieces nearly touch: more ring nodes there, and again.
+    {
+      std::unordered_map<unsigned long long, int> directed;
+      auto key = [](int a, int b) {
+        return (static_cast<unsigned long long>(static_cast<unsigned>(a)) << 32) | static_cast<unsigned>(b);
+      };
+      for (const auto& q : qm.quads)
+        for (int j = 0; j < 4; ++j) ++directed[key(q[j], q[(j + 1) % 4])];
+      bool broken = false;
+      for (const auto& q : qm.quads)
+        for (int j = 0; j < 4; ++j) {
+          const int a = q[j], b = q[(j + 1) % 4];
+          const bool twice = directed[key(a, b)] > 1;
+          const bool boundary = directed.find(key(b, a)) == directed.end();
+          if (twice || (boundary && !(qm.ring[a] >= 0 && qm.ring[a] == qm.ring[b]))) {
+            mark_nearest_piece(0.5 * (qm.nodes[a] + qm.nodes[b]));
+            broken = true;
+          }
+        }
+      if (broken && split_marked()) {
+        out.stats.repair_rounds = ++repairs;
+        continue;
+      }
+      if (broken) throw NumericalError("the quad mesher's quadrilaterals do not tile the domain");
     }
     // The mesh with its boundary nodes on the true rings.
     LayoutMesh m{qm.nodes, qm.ring, std::vector<double>(qm.nodes.size(), 0.0), qm.quads};
