@@ -384,6 +384,9 @@ QuadLayout build_quad_layout(const Domain& d, const QuadLayoutOptions& o) {
         }
       return involved;
     };
+    if (debugging())
+      std::fprintf(stderr, "layout round %d: %zu nodes in violations at the start, %zu after optimization\n", round,
+                   violations(start, false).size(), violations(m, false).size());
     if (!violations(m, false).empty() && m.quads != start.quads) m = start;  // rotations undone
     for (int pass = 0; pass < 3; ++pass) {
       bool changed = false;
@@ -391,6 +394,7 @@ QuadLayout build_quad_layout(const Domain& d, const QuadLayoutOptions& o) {
         if (m.x[n] != start.x[n]) m.x[n] = start.x[n], m.arc[n] = start.arc[n], changed = true;
       if (!changed) break;
     }
+    if (debugging()) std::fprintf(stderr, "  %zu nodes still in violation\n", violations(m, false).size());
     violations(m, true);
     if (split_marked()) {
       out.stats.repair_rounds = ++repairs;
