@@ -220,7 +220,7 @@ TEST_SUITE("layout_quality") {
     }
   }
 
-  TEST_CASE("a flat single-quad corner marks its ring, and the pillow layer gives every ring node two quads") {
+  TEST_CASE("a flat single-quad corner marks its ring, and the pillow layer gives it two quads") {
     // A right triangle as one quad whose fourth corner is the hypotenuse's midpoint (180 degrees).
     const tspline::LayoutRings ring = one_ring({V(0, 0), V(2, 0), V(0, 2)});
     const tspline::LayoutQuality Q(ring);
@@ -229,28 +229,74 @@ TEST_SUITE("layout_quality") {
     REQUIRE(flat.size() == 1);
     CHECK(flat[0] == 1);
     CHECK(tspline::pillow_rings(m, flat) == 1);
-    CHECK(m.quads.size() == 5);
+    // 1 quad and 4 layer quads; the right angle at (0, 0), the first convex corner of the
+    // old quad, keeps one quad (its hexagon re-split: one quad less, its moved node unused).
+    CHECK(m.quads.size() == 4);
     CHECK(m.size() == 8);
     const tspline::LayoutTopology t(m);
-    int on_ring = 0;
+    int on_ring = 0, unused = 0;
     for (std::size_t n = 0; n < m.size(); ++n) {
-      if (m.ring[n] >= 0) {
-        ++on_ring;
-        CHECK(t.valence(static_cast<int>(n)) == 2);
-      } else {
-        CHECK(t.valence(static_cast<int>(n)) == 3);
-      }
+      const std::size_t k = t.valence(static_cast<int>(n));
+      if (k == 0) ++unused;
+      if (m.ring[n] < 0) continue;
+      ++on_ring;
+      if (m.x[n] == V(1, 1)) CHECK(k == 2);  // the flat corner: two quads of about 90 degrees
+      if (m.x[n] == V(0, 0)) CHECK(k == 1);  // the corner kept whole
     }
     CHECK(on_ring == 4);
-    // The quads tile the triangle (area 2).
+    CHECK(unused == 1);
+    // The signed areas of the quads add up to the triangle's, 2: the boundary is kept.
     double area = 0.0;
     for (const auto& q : m.quads)
       for (int k = 0; k < 4; ++k) {
-        const V &p = m.x[q[k]], &s = m.x[q[(k + 1) % 4]];
-        area += 0.5 * (p.x() * s.y() - p.y() * s.x());
+        const V &p = m.x[q[k]], &s2 = m.x[q[(k + 1) % 4]];
+        area += 0.5 * (p.x() * s2.y() - p.y() * s2.x());
       }
     CHECK(area == doctest::Approx(2.0));
-    CHECK(tspline::rings_with_flat_corners(m, Q)[0] == 0);  // the flat corner now has two quads
+    CHECK(tspline::rings_with_flat_corners(m, Q)[0] == 0);
+  }
+
+  TEST_CASE("pillowing keeps convex corners whole: a 3 x 3 grid's corners stay single-quad corners") {
+    const tspline::LayoutRings ring = one_ring({V(0, 0), V(3, 0), V(3, 3), V(0, 3)});
+    // Ring nodes counter-clockwise from (0, 0), then the inner nodes (1, 1), (2, 1), (2, 2), (1, 2).
+    const std::vector<V> on_ring = {V(0, 0), V(1, 0), V(2, 0), V(3, 0), V(3, 1), V(3, 2),
+                                    V(3, 3), V(2, 3), V(1, 3), V(0, 3), V(0, 2), V(0, 1)};
+    tspline::LayoutMesh m = ring_mesh(ring.curves[0], on_ring, {V(1, 1), V(2, 1), V(2, 2), V(1, 2)},
+                                      {{0, 1, 12, 11}, {1, 2, 13, 12}, {2, 3, 4, 13},
+                                       {12, 13, 14, 15}, {13, 4, 5, 14}, {11, 12, 15, 10},
+                                       {10, 15, 9, 9}, {15, 14, 7, 8}, {14, 5, 6, 7}});
+    m.quads[6] = {10, 15, 8, 9};  // the top-left quad
+    REQUIRE(tspline::pillow_rings(m, {1}) == 1);
+    // 9 quads, 12 layer quads, less one for each of the 4 corners.
+    CHECK(m.quads.size() == 9 + 12 - 4);
+    const tspline::LayoutTopology t(m);
+    int corners = 0, unused = 0, threes = 0;
+    double area = 0.0;
+    for (std::size_t n = 0; n < m.size(); ++n) {
+      const int k = static_cast<int>(t.valence(static_cast<int>(n)));
+      if (k == 0) ++unused;
+      if (m.ring[n] < 0 || k == 0) continue;
+      const bool corner = (m.x[n].x() == 0.0 || m.x[n].x() == 3.0) && (m.x[n].y() == 0.0 || m.x[n].y() == 3.0);
+      // A corner keeps one quad; per corner one ring neighbour gets the cut of the
+      // re-split hexagon (3 quads), every other ring node has 2.
+      if (corner) CHECK(k == 1);
+      else CHECK((k == 2 || k == 3));
+      corners += corner;
+      threes += k == 3;
+    }
+    CHECK(corners == 4);
+    CHECK(threes == 4);
+    CHECK(unused == 4);  // the moved corner nodes
+    for (const auto& q : m.quads) {
+      double a = 0.0;
+      for (int k = 0; k < 4; ++k) {
+        const V &p = m.x[q[k]], &s2 = m.x[q[(k + 1) % 4]];
+        a += 0.5 * (p.x() * s2.y() - p.y() * s2.x());
+      }
+      CHECK(a > 0.0);
+      area += a;
+    }
+    CHECK(area == doctest::Approx(9.0));
   }
 
   TEST_CASE("ring geometry: inside a square with a hole, segments crossing a ring, the nearest edge") {

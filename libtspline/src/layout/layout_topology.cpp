@@ -111,7 +111,61 @@ std::size_t pillow_rings(LayoutMesh& m, const std::vector<char>& pillow) {
     if (k > 0) x[v] += (1.0 / 3.0) * (mean / k - x[v]);
     ring[v] = -1;
   }
-  for (const auto& [v, w] : along) quads.push_back({w, v, copy[v], copy[w]});
+  // The layer quad of each ring edge, by the edge's first node in its quad.
+  std::vector<int> layer_from(n0, -1), layer_to(n0, -1);
+  for (const auto& [v, w] : along) {
+    layer_from[v] = static_cast<int>(quads.size());
+    layer_to[w] = static_cast<int>(quads.size());
+    quads.push_back({w, v, copy[v], copy[w]});
+  }
+  // A tip keeps one quad: where a node was the corner of one quad only, with
+  // a corner below 150 degrees (a convex tip of the coast, not the flat corner
+  // the layer is for), its two layer quads and its old quad form a hexagon
+  // a, a_r, v_r, b_r, b, X around the moved node v, which goes; the hexagon is
+  // split by whichever of a_r-b and a-b_r gives the better worst corner (with
+  // straight sides; it may be folded where the moved nodes crowd a thin tip:
+  // the node optimization that follows untangles it, and the checks on the
+  // true geometry still hold the layout to account).
+  std::vector<char> resplit(quads.size(), 0);  // old quads already part of a hexagon
+  for (std::size_t v = 0; v < n0; ++v) {
+    if (copy[v] < 0 || quads_of[v].size() != 1 || layer_from[v] < 0 || layer_to[v] < 0) continue;
+    const int q = quads_of[v].front();
+    if (resplit[q]) continue;
+    int j = 0;
+    while (j < 4 && quads[q][j] != static_cast<int>(v)) ++j;
+    if (j == 4) continue;
+    const int b = quads[q][(j + 1) % 4], X = quads[q][(j + 2) % 4], a = quads[q][(j + 3) % 4];
+    if (b >= static_cast<int>(n0) || a >= static_cast<int>(n0) || copy[a] < 0 || copy[b] < 0) continue;
+    const Eigen::Vector2d tip = x[copy[v]];
+    const double sn = corner_sj(tip, x[copy[b]], x[copy[a]]);
+    if (!(sn > 0.5 || (sn > 0.0 && (x[copy[b]] - tip).dot(x[copy[a]] - tip) > 0.0))) continue;
+    const int ar = copy[a], vr = copy[v], br = copy[b];
+    const std::array<std::array<int, 4>, 2> split_a = {{{ar, vr, br, b}, {b, X, a, ar}}};
+    const std::array<std::array<int, 4>, 2> split_b = {{{a, ar, vr, br}, {br, b, X, a}}};
+    auto worst = [&](const std::array<std::array<int, 4>, 2>& s2) {
+      double w = 1.0;
+      for (const auto& qq : s2)
+        for (int k = 0; k < 4; ++k) w = std::min(w, corner_sj(x[qq[k]], x[qq[(k + 1) % 4]], x[qq[(k + 3) % 4]]));
+      return w;
+    };
+    const auto& best = worst(split_a) >= worst(split_b) ? split_a : split_b;
+    const int kept = layer_from[v], gone = layer_to[v];
+    resplit[q] = 1;
+    quads[q] = best[0];
+    quads[kept] = best[1];
+    // Neither is a layer quad any more; `gone` is removed, the last quad takes its place.
+    for (std::vector<int>* l : {&layer_from, &layer_to})
+      for (int& f : *l)
+        if (f == kept || f == gone) f = -1;
+    const int last = static_cast<int>(quads.size()) - 1;
+    if (gone != last) {
+      quads[gone] = quads[last];
+      for (std::vector<int>* l : {&layer_from, &layer_to})
+        for (int& f : *l)
+          if (f == last) f = gone;
+    }
+    quads.pop_back();
+  }
   return count;
 }
 

@@ -45,7 +45,11 @@ std::vector<char> rings_with_flat_corners(const LayoutMesh& m, const LayoutQuali
 /// Pillows the rings marked: every node of such a ring moves a third of the
 /// way inside, a copy takes its place on the ring, and each quad edge along
 /// the ring gets a new quad between the two (a conforming layer; every ring
-/// node then has two quads). Returns the rings pillowed.
+/// node then has two quads). A ring node that was the corner of one quad with
+/// a convex corner below 150 degrees (a tip of the coast, not a flat corner)
+/// keeps one quad: its two layer quads and its old quad become two quads (the
+/// moved node goes, left with no quad), so that a sharp tip is not split in
+/// two halves. Returns the rings pillowed.
 std::size_t pillow_rings(LayoutMesh& m, const std::vector<char>& rings);
 
 /// The figure of quad q used to rank layouts: min(J_r, side shape) over its corners and sides.
