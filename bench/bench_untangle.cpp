@@ -3,11 +3,19 @@
 // interpolating fit, then untangle_map. Prints one row per continuation stage
 // (with -v) and a summary row:
 //   cells elements free_points samples stages iterations evals seconds certified min_rel_bound min_Jr_samples
-// (iterations: Newton or L-BFGS), after a line with the Newton counters and the peak resident memory.
-// Usage: bench_untangle POLYGON [INIT_LEVEL [TOL_REL]] [-v]
+// (iterations: Newton or L-BFGS), after a line with the Newton counters, the CPU time
+// (user + system, all threads) of the untangling and the peak resident memory.
+// Usage: bench_untangle POLYGON [INIT_LEVEL [TOL_REL]] [-v] [--pipeline]
+// --pipeline: untangle the map that `tspline param --layout single` untangles
+// in its first round (run_parameterization without the control point
+// optimization and without adaptive rounds: the fit after the boundary curve
+// is frozen, all corner trials), instead of the fit of the front half alone.
 // UNTANGLE_OPTIMIZER=newton|lbfgs selects the optimizer (default: the library's, L-BFGS).
+// UNTANGLE_KERNEL_PASSES=N first times N energy-and-gradient passes and N Hessian
+// assemblies at the starting map (eps 0.01), CPU time per sample, and exits.
 #include <sys/resource.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
@@ -16,32 +24,57 @@
 #include "bench_front_args.h"
 #include "tspline/io/polygon_reader.h"
 #include "tspline/validity/map_untangling.h"
+#include "tspline/pipeline/adaptive_parameterization.h"
 #include "tspline/pipeline/parameterization.h"
 #include "tspline/spline/tspline_fit.h"
 
 using bench::since;
 
+namespace {
+double cpu_seconds() {
+  rusage ru{};
+  getrusage(RUSAGE_SELF, &ru);
+  return ru.ru_utime.tv_sec + ru.ru_stime.tv_sec + 1e-6 * (ru.ru_utime.tv_usec + ru.ru_stime.tv_usec);
+}
+}  // namespace
+
 int main(int argc, char** argv) {
   bool verbose = false;
+  bool pipeline = false;
   int n = 0;
   char* args[4] = {nullptr, nullptr, nullptr, nullptr};
   for (int i = 1; i < argc; ++i) {
     if (std::strcmp(argv[i], "-v") == 0)
       verbose = true;
+    else if (std::strcmp(argv[i], "--pipeline") == 0)
+      pipeline = true;
     else if (n < 3)
       args[n++] = argv[i];
   }
   if (n < 1) {
-    std::fprintf(stderr, "usage: %s POLYGON [INIT_LEVEL [TOL_REL]] [-v]\n", argv[0]);
+    std::fprintf(stderr, "usage: %s POLYGON [INIT_LEVEL [TOL_REL]] [-v] [--pipeline]\n", argv[0]);
     return 1;
   }
   tspline::ParameterizationOptions opt;
   if (n > 1) opt.initial_level = std::atoi(args[1]);
   if (n > 2) opt.tolerance_relative = std::atof(args[2]);
   auto t = std::chrono::steady_clock::now();
-  const tspline::FrontResult front = tspline::run_front(tspline::io::read_polygon(args[0]), opt);
+  std::optional<tspline::TSplineMap> input;
+  std::optional<tspline::FrontResult> front_result;
+  if (pipeline) {
+    tspline::AdaptiveOptions ad;
+    ad.optimize_control_points = false;
+    ad.max_adapt = 0;
+    tspline::ParameterizationResult pr = tspline::run_parameterization(tspline::io::read_polygon(args[0]), opt, ad);
+    input = std::move(*pr.map);
+    front_result = std::move(pr.front);
+  } else {
+    front_result = tspline::run_front(tspline::io::read_polygon(args[0]), opt);
+    input = tspline::fit_tspline(front_result->mesh, front_result->optimized, front_result->boundary);
+  }
+  const tspline::FrontResult& front = *front_result;
   const double t_front = since(t);
-  tspline::TSplineMap map = tspline::fit_tspline(front.mesh, front.optimized, front.boundary);
+  tspline::TSplineMap map = std::move(*input);
   tspline::MapUntanglingOptions uopt;
   // Experiment knobs (environment): iterations per stage, element weighting.
   if (const char* v = std::getenv("UNTANGLE_STAGE_ITERATIONS")) uopt.max_iterations_per_stage = std::atoi(v);
@@ -61,16 +94,41 @@ int main(int argc, char** argv) {
                   p.samples.min_mean_ratio, p.certified ? " certified" : "");
       std::fflush(stdout);
     };
+  if (const char* v = std::getenv("UNTANGLE_KERNEL_PASSES")) {
+    const int passes = std::max(1, std::atoi(v));
+    const tspline::MapEnergy energy(map, uopt.energy);
+    const Eigen::VectorXd x = energy.variables(map);
+    Eigen::VectorXd g(x.size());
+    double sum = 0.0;
+    double c = cpu_seconds();
+    auto w = std::chrono::steady_clock::now();
+    for (int i = 0; i < passes; ++i) sum += energy.evaluate(x.data(), 0.01, g.data());
+    const double cpu_eval = (cpu_seconds() - c) / passes, wall_eval = since(w) / passes;
+    Eigen::SparseMatrix<double> H;
+    energy.hessian(x.data(), 0.01, H);  // the pattern, once
+    c = cpu_seconds();
+    w = std::chrono::steady_clock::now();
+    for (int i = 0; i < passes; ++i) energy.hessian(x.data(), 0.01, H);
+    const double cpu_hess = (cpu_seconds() - c) / passes, wall_hess = since(w) / passes;
+    const double ns = 1e9 / static_cast<double>(energy.num_samples());
+    std::printf("%zu samples, %zu unknowns, H nnz (lower) %ld: energy+gradient %.2f ms CPU (%.1f ns/sample), %.2f ms wall; "
+                "Hessian %.2f ms CPU (%.1f ns/sample), %.2f ms wall  [E %.6g]\n",
+                energy.num_samples(), energy.num_variables(), static_cast<long>(H.nonZeros()), 1e3 * cpu_eval,
+                cpu_eval * ns, 1e3 * wall_eval, 1e3 * cpu_hess, cpu_hess * ns, 1e3 * wall_hess, sum / passes);
+    return 0;
+  }
   t = std::chrono::steady_clock::now();
+  const double cpu0 = cpu_seconds();
   const tspline::MapUntanglingReport r = tspline::untangle_map(map, uopt);
   const double t_untangle = since(t);
+  const double cpu_untangle = cpu_seconds() - cpu0;
   std::printf("front %.2f s; before: %zu of %zu samples det<=0, min Jr %.4f\n", t_front, r.before.nonpositive,
               r.before.points, r.before.min_mean_ratio);
   rusage ru{};
   getrusage(RUSAGE_SELF, &ru);
-  std::printf("%s: hessians %d (%.2f s), shifted %d, CHOLMOD %.2f s, certified trial steps %d; peak RSS %.0f MiB; mean Jr %.4f\n",
+  std::printf("%s: hessians %d (%.2f s), shifted %d, CHOLMOD %.2f s, certified trial steps %d; CPU %.2f s; peak RSS %.0f MiB; mean Jr %.4f\n",
               uopt.optimizer == tspline::MapOptimizer::Newton ? "newton" : "lbfgs", r.factorizations,
-              r.hessian_seconds, r.shifted_factorizations, r.solve_seconds, r.line_search_certifications, ru.ru_maxrss / 1024.0,
+              r.hessian_seconds, r.shifted_factorizations, r.solve_seconds, r.line_search_certifications, cpu_untangle, ru.ru_maxrss / 1024.0,
               r.after.mean_mean_ratio);
   std::printf("%9zu %9zu %9zu %9zu %6d %7d %7d %9.3f %9s %13.4g %9.4f  (%s)\n", front.mesh.num_cells(), r.elements,
               r.free_points, r.samples, r.stages, r.iterations, r.evaluations, t_untangle,
