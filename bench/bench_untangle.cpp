@@ -11,6 +11,7 @@
 // optimization and without adaptive rounds: the fit after the boundary curve
 // is frozen, all corner trials), instead of the fit of the front half alone.
 // UNTANGLE_OPTIMIZER=newton|lbfgs selects the optimizer (default: the library's, L-BFGS).
+// UNTANGLE_THREADS=N: threads of the energy (default: all cores).
 // UNTANGLE_KERNEL_PASSES=N first times N energy-and-gradient passes and N Hessian
 // assemblies at the starting map (eps 0.01), CPU time per sample, and exits.
 #include <sys/resource.h>
@@ -83,6 +84,7 @@ int main(int argc, char** argv) {
   if (const char* v = std::getenv("UNTANGLE_MIN_DECREASE")) uopt.min_decrease = std::atof(v);
   if (const char* v = std::getenv("UNTANGLE_GAUSS")) uopt.energy.gauss = std::atoi(v);
   if (const char* v = std::getenv("UNTANGLE_LEGENDRE"); v && *v == '1') uopt.energy.lobatto = false;
+  if (const char* v = std::getenv("UNTANGLE_THREADS")) uopt.energy.threads = std::atoi(v);
   if (const char* v = std::getenv("UNTANGLE_OPTIMIZER"))
     uopt.optimizer = std::strcmp(v, "newton") == 0 ? tspline::MapOptimizer::Newton : tspline::MapOptimizer::LBFGS;
   if (const char* v = std::getenv("UNTANGLE_NEWTON_ITERATIONS")) uopt.max_newton_iterations_per_stage = std::atoi(v);

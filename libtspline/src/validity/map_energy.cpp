@@ -47,22 +47,26 @@ void lobatto_points_01(int n, std::vector<double>& p, std::vector<double>& w) {
 enum class Power { One, Four, Other };
 
 template <Power P, bool Grad>
-std::size_t sample_terms(std::size_t n, const double* J00, const double* J01, const double* J10, const double* J11,
-                         const double* weight, double element_weight, double eps, double theta, double power,
-                         double* term, double* G00, double* G01, double* G10, double* G11) {
-  const double e2 = eps * eps;
+std::size_t sample_terms(std::size_t n, const double* __restrict J00, const double* __restrict J01,
+                         const double* __restrict J10, const double* __restrict J11, const double* __restrict weight,
+                         double element_weight, double eps, double theta, double power, double* __restrict term,
+                         double* __restrict G00, double* __restrict G01, double* __restrict G10,
+                         double* __restrict G11) {
+  const double e2 = eps * eps, ie2 = 1.0 / e2;
   std::size_t nonpos = 0;
   for (std::size_t q = 0; q < n; ++q) {
     const double j00 = J00[q], j01 = J01[q], j10 = J10[q], j11 = J11[q];
     const double omega = weight[q] * element_weight;
     const double D = j00 * j11 - j01 * j10;
     const double n2 = j00 * j00 + j01 * j01 + j10 * j10 + j11 * j11;
-    nonpos += D > 0.0 ? 0 : 1;
+    nonpos += static_cast<std::size_t>(!(D > 0.0));
     const double r = std::sqrt(e2 + D * D);
-    // chi = regularized_det(D, eps), both branches computed (no cancellation for D < 0).
-    const double c1 = D > 0.0 ? 0.5 * (D + r) : 0.5 * e2 / (r - D);
-    const double ic1 = 1.0 / c1;
-    const double c2 = c1 / r;  // d chi / dD = (1 + D / r) / 2 = chi / r
+    const double ir = 1.0 / r;
+    // 1 / chi = 2 / (D + r) = 2 (r - D) / eps^2 (regularized_det), each form
+    // where it has no cancellation; both computed (a select, no branch).
+    const double ic1_pos = 2.0 / (D + r), ic1_neg = 2.0 * (r - D) * ie2;
+    const double ic1 = D > 0.0 ? ic1_pos : ic1_neg;
+    const double c2 = 0.5 * (1.0 + D * ir);  // d chi / dD = (1 + D / r) / 2 = chi / r
     const double f = n2 * ic1, gA = (1.0 + D * D) * ic1;
     const double t = (1.0 - theta) * f + theta * gA;
     double tp, chain;  // t^p and omega p t^(p - 1)
@@ -136,6 +140,16 @@ struct KernelBuffers {
   double *x, *xs, *xt, *y, *ys, *yt, *rw, *rs, *rt, *J00, *J01, *J10, *J11, *term, *scratch;
 };
 
+// sum of a[0..n) in four interleaved partial sums (independent add chains).
+inline double sum4(const double* a, std::size_t n) {
+  double p[4] = {};
+  std::size_t q = 0;
+  for (; q + 4 <= n; q += 4)
+    for (int l = 0; l < 4; ++l) p[l] += a[q + l];
+  for (; q < n; ++q) p[0] += a[q];
+  return (p[0] + p[1]) + (p[2] + p[3]);
+}
+
 template <int M>
 inline void values(const detail::TensorGrid& g, const double* c, double* f, double* fs, double* ft, double* scratch) {
   detail::tensor_values_fixed<M>(g, c, f, fs, ft, scratch);
@@ -187,9 +201,7 @@ std::size_t element_energy_m(const ElementKernel& in, const double* xv, double e
                              s.xt, s.ys, s.yt)
         : sample_terms<false>(n, s.J00, s.J01, s.J10, s.J11, in.point_weight, in.weight, eps, theta, power, s.term,
                               nullptr, nullptr, nullptr, nullptr);
-  double sum = 0.0;
-  for (std::size_t q = 0; q < n; ++q) sum += s.term[q];
-  F += sum;
+  F += sum4(s.term, n);
   if (!g) return nonpos;
   // Back through J = [S_s / hx, S_t / hy] to dE/dX_s, dE/dX_t (and dE/dX for
   // a rational element), then to the Bernstein coefficients.
@@ -214,10 +226,13 @@ std::size_t element_energy_m(const ElementKernel& in, const double* xv, double e
   for (long r = 0; r < in.rows; ++r) {
     const int v = in.variable_of[in.functions[r]];
     if (v < 0) continue;
+    // Four partial sums each: one vector chain instead of 16 dependent adds.
     const double* c = in.C + 16 * r;
-    double sx = 0.0, sy = 0.0;
-    for (int i = 0; i < 16; ++i) sx += c[i] * GX[i], sy += c[i] * GY[i];
-    g[v] += sx, g[v + 1] += sy;
+    double sx[4] = {}, sy[4] = {};
+    for (int i = 0; i < 16; i += 4)
+      for (int l = 0; l < 4; ++l) sx[l] += c[i + l] * GX[i + l], sy[l] += c[i + l] * GY[i + l];
+    g[v] += (sx[0] + sx[1]) + (sx[2] + sx[3]);
+    g[v + 1] += (sy[0] + sy[1]) + (sy[2] + sy[3]);
   }
   return nonpos;
 }
