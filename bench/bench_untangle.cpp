@@ -22,6 +22,9 @@
 #include <cstdlib>
 #include <cstring>
 
+#include <Eigen/CholmodSupport>
+#include <Eigen/IterativeLinearSolvers>
+
 #include "bench_front_args.h"
 #include "tspline/io/polygon_reader.h"
 #include "tspline/validity/map_untangling.h"
@@ -86,7 +89,9 @@ int main(int argc, char** argv) {
   if (const char* v = std::getenv("UNTANGLE_LEGENDRE"); v && *v == '1') uopt.energy.lobatto = false;
   if (const char* v = std::getenv("UNTANGLE_THREADS")) uopt.energy.threads = std::atoi(v);
   if (const char* v = std::getenv("UNTANGLE_OPTIMIZER"))
-    uopt.optimizer = std::strcmp(v, "newton") == 0 ? tspline::MapOptimizer::Newton : tspline::MapOptimizer::LBFGS;
+    uopt.optimizer = std::strcmp(v, "newton") == 0  ? tspline::MapOptimizer::Newton
+                     : std::strcmp(v, "ceres") == 0 ? tspline::MapOptimizer::CeresLBFGS
+                                                    : tspline::MapOptimizer::LBFGS;
   if (const char* v = std::getenv("UNTANGLE_NEWTON_ITERATIONS")) uopt.max_newton_iterations_per_stage = std::atoi(v);
   if (const char* v = std::getenv("UNTANGLE_NEWTON_TOL")) uopt.newton_stage_tolerance = std::atof(v);
   if (verbose)
@@ -119,17 +124,70 @@ int main(int argc, char** argv) {
                 cpu_eval * ns, 1e3 * wall_eval, 1e3 * cpu_hess, cpu_hess * ns, 1e3 * wall_hess, sum / passes);
     return 0;
   }
+  if (const char* v = std::getenv("TMP_SOLVER_TEST")) {
+    const tspline::MapEnergy energy(map, uopt.energy);
+    const Eigen::VectorXd x = energy.variables(map);
+    const tspline::SampleStats st = energy.stats(x.data());
+    const double eps = st.nonpositive > 0 ? std::clamp(0.2 * std::abs(st.min_det), 1e-3, 1.0) : std::atof(v);
+    Eigen::VectorXd g(x.size());
+    energy.evaluate(x.data(), eps, g.data());
+    Eigen::SparseMatrix<double> H;
+    energy.hessian(x.data(), eps, H);
+    double c = cpu_seconds();
+    energy.hessian(x.data(), eps, H);
+    std::printf("n %ld nnz(lower) %ld, eps %g, hessian %.1f ms\n", (long)H.rows(), (long)H.nonZeros(), eps, 1e3 * (cpu_seconds() - c));
+    {
+      Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<double>, Eigen::Lower> llt;
+      c = cpu_seconds();
+      llt.analyzePattern(H);
+      const double ta = cpu_seconds() - c;
+      c = cpu_seconds();
+      llt.factorize(H);
+      const double tf = cpu_seconds() - c;
+      Eigen::VectorXd d = llt.solve(-g);
+      std::printf("cholmod supernodal: analyze %.1f ms factorize %.1f ms, info %d, |d| %g\n", 1e3 * ta, 1e3 * tf, (int)llt.info(), d.norm());
+      Eigen::SparseMatrix<double> Hf = H.selfadjointView<Eigen::Lower>();
+      for (int pre = 0; pre < 2; ++pre)
+        for (double tol : {1e-1, 1e-2, 1e-4}) {
+          c = cpu_seconds();
+          Eigen::VectorXd y;
+          int its = 0;
+          double err = 0;
+          if (pre == 0) {
+            Eigen::ConjugateGradient<Eigen::SparseMatrix<double>, Eigen::Lower | Eigen::Upper, Eigen::DiagonalPreconditioner<double>> cg;
+            cg.setTolerance(tol);
+            cg.setMaxIterations(5000);
+            cg.compute(Hf);
+            y = cg.solve(-g);
+            its = cg.iterations(), err = cg.error();
+          } else {
+            Eigen::ConjugateGradient<Eigen::SparseMatrix<double>, Eigen::Lower | Eigen::Upper, Eigen::IncompleteCholesky<double>> cg;
+            cg.setTolerance(tol);
+            cg.setMaxIterations(5000);
+            cg.compute(Hf);
+            y = cg.solve(-g);
+            its = cg.iterations(), err = cg.error();
+          }
+          std::printf("  CG %s tol %g: %d its, err %g, %.1f ms, |y - d|/|d| %.3g, slope ratio %.3f\n", pre ? "IC" : "Jacobi", tol, its, err, 1e3 * (cpu_seconds() - c), (y - d).norm() / d.norm(), g.dot(y) / g.dot(d));
+        }
+    }
+    return 0;
+  }
   t = std::chrono::steady_clock::now();
   const double cpu0 = cpu_seconds();
   const tspline::MapUntanglingReport r = tspline::untangle_map(map, uopt);
   const double t_untangle = since(t);
   const double cpu_untangle = cpu_seconds() - cpu0;
-  std::printf("front %.2f s; before: %zu of %zu samples det<=0, min Jr %.4f\n", t_front, r.before.nonpositive,
-              r.before.points, r.before.min_mean_ratio);
+  std::printf("front %.2f s; before: %zu of %zu samples det<=0, min Jr %.4f; local repairs %d (%d certified), %d iterations, %.2f s\n",
+              t_front, r.before.nonpositive, r.before.points, r.before.min_mean_ratio, r.local_repairs,
+              r.local_repairs_certified, r.local_repair_iterations, r.local_repair_seconds);
   rusage ru{};
   getrusage(RUSAGE_SELF, &ru);
   std::printf("%s: hessians %d (%.2f s), shifted %d, CHOLMOD %.2f s, certified trial steps %d; CPU %.2f s; peak RSS %.0f MiB; mean Jr %.4f\n",
-              uopt.optimizer == tspline::MapOptimizer::Newton ? "newton" : "lbfgs", r.factorizations,
+              uopt.optimizer == tspline::MapOptimizer::Newton ? "newton"
+              : uopt.optimizer == tspline::MapOptimizer::CeresLBFGS ? "ceres"
+                                                                    : "lbfgs",
+              r.factorizations,
               r.hessian_seconds, r.shifted_factorizations, r.solve_seconds, r.line_search_certifications, cpu_untangle, ru.ru_maxrss / 1024.0,
               r.after.mean_mean_ratio);
   std::printf("%9zu %9zu %9zu %9zu %6d %7d %7d %9.3f %9s %13.4g %9.4f  (%s)\n", front.mesh.num_cells(), r.elements,

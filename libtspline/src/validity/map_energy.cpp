@@ -321,6 +321,7 @@ MapEnergy::MapEnergy(const TSplineMap& map, const MapEnergyOptions& opt)
     d.weight = opt.weighting == ElementWeighting::Area ? d.hx * d.hy : 1.0;
     d.active = false;
     for (int a : e.functions) d.active = d.active || variable_of_[a] >= 0;
+    if (d.active) active_.push_back(static_cast<int>(k));
   }
 
   // L^2 = area of the domain = integral of det J over the square (exact up to
@@ -431,7 +432,7 @@ double MapEnergy::evaluate(const double* xv, double eps, double* gradient, std::
   std::vector<std::vector<double>> grads(gradient ? threads - 1 : 0, std::vector<double>(num_variables(), 0.0));
   if (gradient) std::fill(gradient, gradient + num_variables(), 0.0);
   const double theta = options_.theta;
-  detail::parallel_ranges(es.size(), threads, [&](std::size_t b, std::size_t e_end, int slot) {
+  detail::parallel_ranges(active_.size(), threads, [&](std::size_t b, std::size_t e_end, int slot) {
     double* g = gradient ? (slot == 0 ? gradient : grads[slot - 1].data()) : nullptr;
     Samples s(*this);
     const KernelBuffers buffers{s.x.data(),   s.xs.data(),  s.xt.data(),  s.y.data(),    s.ys.data(),
@@ -439,9 +440,9 @@ double MapEnergy::evaluate(const double* xv, double eps, double* gradient, std::
                                 s.J01.data(), s.J10.data(), s.J11.data(), s.term.data(), s.scratch.data()};
     double F = 0.0;
     std::size_t nonpos = 0;
-    for (std::size_t k = b; k < e_end; ++k) {
+    for (std::size_t i = b; i < e_end; ++i) {
+      const std::size_t k = static_cast<std::size_t>(active_[i]);
       const Element& d = elements_[k];
-      if (!d.active) continue;
       const BezierElement& e = es[k];
       const Level& level = levels_[d.level];
       const ElementKernel in{e.C.data(), static_cast<long>(e.C.rows()), e.functions.data(), variable_of_.data(),
@@ -464,15 +465,14 @@ double MapEnergy::evaluate(const double* xv, double eps, double* gradient, std::
 }
 
 SampleStats MapEnergy::stats(const double* xv) const {
-  const auto& es = extraction_.elements();
   SampleStats st;
   st.min_det = std::numeric_limits<double>::infinity();
   st.min_mean_ratio = std::numeric_limits<double>::infinity();
   double wsum = 0.0, jsum = 0.0;
   Samples s(*this);
-  for (std::size_t k = 0; k < es.size(); ++k) {
+  for (const int ka : active_) {
+    const std::size_t k = static_cast<std::size_t>(ka);
     const Element& d = elements_[k];
-    if (!d.active) continue;
     const Level& level = levels_[d.level];
     std::array<double, 16> X, Y;
     element_coefficients(k, xv, X, Y);
@@ -494,17 +494,16 @@ SampleStats MapEnergy::stats(const double* xv) const {
 }
 
 double MapEnergy::max_positive_step(const double* xv, const double* dv, double a_max, double safety) const {
-  const auto& es = extraction_.elements();
   // The direction's own coefficients: element_coefficients is affine, so the
   // coefficients of x + t d are X + t (X(d) - X(0)) with the fixed points in X(0).
   const std::vector<double> zero(num_variables(), 0.0);
   std::vector<double> result(static_cast<std::size_t>(std::max(1, options_.threads)), a_max);
-  detail::parallel_ranges(es.size(), options_.threads, [&](std::size_t b, std::size_t e_end, int slot) {
+  detail::parallel_ranges(active_.size(), options_.threads, [&](std::size_t b, std::size_t e_end, int slot) {
     Samples s(*this), sd(*this);
     double best = a_max;
-    for (std::size_t k = b; k < e_end; ++k) {
+    for (std::size_t i = b; i < e_end; ++i) {
+      const std::size_t k = static_cast<std::size_t>(active_[i]);
       const Element& d = elements_[k];
-      if (!d.active) continue;
       std::array<double, 16> X, Y, DX, DY, X0, Y0;
       element_coefficients(k, xv, X, Y);
       element_coefficients(k, dv, DX, DY);

@@ -263,4 +263,5 @@ void MapEnergy::hessian(const double* xv, double eps, Eigen::SparseMatrix<double
   }
 }
 
+
 }  // namespace tspline

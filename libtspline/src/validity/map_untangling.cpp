@@ -6,6 +6,8 @@
 
 #include <Eigen/CholmodSupport>
 
+#include "tspline/detail/lbfgs.h"
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -181,8 +183,14 @@ MapUntanglingReport untangle_map(TSplineMap& map, const MapUntanglingOptions& op
 
   std::optional<Eigen::VectorXd> best;  // the last certified iterate
   MapCertification best_cert;
+  // A local problem (movable functions) examines only its own elements: the
+  // others do not move, and the caller certified them.
+  std::vector<char> local_elements;
+  if (!opt.energy.movable.empty())
+    for (std::size_t k = 0; k < energy.num_elements(); ++k) local_elements.push_back(energy.element_active(k));
   auto certify = [&](const Eigen::VectorXd& v) {
-    return certify_map(energy.extraction(), num_cells, energy.control_points(v.data()), opt.certification);
+    return certify_map(energy.extraction(), num_cells, energy.control_points(v.data()), opt.certification,
+                       local_elements.empty() ? nullptr : &local_elements);
   };
   // A map without free points is what it is.
   if (rep.free_points == 0) {
@@ -213,8 +221,11 @@ MapUntanglingReport untangle_map(TSplineMap& map, const MapUntanglingOptions& op
   bool x_certified = false;  // x is the last certified iterate (Newton keeps it certified)
   NewtonStage newton(energy);
   newton.set_max_total(opt.max_iterations);
+  detail::Lbfgs lbfgs;
+  double lbfgs_eps = -1.0, lbfgs_power = 0.0;  // of its last stage
   auto certified_valid = [&](const Eigen::VectorXd& v) { return certify(v).certified_valid(); };
   for (int stage = 0; stage < opt.max_stages; ++stage) {
+    const bool new_samples = resampled;
     if (resampled) {
       // Finer samples can show det J <= 0 where the coarser ones had none:
       // leave the barrier (eps above the floor) but keep the regularization
@@ -232,6 +243,21 @@ MapUntanglingReport untangle_map(TSplineMap& map, const MapUntanglingOptions& op
     if (opt.optimizer == MapOptimizer::Newton) {
       newton.run(x, eps, power, opt.max_newton_iterations_per_stage, opt.newton_stage_tolerance, barrier, x_certified,
                  certified_valid, rep);
+    } else if (opt.optimizer == MapOptimizer::LBFGS) {
+      // The curvature pairs carry over from the last stage unless the energy
+      // changed more than by a lower eps: new samples, another power, eps raised.
+      if (new_samples || power != lbfgs_power || eps > lbfgs_eps) lbfgs.reset();
+      lbfgs_eps = eps, lbfgs_power = power;
+      const auto f = [&](const double* v, double* g) {
+        std::size_t nonpositive = 0;
+        const double e = energy.evaluate(v, eps, g, &nonpositive, power);
+        return barrier && nonpositive > 0 ? std::numeric_limits<double>::infinity() : e;
+      };
+      const detail::Lbfgs::Result r =
+          lbfgs.run(x, f, std::min(opt.max_iterations_per_stage, opt.max_iterations - rep.iterations));
+      rep.iterations += r.iterations;
+      rep.evaluations += r.evaluations;
+      x_certified = false;
     } else {
       so.max_num_iterations = std::min(opt.max_iterations_per_stage, opt.max_iterations - rep.iterations);
       ceres::GradientProblem problem(new EnergyFunction(energy, eps, barrier, power, &rep.evaluations));
@@ -269,16 +295,23 @@ MapUntanglingReport untangle_map(TSplineMap& map, const MapUntanglingOptions& op
           TSplineMap local = map;
           local.set_control_points(energy.control_points(x.data()));
           const MapUntanglingReport lr = untangle_map(local, local_repair_options(map, energy, cert, opt));
+          rep.local_repair_iterations += lr.iterations;
+          rep.local_repair_seconds += lr.seconds;
           rep.iterations += lr.iterations;
           rep.evaluations += lr.evaluations;
           if (lr.certified) {
-            ++rep.local_repairs_certified;
-            x = energy.variables(local);
-            certified_now = true;
-            x_certified = true;
-            best = x;
-            best_cert = lr.certification;
-            resampled = false;  // the finer samples of the failing elements stay; they are positive now
+            // The local problem certified its own elements; the whole map once more.
+            const Eigen::VectorXd xl = energy.variables(local);
+            MapCertification whole = certify(xl);
+            if (whole.certified_valid()) {
+              ++rep.local_repairs_certified;
+              x = xl;
+              certified_now = true;
+              x_certified = true;
+              best = x;
+              best_cert = std::move(whole);
+              resampled = false;  // the finer samples of the failing elements stay; they are positive now
+            }
           }
         }
       }

@@ -115,6 +115,8 @@ class MapEnergy {
   /// Indices (into the basis) of the functions whose control points are free.
   const std::vector<int>& free_functions() const { return free_functions_; }
   std::size_t num_elements() const { return elements_.size(); }
+  /// Does element k touch a free control point (else the energy leaves it out)?
+  bool element_active(std::size_t k) const { return elements_[k].active; }
   const BezierExtraction& extraction() const { return extraction_; }
   double length_scale() const { return L_; }
 
@@ -199,6 +201,7 @@ class MapEnergy {
   MapEnergyOptions options_;
   BezierExtraction extraction_;
   std::vector<Element> elements_;
+  std::vector<int> active_;  // the elements that touch a variable, in order
   std::vector<Level> levels_;
   std::vector<int> variable_of_;             // per function: index of its x coordinate, or -1
   std::vector<int> free_functions_;

@@ -49,7 +49,8 @@ namespace tspline {
 /// The minimizer of each eps stage.
 enum class MapOptimizer {
   Newton,  ///< projected Newton, CHOLMOD: fewer iterations, but each costs a sparse Cholesky
-  LBFGS    ///< Ceres' L-BFGS (the default: faster on every benchmark here, bench/README.md)
+  LBFGS,   ///< L-BFGS, curvature pairs kept across the stages (detail/lbfgs.h)
+  CeresLBFGS  ///< Ceres' L-BFGS, restarted every stage (the method before issue 23)
 };
 
 struct UntanglingProgress {
@@ -118,6 +119,8 @@ struct MapUntanglingReport {
   int sample_refinements = 0;  ///< elements whose sample level was raised
   int local_repairs = 0;        ///< local problems solved for hidden folds (see local_repair)
   int local_repairs_certified = 0;  ///< of which certified the map
+  int local_repair_iterations = 0;  ///< optimizer iterations inside the local repairs (also in iterations)
+  double local_repair_seconds = 0.0;  ///< time in the local repairs (also in seconds)
   SampleStats before, after;   ///< at the initial samples / at the final samples, of the returned map
   bool certified = false;
   MapCertification certification;  ///< of the returned map
