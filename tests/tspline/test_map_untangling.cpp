@@ -86,6 +86,48 @@ TEST_SUITE("map_untangling") {
         }
   }
 
+  TEST_CASE("the energy (sum factorization) equals the direct sum over 5 x 5 Lobatto points of the map's Jacobian") {
+    // A folded map with T-junctions: some elements are rational (their
+    // functions do not sum to 1), where the chain rule goes through w.
+    const TSplineMap map = perturbed_map(3, 0.12);
+    const MapEnergy energy(map);
+    const tspline::BezierExtraction& ex = energy.extraction();
+    std::size_t rational = 0;
+    for (const tspline::BezierElement& e : ex.elements())
+      rational += (e.C.colwise().sum().array() - 1.0).abs().maxCoeff() > 1e-12 ? 1 : 0;
+    REQUIRE(rational > 0);
+    const double a = 0.5 * std::sqrt(3.0 / 7.0);
+    const double pt[5] = {0.0, 0.5 - a, 0.5, 0.5 + a, 1.0};
+    const double wt[5] = {1.0 / 20, 49.0 / 180, 16.0 / 45, 49.0 / 180, 1.0 / 20};
+    const double theta = tspline::MapEnergyOptions{}.theta, L = energy.length_scale();
+    const Eigen::VectorXd x = energy.variables(map);
+    for (double eps : {0.3, 0.01})
+      for (double power : {1.0, 4.0}) {
+        double direct = 0.0;
+        std::size_t folded = 0;
+        for (std::size_t k = 0; k < ex.elements().size(); ++k) {
+          if (!energy.element_active(k)) continue;
+          const tspline::BezierElement& e = ex.elements()[k];
+          for (int r = 0; r < 5; ++r)
+            for (int p = 0; p < 5; ++p) {
+              const Eigen::Vector2d uv(e.lo.x() + pt[p] * (e.hi.x() - e.lo.x()), e.lo.y() + pt[r] * (e.hi.y() - e.lo.y()));
+              const Eigen::Matrix2d J = map.jacobian(uv) / L;
+              const double D = J.determinant();
+              folded += D > 0.0 ? 0 : 1;
+              const double t = ((1.0 - theta) * J.squaredNorm() + theta * (D * D + 1.0)) / tspline::regularized_det(D, eps);
+              direct += wt[p] * wt[r] * std::pow(t, power);
+            }
+        }
+        std::size_t nonpositive = 0;
+        const double E = energy.evaluate(x.data(), eps, nullptr, &nonpositive, power);
+        CAPTURE(eps);
+        CAPTURE(power);
+        CHECK(folded > 0);
+        CHECK(nonpositive == folded);
+        CHECK(E == doctest::Approx(direct).epsilon(1e-10));
+      }
+  }
+
   TEST_CASE("the energy of the scaled identity is the ideal 2 per unit weight, and the variables round-trip") {
     // Without T-junctions the Greville map is exactly the identity.
     const TSplineMap map = perturbed_map(5, 0.0, false);

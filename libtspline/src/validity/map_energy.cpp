@@ -1,6 +1,7 @@
 // The regularized distortion energy of a T-spline map; see map_energy.h.
 #include "tspline/validity/map_energy.h"
 #include "tspline/detail/quadrature.h"
+#include "tspline/detail/simd_clones.h"
 #include "tspline/detail/thread_pool.h"
 
 #include <algorithm>
@@ -107,21 +108,7 @@ std::size_t sample_terms(std::size_t n, const double* J00, const double* J01, co
                                           G00, G01, G10, G11);
 }
 
-// The energy kernel is compiled twice, for x86-64-v3 (AVX2, FMA) and for the
-// baseline, and the loader picks the one the processor runs (GCC/Clang
-// function multiversioning); not under the sanitizers.
-#if defined(__x86_64__) && defined(__GNUC__) && !defined(__SANITIZE_ADDRESS__) && !defined(__SANITIZE_THREAD__)
-#if defined(__has_feature)
-#if !__has_feature(address_sanitizer) && !__has_feature(memory_sanitizer) && !__has_feature(thread_sanitizer)
-#define TSPLINE_SIMD_CLONES __attribute__((target_clones("arch=x86-64-v3", "default"), flatten))
-#endif
-#else
-#define TSPLINE_SIMD_CLONES __attribute__((target_clones("arch=x86-64-v3", "default"), flatten))
-#endif
-#endif
-#ifndef TSPLINE_SIMD_CLONES
-#define TSPLINE_SIMD_CLONES __attribute__((flatten))
-#endif
+// The energy kernel is compiled for AVX2 and the baseline (simd_clones.h).
 
 // What element_energy needs of one element, and its buffers (n samples each).
 struct ElementKernel {

@@ -187,6 +187,7 @@ class MapEnergy {
     std::vector<std::size_t> slot_offset;   // per element: start of its n x n slots
     std::vector<int> slots;                 // (r, c): position of node(r) in node column node(c), -1 if above
     std::vector<std::vector<int>> colors;   // elements in groups sharing no free function
+    std::size_t max_rows = 0;               // functions per element at most
     bool built = false;
   };
   void build_hessian_pattern() const;
