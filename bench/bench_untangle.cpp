@@ -12,6 +12,10 @@
 // is frozen, all corner trials), instead of the fit of the front half alone.
 // UNTANGLE_OPTIMIZER=newton|lbfgs selects the optimizer (default: the library's, L-BFGS).
 // UNTANGLE_THREADS=N: threads of the energy (default: all cores).
+// UNTANGLE_NEWTON_SOLVER=cholesky|cg|auto, UNTANGLE_NEWTON_MIN_DECREASE=S: Newton's linear solve and eps rule.
+// UNTANGLE_SOLVE_TEST=EPS: the projected Hessian at the starting map (eps 0.2 |min det J| if folded,
+// else EPS) solved by CHOLMOD and by CG with diagonal and incomplete-Cholesky preconditioners
+// to relative residuals 1e-1, 1e-2, 1e-4 (time, iterations, distance to the exact step), and exits.
 // UNTANGLE_KERNEL_PASSES=N first times N energy-and-gradient passes and N Hessian
 // assemblies at the starting map (eps 0.01), CPU time per sample, and exits.
 #include <sys/resource.h>
@@ -87,6 +91,11 @@ int main(int argc, char** argv) {
   if (const char* v = std::getenv("UNTANGLE_MIN_DECREASE")) uopt.min_decrease = std::atof(v);
   if (const char* v = std::getenv("UNTANGLE_GAUSS")) uopt.energy.gauss = std::atoi(v);
   if (const char* v = std::getenv("UNTANGLE_LEGENDRE"); v && *v == '1') uopt.energy.lobatto = false;
+  if (const char* v = std::getenv("UNTANGLE_NEWTON_SOLVER"))
+    uopt.newton_solver = std::strcmp(v, "cg") == 0         ? tspline::NewtonSolver::ConjugateGradient
+                         : std::strcmp(v, "cholesky") == 0 ? tspline::NewtonSolver::Cholesky
+                                                           : tspline::NewtonSolver::Auto;
+  if (const char* v = std::getenv("UNTANGLE_NEWTON_MIN_DECREASE")) uopt.newton_min_decrease = std::atof(v);
   if (const char* v = std::getenv("UNTANGLE_THREADS")) uopt.energy.threads = std::atoi(v);
   if (const char* v = std::getenv("UNTANGLE_OPTIMIZER"))
     uopt.optimizer = std::strcmp(v, "newton") == 0  ? tspline::MapOptimizer::Newton
@@ -124,7 +133,7 @@ int main(int argc, char** argv) {
                 cpu_eval * ns, 1e3 * wall_eval, 1e3 * cpu_hess, cpu_hess * ns, 1e3 * wall_hess, sum / passes);
     return 0;
   }
-  if (const char* v = std::getenv("TMP_SOLVER_TEST")) {
+  if (const char* v = std::getenv("UNTANGLE_SOLVE_TEST")) {
     const tspline::MapEnergy energy(map, uopt.energy);
     const Eigen::VectorXd x = energy.variables(map);
     const tspline::SampleStats st = energy.stats(x.data());
@@ -183,12 +192,12 @@ int main(int argc, char** argv) {
               r.local_repairs_certified, r.local_repair_iterations, r.local_repair_seconds);
   rusage ru{};
   getrusage(RUSAGE_SELF, &ru);
-  std::printf("%s: hessians %d (%.2f s), shifted %d, CHOLMOD %.2f s, certified trial steps %d; CPU %.2f s; peak RSS %.0f MiB; mean Jr %.4f\n",
+  std::printf("%s: hessians %d (%.2f s), shifted %d, solves %.2f s (CG iterations %d), certified trial steps %d; CPU %.2f s; peak RSS %.0f MiB; mean Jr %.4f\n",
               uopt.optimizer == tspline::MapOptimizer::Newton ? "newton"
               : uopt.optimizer == tspline::MapOptimizer::CeresLBFGS ? "ceres"
                                                                     : "lbfgs",
               r.factorizations,
-              r.hessian_seconds, r.shifted_factorizations, r.solve_seconds, r.line_search_certifications, cpu_untangle, ru.ru_maxrss / 1024.0,
+              r.hessian_seconds, r.shifted_factorizations, r.solve_seconds, r.cg_iterations, r.line_search_certifications, cpu_untangle, ru.ru_maxrss / 1024.0,
               r.after.mean_mean_ratio);
   std::printf("%9zu %9zu %9zu %9zu %6d %7d %7d %9.3f %9s %13.4g %9.4f  (%s)\n", front.mesh.num_cells(), r.elements,
               r.free_points, r.samples, r.stages, r.iterations, r.evaluations, t_untangle,
