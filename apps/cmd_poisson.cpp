@@ -1,7 +1,8 @@
 // `tspline poisson`: solve -Laplace(u) = f, u = g on the boundary, with T-spline
-// isogeometric analysis on the domain of a T-spline file, and refine adaptively
-// or uniformly (libtspline/include/tspline/analysis/poisson.h). Writes convergence.csv, convergence.png,
-// report.json and solution.pvd + solution/step_NNN.vtu into OUTDIR.
+// isogeometric analysis on the domain of a T-spline file of one or more
+// patches, and refine adaptively or uniformly (tspline/analysis/poisson.h: one
+// path for every map). Writes convergence.csv, convergence.png, report.json and
+// solution.pvd + solution/step_NNN.vtu into OUTDIR. This file parses and prints.
 // Under `mpirun -n P` every process runs the same loop; the interior system is
 // assembled and solved by all of them (PETSc module, tspline/petsc_solver.h) when
 // the iterative solver is chosen, and only rank 0 prints and writes files.
@@ -16,10 +17,8 @@
 #include <cstring>
 #include <filesystem>
 #include <iostream>
-#include <limits>
 #include <memory>
 #include <nlohmann/json.hpp>
-#include <numbers>
 #include <numeric>
 #include <optional>
 #include <sstream>
@@ -36,7 +35,6 @@
 #include "tspline/io/poisson_output.h"
 #include "tspline/io/multipatch_file.h"
 #include "tspline/io/tspline_file.h"
-#include "poisson_multipatch.h"
 #include "toolkit/io/vtu_writer.h"
 #include "petsc_session.h"
 #include "tspline/petsc_solver.h"
@@ -99,70 +97,6 @@ struct ProblemSetup {
   json description;
 };
 
-constexpr double kPi = std::numbers::pi;
-
-ProblemSetup sinsin_problem() {
-  ProblemSetup s;
-  s.problem.exact = [](double x, double y) { return std::sin(kPi * x) * std::sin(kPi * y); };
-  s.problem.exact_gradient = [](double x, double y) {
-    return Eigen::Vector2d(kPi * std::cos(kPi * x) * std::sin(kPi * y),
-                           kPi * std::sin(kPi * x) * std::cos(kPi * y));
-  };
-  s.problem.f = [](double x, double y) { return 2 * kPi * kPi * std::sin(kPi * x) * std::sin(kPi * y); };
-  s.problem.g = s.problem.exact;
-  s.description = {{"u", "sin(pi x) sin(pi y)"}, {"f", "2 pi^2 sin(pi x) sin(pi y)"}, {"g", "u"}};
-  return s;
-}
-
-ProblemSetup polynomial_problem() {
-  ProblemSetup s;
-  s.problem.exact = [](double x, double y) { return x * x * x + x * x * y - 2 * y * y * y + x * y; };
-  s.problem.exact_gradient = [](double x, double y) {
-    return Eigen::Vector2d(3 * x * x + 2 * x * y + y, x * x - 6 * y * y + x);
-  };
-  s.problem.f = [](double x, double y) { return -6 * x + 10 * y; };
-  s.problem.g = s.problem.exact;
-  s.description = {{"u", "x^3 + x^2 y - 2 y^3 + x y"}, {"f", "-6 x + 10 y"}, {"g", "u"}};
-  return s;
-}
-
-/// Gaussian peak centred on the bounding box of the control points, width 0.1 x its diagonal.
-ProblemSetup gaussian_problem(const tspline::TSplineMap& map) {
-  Eigen::Vector2d lo = Eigen::Vector2d::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
-  for (const Eigen::Vector2d& p : map.control_points()) {
-    lo = lo.cwiseMin(p);
-    hi = hi.cwiseMax(p);
-  }
-  const double x0 = 0.5 * (lo.x() + hi.x()), y0 = 0.5 * (lo.y() + hi.y());
-  const double s = 0.1 * (hi - lo).norm();
-  if (!(s > 0.0) || !std::isfinite(s))
-    throw tspline::InputError("--problem gaussian: the control points span no area (bounding box diagonal " +
-                              fmt((hi - lo).norm()) + ")");
-  const double s2 = s * s;
-  ProblemSetup p;
-  p.problem.exact = [=](double x, double y) {
-    return std::exp(-((x - x0) * (x - x0) + (y - y0) * (y - y0)) / s2);
-  };
-  p.problem.exact_gradient = [=](double x, double y) {
-    const double u = std::exp(-((x - x0) * (x - x0) + (y - y0) * (y - y0)) / s2);
-    return Eigen::Vector2d(-2 * (x - x0) / s2 * u, -2 * (y - y0) / s2 * u);
-  };
-  p.problem.f = [=](double x, double y) {
-    const double r2 = (x - x0) * (x - x0) + (y - y0) * (y - y0);
-    return std::exp(-r2 / s2) * (4 / s2 - 4 * r2 / (s2 * s2));
-  };
-  p.problem.g = p.problem.exact;
-  p.description = {
-      {"u", "exp(-((x - x0)^2 + (y - y0)^2) / s^2)"},
-      {"f", "u (4 / s^2 - 4 ((x - x0)^2 + (y - y0)^2) / s^4)"},
-      {"g", "u"},
-      {"x0", x0},
-      {"y0", y0},
-      {"s", s},
-      {"choice", "(x0, y0) = centre of the bounding box of the control points, s = 0.1 x its diagonal"}};
-  return p;
-}
-
 /// A field given on the command line, checked: a non-finite value is an input
 /// error naming the option (the core checks f and g too, without the option name).
 tspline::ScalarField checked_field(const std::string& option, tspline::ScalarField u) {
@@ -176,19 +110,16 @@ tspline::ScalarField checked_field(const std::string& option, tspline::ScalarFie
 }
 
 /// Parses the expressions or picks the built-in problem. Throws InputError.
-ProblemSetup make_problem(const PoissonArgs& a, const tspline::TSplineMap& map) {
+ProblemSetup make_problem(const PoissonArgs& a, const tspline::AnalysisGeometry& geometry) {
   ProblemSetup s;
   const std::string gradient_note =
       "exact gradient by central differences, step " + fmt(tspline::kGradientStep);
   if (!a.problem.empty()) {
-    if (a.problem == "sinsin")
-      s = sinsin_problem();
-    else if (a.problem == "polynomial")
-      s = polynomial_problem();
-    else
-      s = gaussian_problem(map);
-    s.description["name"] = a.problem;
-    s.description["exact_gradient"] = "analytic";
+    const tspline::ManufacturedProblem m = tspline::manufactured_problem(a.problem, geometry);
+    s.problem = m.problem;
+    s.description = {{"name", m.name}, {"u", m.u}, {"f", m.f}, {"g", m.g}, {"choice", m.choice},
+                     {"exact_gradient", "analytic"}};
+    for (const auto& [name, value] : m.constants) s.description[name] = value;
     return s;
   }
   s.problem.f = checked_field("--f", make_field("--f", a.f));
@@ -270,15 +201,16 @@ int run_poisson_process(const PoissonArgs& args, const PetscSession& session,
                         std::chrono::steady_clock::time_point t_start) {
   const bool root = session.rank() == 0;
   const tspline::io::LoadedMaps maps = tspline::io::read_maps_file(args.file);
-  if (maps.version == 2) {  // multi-patch map: C0 coupling across the interfaces (poisson_multipatch.h)
-    const ProblemSetup mp = make_problem(args, maps.patches.front().map);
-    return root ? tspline_app::run_multipatch_poisson(
-                      maps, {args.refine, args.steps, args.gamma, args.max_dofs, args.out_dir, args.quiet || args.json, args.samples},
-                      mp.problem, mp.description)
-                : 0;
+  tspline::AnalysisGeometry geometry;
+  geometry.interfaces = maps.interfaces;
+  std::size_t cells = 0, functions = 0, hanging = 0;
+  for (const tspline::io::LoadedTSpline& t : maps.patches) {
+    geometry.patches.push_back(&t.map);
+    cells += t.map.mesh().num_cells();
+    functions += t.map.basis().size();
+    hanging += t.map.mesh().num_hanging_vertices();
   }
-  const tspline::io::LoadedTSpline& t = maps.patches.front();
-  const ProblemSetup setup = make_problem(args, t.map);
+  const ProblemSetup setup = make_problem(args, geometry);
 
   tspline::AdaptiveSolveOptions opt;
   opt.refine = args.refine == "uniform" ? tspline::AdaptiveSolveOptions::Refine::Uniform
@@ -306,17 +238,22 @@ int run_poisson_process(const PoissonArgs& args, const PetscSession& session,
         {"direct_below", args.direct_below},
         {"processes", session.size()}}},
       {"geometry",
-       {{"cells", t.map.mesh().num_cells()},
-        {"functions", t.map.basis().size()},
-        {"hanging_vertices", t.map.mesh().num_hanging_vertices()}}},
-      {"analysis_space", "cubic hierarchical B-splines of the analysis T-mesh"},
-      {"dirichlet", "L2 projection of g onto the boundary functions' traces on the parameter square's border"},
+       {{"patches", maps.patches.size()},
+        {"interfaces", maps.interfaces.size()},
+        {"cells", cells},
+        {"functions", functions},
+        {"hanging_vertices", hanging}}},
+      {"analysis_space",
+       "cubic hierarchical B-splines of the analysis T-mesh of every patch, glued C0 across the interfaces (one "
+       "unknown per glued pair)"},
+      {"dirichlet", "L2 projection of g onto the traces of the Dirichlet functions on the domain's boundary "
+                    "(physical arc length)"},
       {"quadrature", {{"assembly", "4x4 Gauss"}, {"errors", "6x6 Gauss"}, {"estimator", "4x4 Gauss"}}}};
   Progress progress(root ? output_mode(args.quiet, args.json) : OutputMode::Quiet);
-  tspline::io::PoissonOutputWriter output(args.out_dir, args.samples, t.map, setup.problem, std::move(report));
+  tspline::io::PoissonOutputWriter output(args.out_dir, args.samples, setup.problem, std::move(report));
   tspline::AdaptiveSolveResult run;
   try {
-    run = tspline::solve_adaptive(t.map, setup.problem, opt,
+    run = tspline::solve_adaptive(geometry, setup.problem, opt,
                                     [&](const tspline::PoissonStep& st, const tspline::PoissonSolution& sol,
                                         const std::vector<double>& eta) {
                                       const std::vector<double> peak = tspline::petsc::peak_memory_mib();
@@ -392,18 +329,19 @@ void add_poisson_command(CLI::App& app, CommandAction& action) {
   auto a = std::make_shared<PoissonArgs>();
   CLI::App* cmd = app.add_subcommand(
       "poisson",
-      "Solve -Laplace(u) = f in the domain of a T-spline file, u = g on its boundary, with isogeometric "
-      "analysis (cubic hierarchical B-splines of an analysis T-mesh that starts as the geometry's and is refined; "
-      "the geometry map stays fixed), and refine adaptively (residual estimator eta_e^2 = int h^2 (f + Laplace "
-      "u_h)^2, cells with eta_e > gamma max eta split with their neighbours) or uniformly. Dirichlet data by L2 "
-      "projection on the boundary "
-      "functions. Prints one table row per step and writes OUTDIR/convergence.csv, OUTDIR/convergence.png, OUTDIR/report.json and "
-      "OUTDIR/solution.pvd with OUTDIR/solution/step_NNN.vtu (point data u_h, u_exact, error = u_h - "
-      "u_exact; cell "
-      "data eta, level, cell). Built-in problems (f = -Laplace(u) analytic, g = u, exact gradient analytic): "
-      "sinsin u = sin(pi x) sin(pi y); polynomial u = x^3 + x^2 y - 2 y^3 + x y (in the discrete space when "
-      "the map is affine); gaussian u = exp(-((x-x0)^2 + (y-y0)^2)/s^2) with "
-      "(x0, y0) the centre of the bounding box of the control points and s = 0.1 x its diagonal");
+      "Solve -Laplace(u) = f in the domain of a T-spline file (one patch or a multi-patch map), u = g on its "
+      "boundary, with isogeometric analysis (cubic hierarchical B-splines of an analysis T-mesh per patch that "
+      "starts as the geometry's and is refined, glued C0 across the interfaces; the geometry map stays fixed), and "
+      "refine adaptively (residual estimator eta_e^2 = int h^2 (f + Laplace u_h)^2, cells with eta_e > gamma max "
+      "eta over all patches split with their neighbours, refinement carried across the interfaces) or uniformly. "
+      "Dirichlet data by L2 projection on the boundary functions. Prints one table row per step and writes "
+      "OUTDIR/convergence.csv, OUTDIR/convergence.png, OUTDIR/report.json and OUTDIR/solution.pvd with "
+      "OUTDIR/solution/step_NNN.vtu (every patch; point data u_h, u_exact, error = u_h - u_exact; cell data eta, "
+      "level, cell, patch). Built-in problems (f = -Laplace(u) analytic, g = u, exact gradient analytic), in "
+      "X = (x - x_lo) / L, Y = (y - y_lo) / L with (x_lo, y_lo) the lower-left corner of the bounding box of the "
+      "control points of every patch and L its longer side: sinsin u = sin(pi X) sin(pi Y); polynomial u = X^3 + "
+      "X^2 Y - 2 Y^3 + X Y (in the discrete space when the map is affine); gaussian u = exp(-((x-x0)^2 + "
+      "(y-y0)^2)/s^2) with (x0, y0) the centre of that box and s = 0.1 x its diagonal");
   cmd->add_option("TSPLINE", a->file, "T-spline file (tspline.json written by `tspline param`)")
       ->type_name("FILE")
       ->required();
@@ -424,7 +362,7 @@ void add_poisson_command(CLI::App& app, CommandAction& action) {
           ->type_name("EXPR");
   a->problem_opt = cmd->add_option("--problem", a->problem,
                                    "Built-in manufactured problem instead of --f/--g/--exact (see above)")
-                       ->check(CLI::IsMember({"gaussian", "sinsin", "polynomial"}));
+                       ->check(CLI::IsMember(tspline::manufactured_problem_names()));
   cmd->add_option("--refine", a->refine,
                   "adaptive: split the cells with eta_e > gamma max eta; uniform: split every cell")
       ->check(CLI::IsMember({"adaptive", "uniform"}))

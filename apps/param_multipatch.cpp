@@ -29,6 +29,10 @@ int write_multipatch_param(const tspline::DomainParameterization& P, const tspli
                                 {"repair_rounds", s.repair_rounds},
                                 {"pillowed_rings", s.pillowed_rings},
                                 {"optimization_level", s.optimization_level},
+                                {"rotations", s.rotations},
+                                {"optimization_sweeps", s.optimization_sweeps},
+                                {"corner_mean_ratio", s.corner_mean_ratio},
+                                {"corner_scaled_jacobian", s.corner_scaled_jacobian},
                                 {"min_size", s.min_size},
                                 {"max_size", s.max_size},
                                 {"seconds", s.seconds}};

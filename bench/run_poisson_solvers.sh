@@ -37,4 +37,15 @@ for s in json.load(open('$T/$solver/report.json'))['steps']:
     '$solver', s['dofs'], s['assembly_seconds'], s['solve_seconds'], s['solver']['iterations'], s['solver']['rtol'],
     s['solver']['relative_residual'], s['l2'], s['h1'], s['peak_memory_mib']['total']))"
 done
+echo "multi-patch maps (bench_poisson MAP.json R): the framed square cut along its diagonals (4 patches) at"
+echo "1.06e6 DOFs and the disk's quad layout (44 patches) at 7.3e5, 1 and 2 ranks"
+printf "0 0\n10 0\n10 10\n0 10\n\n3 3\n7 3\n7 7\n3 7\n" > "$T/framed.txt"
+printf "3 3\n0 0\n\n7 3\n10 0\n\n7 7\n10 10\n\n3 7\n0 10\n" > "$T/framed_cuts.txt"
+./build/apps/tspline param "$T/framed.txt" --cuts "$T/framed_cuts.txt" --out "$T/framed" -q
+./build/apps/tspline param tests/data/polygons/disk.txt --out "$T/disk_layout" -q
+for map in "framed 6" "disk_layout 4"; do
+  set -- $map
+  /usr/bin/time -f "whole process: %e s wall, %U s user, %M KB" $B "$T/$1/tspline.json" "$2" iterative
+  $MPIRUN 2 $B "$T/$1/tspline.json" "$2" iterative
+done
 rm -rf "$T"

@@ -18,6 +18,7 @@
 #include "tspline/pipeline/adaptive_parameterization.h"
 #include "tspline/errors.h"
 #include "tspline/io/gis_reader.h"
+#include "tspline/io/multipatch_file.h"
 #include "tspline/io/param_output.h"
 #include "tspline/io/tspline_file.h"
 #include "tspline/validity/map_certification.h"
@@ -166,8 +167,31 @@ tspline::ScalarField field(const char* name, const py::object& f) {
   return [fn](double x, double y) { return fn(x, y).cast<double>(); };
 }
 
+/// The maps a solve runs on: a Map, or every patch of a T-spline file (version 1 or 2).
+struct SolveGeometry {
+  std::shared_ptr<Map> map;
+  std::shared_ptr<tspline::io::LoadedMaps> file;
+  tspline::AnalysisGeometry geometry;
+};
+
+SolveGeometry solve_geometry(const py::object& m) {
+  SolveGeometry g;
+  if (py::isinstance<Map>(m)) {
+    g.map = m.cast<std::shared_ptr<Map>>();
+    g.geometry = tspline::AnalysisGeometry(g.map->map);
+    return g;
+  }
+  if (!py::isinstance<py::str>(m) && !py::hasattr(m, "__fspath__"))
+    throw py::type_error("poisson: map must be a tspline.Map or the path of a T-spline file");
+  const std::string path = py::str(py::module_::import("os").attr("fspath")(m)).cast<std::string>();
+  g.file = std::make_shared<tspline::io::LoadedMaps>(tspline::io::read_maps_file(path));
+  for (const auto& t : g.file->patches) g.geometry.patches.push_back(&t.map);
+  g.geometry.interfaces = g.file->interfaces;
+  return g;
+}
+
 struct Solution {
-  std::shared_ptr<Map> geometry;
+  SolveGeometry geometry;  // keeps the maps alive
   tspline::PoissonSolution solution;
   py::list steps;
 };
@@ -182,7 +206,7 @@ py::dict step_dict(const tspline::PoissonStep& s) {
   return d;
 }
 
-Solution poisson(std::shared_ptr<Map> m, const py::object& f, const py::object& g, const py::object& exact,
+Solution poisson(const py::object& m, const py::object& f, const py::object& g, const py::object& exact,
                  int steps, const std::string& refine, double gamma, std::size_t max_dofs) {
   tspline::PoissonProblem problem;
   problem.f = field("f", f);
@@ -196,9 +220,9 @@ Solution poisson(std::shared_ptr<Map> m, const py::object& f, const py::object& 
     throw tspline::InputError("refine: expected 'adaptive' or 'uniform', got '" + refine + "'");
   opt.steps = steps, opt.gamma = gamma, opt.max_dofs = max_dofs;
   Solution out;
-  out.geometry = m;
+  out.geometry = solve_geometry(m);
   const std::vector<tspline::PoissonStep> records = tspline::solve_adaptive(
-      m->map, problem, opt,
+      out.geometry.geometry, problem, opt,
       [&](const tspline::PoissonStep&, const tspline::PoissonSolution& sol, const std::vector<double>&) {
         out.solution = sol;
       }).steps;
@@ -206,17 +230,16 @@ Solution poisson(std::shared_ptr<Map> m, const py::object& f, const py::object& 
   return out;
 }
 
-py::array_t<double> evaluate_solution(const Solution& s, const Array& uv) {
+py::array_t<double> evaluate_solution(const Solution& s, const Array& uv, std::size_t patch) {
   const std::size_t n = rows_of(uv, "uv");
   py::array_t<double> out(static_cast<py::ssize_t>(n));
   const double* in = uv.data();
   double* o = out.mutable_data();
   if (!s.solution.space) throw tspline::NumericalError("the Poisson solve made no step");
-  const auto& basis = s.solution.space->basis();
-  for (std::size_t i = 0; i < n; ++i) {
-    const Eigen::Vector2d p = checked_uv(in + 2 * i);
-    o[i] = tspline::evaluate_solution(s.geometry->map, s.solution, basis.locate(p), p, 0).u;
-  }
+  if (patch >= s.solution.space->num_patches())
+    throw tspline::InputError("patch " + std::to_string(patch) + " out of range (the map has " +
+                              std::to_string(s.solution.space->num_patches()) + " patches)");
+  for (std::size_t i = 0; i < n; ++i) o[i] = tspline::evaluate_solution(s.solution, patch, checked_uv(in + 2 * i)).u;
   return out;
 }
 
@@ -253,7 +276,9 @@ PYBIND11_MODULE(tspline, m) {
   py::class_<Solution>(m, "Solution", "The last step of an adaptive Poisson solve")
       .def_readonly("steps", &Solution::steps, "one dict per solve (dofs, cells, eta, l2, h1, solver, ...)")
       .def_property_readonly("dofs", [](const Solution& s) { return s.solution.space->num_dofs(); })
-      .def("evaluate", &evaluate_solution, py::arg("uv"), "u_h(S(uv)) for uv of shape (n, 2): array (n,)");
+      .def_property_readonly("patches", [](const Solution& s) { return s.solution.space->num_patches(); })
+      .def("evaluate", &evaluate_solution, py::arg("uv"), py::arg("patch") = 0,
+           "u_h(S_patch(uv)) for uv of shape (n, 2) in the parameter square of patch `patch`: array (n,)");
 
   m.def("parameterize", &parameterize, py::arg("domain"),
         "parameterize(domain, **options) -> Map. domain: an (n, 2) array of polygon vertices, or a file path (text "
@@ -263,6 +288,7 @@ PYBIND11_MODULE(tspline, m) {
   m.def("load", &load, py::arg("path"), "Reads a T-spline file; certified_valid is recomputed");
   m.def("poisson", &poisson, py::arg("map"), py::arg("f"), py::arg("g"), py::arg("exact") = py::none(),
         py::arg("steps") = 5, py::arg("refine") = "adaptive", py::arg("gamma") = 0.5, py::arg("max_dofs") = 200000,
-        "Adaptive IGA solve of -Laplace u = f, u = g on the boundary. f, g, exact: expressions in x, y (as "
-        "tspline poisson --f) or callables f(x, y).");
+        "Adaptive IGA solve of -Laplace u = f, u = g on the boundary. map: a Map, or the path of a T-spline file "
+        "of one or more patches (tspline.json of `tspline param`; C0 across the interfaces). f, g, exact: "
+        "expressions in x, y (as tspline poisson --f) or callables f(x, y).");
 }

@@ -1,5 +1,7 @@
-// IGA Poisson on the multi-patch map of the plate with a hole: C0 coupling
-// across the cuts, optimal rates on uniform refinement.
+// IGA Poisson on the multi-patch map of the plate with a hole, through the
+// same solver as a single map (poisson.h): C0 coupling across the cuts,
+// optimal rates on uniform refinement, adaptive refinement carried across
+// the cuts.
 #include <doctest/doctest.h>
 
 #include <algorithm>
@@ -9,7 +11,7 @@
 #include "tspline/errors.h"
 #include "tspline/io/gis_reader.h"
 #include "tspline/multipatch/multipatch_parameterization.h"
-#include "tspline/analysis/multipatch_poisson.h"
+#include "tspline/analysis/poisson.h"
 
 namespace {
 
@@ -32,14 +34,17 @@ tspline::PoissonProblem smooth_problem() {
   return pb;
 }
 
-std::vector<tspline::TMesh> refined(const std::vector<tspline::TMesh>& meshes) {
-  std::vector<tspline::TMesh> out;
-  for (const tspline::TMesh& m : meshes) {
-    std::vector<int> all(m.num_cells());
-    for (int c = 0; c < static_cast<int>(all.size()); ++c) all[c] = c;
-    out.push_back(tspline::refine_cells(m, all));
-  }
-  return out;
+tspline::AnalysisGeometry geometry_of(const tspline::MultiPatchResult& R) {
+  tspline::AnalysisGeometry g;
+  for (const auto& r : R.patches) g.patches.push_back(&*r.map);
+  g.interfaces = R.layout.interfaces;
+  return g;
+}
+
+tspline::TMesh refined(const tspline::TMesh& m) {
+  std::vector<int> all(m.num_cells());
+  for (int c = 0; c < static_cast<int>(all.size()); ++c) all[c] = c;
+  return tspline::refine_cells(m, all);
 }
 
 }  // namespace
@@ -47,24 +52,26 @@ std::vector<tspline::TMesh> refined(const std::vector<tspline::TMesh>& meshes) {
 TEST_SUITE("holes_poisson") {
   TEST_CASE("plate with a hole, uniform refinement: C0 across the cuts, rates 4 (L2) and 3 (H1)") {
     const tspline::MultiPatchResult R = plate_map();
-    std::vector<const tspline::TSplineMap*> maps;
-    std::vector<tspline::TMesh> meshes;
-    for (const auto& r : R.patches) maps.push_back(&*r.map), meshes.push_back(r.map->mesh());
-    const tspline::PoissonProblem pb = smooth_problem();
+    const tspline::AnalysisGeometry g = geometry_of(R);
+    REQUIRE(g.size() > 1);
+    tspline::AdaptiveSolveOptions o;
+    o.refine = tspline::AdaptiveSolveOptions::Refine::Uniform;
+    o.steps = 4;
     std::vector<double> l2, h1;
-    for (int step = 0; step < 4; ++step) {
-      const tspline::MultiPatchSolution S = tspline::solve_multipatch_poisson(maps, R.layout.interfaces, meshes, pb);
+    const auto run = tspline::solve_adaptive(g, smooth_problem(), o, [&](const tspline::PoissonStep& st,
+                                                                         const tspline::PoissonSolution& sol,
+                                                                         const std::vector<double>&) {
       // One unknown per glued pair: fewer unknowns than functions.
       std::size_t functions = 0;
-      for (const auto& sp : S.spaces) functions += sp->num_dofs();
-      CHECK(S.unknowns < functions);
-      CHECK(S.glued_pairs > 0);
-      CHECK(tspline::multipatch_interface_jump(R.layout.interfaces, S) < 1e-12);
-      const tspline::PoissonErrors e = tspline::multipatch_errors(maps, S, pb);
-      MESSAGE("step " << step << ": unknowns " << S.unknowns << ", L2 " << e.l2 << ", H1 " << e.h1);
-      l2.push_back(e.l2), h1.push_back(e.h1);
-      if (step < 3) meshes = refined(meshes);
-    }
+      for (std::size_t p = 0; p < sol.space->num_patches(); ++p) functions += sol.space->patch(p).num_functions();
+      CHECK(sol.space->num_dofs() < functions);
+      CHECK(sol.space->glued_pairs() > 0);
+      CHECK(st.max_interface_jump < 1e-12);
+      CHECK(tspline::interface_jump(sol) == st.max_interface_jump);
+      MESSAGE("step " << st.step << ": unknowns " << st.dofs << ", L2 " << st.errors.l2 << ", H1 " << st.errors.h1);
+      l2.push_back(st.errors.l2), h1.push_back(st.errors.h1);
+    });
+    REQUIRE(run.steps.size() == 4);
     const double rate_l2 = std::log2(l2[2] / l2[3]), rate_h1 = std::log2(h1[2] / h1[3]);
     MESSAGE("rates: L2 " << rate_l2 << ", H1 " << rate_h1);
     CHECK(std::abs(rate_l2 - 4) <= 0.3);
@@ -73,22 +80,22 @@ TEST_SUITE("holes_poisson") {
 
   TEST_CASE("an analysis space refined on one side of a cut only is not conforming: refused") {
     const tspline::MultiPatchResult R = plate_map();
-    std::vector<const tspline::TSplineMap*> maps;
-    std::vector<tspline::TMesh> meshes;
-    for (const auto& r : R.patches) maps.push_back(&*r.map), meshes.push_back(r.map->mesh());
-    meshes[0] = refined({meshes[0]}).front();
-    CHECK_THROWS_AS(tspline::solve_multipatch_poisson(maps, R.layout.interfaces, meshes, smooth_problem()),
-                    tspline::NumericalError);
+    const tspline::AnalysisGeometry g = geometry_of(R);
+    std::vector<tspline::TMesh> meshes = g.meshes();
+    meshes[0] = refined(meshes[0]);
+    CHECK_THROWS_AS(tspline::AnalysisSpace(g, meshes), tspline::NumericalError);
+    // refine_conforming carries the split across the cuts: the space is conforming again.
+    std::vector<std::vector<int>> none(meshes.size());
+    CHECK(tspline::refine_conforming(meshes, g.interfaces, none) > 0);
+    CHECK_NOTHROW(tspline::AnalysisSpace(g, meshes));
   }
 
   TEST_CASE("adaptive refinement across a cut stays conforming and lowers the H1 error") {
     const tspline::MultiPatchResult R = plate_map();
-    std::vector<const tspline::TSplineMap*> maps;
-    std::vector<tspline::TMesh> meshes;
-    for (const auto& r : R.patches) maps.push_back(&*r.map), meshes.push_back(r.map->mesh());
+    const tspline::AnalysisGeometry g = geometry_of(R);
     // A Gaussian bump on the cut of interface 0, so that the marked region crosses it.
     const tspline::Interface& f = R.layout.interfaces[0];
-    const Eigen::Vector2d c = maps[f.patch_a]->point(tspline::side_point_uv(f.side_a, 0.5));
+    const Eigen::Vector2d c = g.patch(f.patch_a).point(tspline::side_point_uv(f.side_a, 0.5));
     tspline::PoissonProblem pb;
     const double s2 = 0.25;
     pb.exact = [c, s2](double x, double y) { return std::exp(-((x - c.x()) * (x - c.x()) + (y - c.y()) * (y - c.y())) / s2); };
@@ -97,27 +104,26 @@ TEST_SUITE("holes_poisson") {
       return -(4 * r2 / (s2 * s2) - 4 / s2) * std::exp(-r2 / s2);  // -Laplace u
     };
     pb.g = pb.exact;
-    double h1_first = 0, h1_last = 0;
-    std::size_t border_splits = 0;
-    for (int step = 0; step < 3; ++step) {
-      const tspline::MultiPatchSolution S = tspline::solve_multipatch_poisson(maps, R.layout.interfaces, meshes, pb);
-      CHECK(tspline::multipatch_interface_jump(R.layout.interfaces, S) < 1e-12);
-      const double h1 = tspline::multipatch_errors(maps, S, pb).h1;
-      (step == 0 ? h1_first : h1_last) = h1;
-      const auto eta = tspline::multipatch_estimate(maps, S, pb);
-      double max_eta = 0;
-      for (const auto& e : eta) max_eta = std::max(max_eta, *std::max_element(e.begin(), e.end()));
-      std::vector<std::vector<int>> marked(maps.size());
-      for (std::size_t p = 0; p < maps.size(); ++p)  // eta_e > 0.5 max eta over all patches
-        for (int c = 0; c < static_cast<int>(eta[p].size()); ++c)
-          if (eta[p][c] > 0.5 * max_eta) marked[p].push_back(c);
-      // Both patches of the cut are refined.
-      if (step == 0) CHECK((!marked[f.patch_a].empty() && !marked[f.patch_b].empty()));
-      const auto before = tspline::border_params(meshes[f.patch_a], static_cast<tspline::Side>(f.side_a)).size();
-      meshes = tspline::refine_multipatch(meshes, R.layout.interfaces, marked);
-      border_splits += tspline::border_params(meshes[f.patch_a], static_cast<tspline::Side>(f.side_a)).size() - before;
-    }
-    CHECK(border_splits > 0);  // the refined region reached the cut
-    CHECK(h1_last < 0.5 * h1_first);
+    tspline::AdaptiveSolveOptions o;
+    o.steps = 3;
+    std::vector<std::size_t> border_knots;  // on side_a of interface 0, per step
+    const auto run = tspline::solve_adaptive(g, pb, o, [&](const tspline::PoissonStep& st,
+                                                           const tspline::PoissonSolution& sol,
+                                                           const std::vector<double>&) {
+      CHECK(st.max_interface_jump < 1e-12);
+      // Both sides of every cut carry the same knots (mirrored).
+      for (const tspline::Interface& i : g.interfaces) {
+        const auto a = tspline::border_params(sol.space->patch(i.patch_a).mesh(), static_cast<tspline::Side>(i.side_a));
+        auto b = tspline::border_params(sol.space->patch(i.patch_b).mesh(), static_cast<tspline::Side>(i.side_b));
+        for (double& t : b) t = tspline::reversed_param(t);
+        std::reverse(b.begin(), b.end());
+        CHECK(a == b);
+      }
+      border_knots.push_back(
+          tspline::border_params(sol.space->patch(f.patch_a).mesh(), static_cast<tspline::Side>(f.side_a)).size());
+    });
+    REQUIRE(run.steps.size() == 3);
+    CHECK(border_knots.back() > border_knots.front());  // the refined region reached the cut
+    CHECK(run.steps.back().errors.h1 < 0.5 * run.steps.front().errors.h1);
   }
 }

@@ -22,7 +22,7 @@
 #include <string>
 #include <vector>
 
-#include "test_support.h"
+#include "poisson_app_support.h"
 
 namespace fs = std::filesystem;
 
@@ -58,36 +58,9 @@ fs::path geometry(const std::string& polygon) {
   return file;
 }
 
-/// convergence.csv as one map column -> text per row.
-std::vector<std::map<std::string, std::string>> read_csv(const fs::path& p) {
-  std::ifstream f(p);
-  std::string line;
-  std::vector<std::string> header;
-  std::vector<std::map<std::string, std::string>> rows;
-  auto split = [](const std::string& s) {
-    std::vector<std::string> out;
-    std::stringstream ss(s);
-    std::string item;
-    while (std::getline(ss, item, ',')) out.push_back(item);
-    if (!s.empty() && s.back() == ',') out.emplace_back();
-    return out;
-  };
-  if (!std::getline(f, line)) return rows;
-  header = split(line);
-  while (std::getline(f, line)) {
-    const auto cols = split(line);
-    REQUIRE(cols.size() == header.size());
-    std::map<std::string, std::string> row;
-    for (std::size_t i = 0; i < cols.size(); ++i) row[header[i]] = cols[i];
-    rows.push_back(row);
-  }
-  return rows;
-}
-
+using test_support::read_csv;
 double num(const std::map<std::string, std::string>& row, const std::string& col) {
-  REQUIRE(row.count(col) == 1);
-  REQUIRE(!row.at(col).empty());
-  return std::stod(row.at(col));
+  return test_support::csv_number(row, col);
 }
 
 /// Lines of stdout that are table rows (start with a step number).

@@ -13,7 +13,7 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
-#include "test_support.h"
+#include "poisson_app_support.h"
 
 namespace fs = std::filesystem;
 using nlohmann::json;
@@ -43,31 +43,9 @@ fs::path geometry(const std::string& polygon) {
   return made[polygon];
 }
 
-json report(const fs::path& out) { return json::parse(slurp(out / "report.json")); }
-
-/// Every step of b has the DOFs of a and L2 and H1 errors equal to 1e-6 relative.
-void check_same_errors(const json& a, const json& b) {
-  REQUIRE(a["steps"].size() == b["steps"].size());
-  for (std::size_t k = 0; k < a["steps"].size(); ++k) {
-    const json &sa = a["steps"][k], &sb = b["steps"][k];
-    CAPTURE(k);
-    REQUIRE(sa["dofs"] == sb["dofs"]);
-    for (const char* e : {"l2", "h1"}) {
-      CAPTURE(e);
-      const double ea = sa[e].get<double>(), eb = sb[e].get<double>();
-      CHECK(ea > 0);
-      CHECK(std::abs(ea - eb) <= 1e-6 * ea);
-    }
-  }
-}
-
-/// `mpirun -n P tspline ARGS` (as root too; oversubscribed if there are fewer cores).
-test_support::AppRun run_mpi(int processes, const std::string& args, const fs::path& dir) {
-  return run_program("/usr/bin/env",
-                     "OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 mpirun -n " +
-                         std::to_string(processes) + " --oversubscribe " + q(TSPLINE_APP_PATH) + " " + args,
-                     dir);
-}
+json report(const fs::path& out) { return test_support::poisson_report(out); }
+using test_support::check_same_errors;
+using test_support::run_mpi;
 
 }  // namespace
 

@@ -11,11 +11,15 @@
 #include <sstream>
 #include <stdexcept>
 
+#include <algorithm>
+
+#include "tspline/boundary/boundary_map.h"
 #include "tspline/detail/quadrature.h"
 #include "tspline/spline/bezier_extraction.h"
 #include "tspline/errors.h"
 #include "tspline/validity/map_quality.h"
 #include "tspline/analysis/poisson.h"
+#include "cell_tabulation.h"
 
 #include <Eigen/CholmodSupport>
 
@@ -41,31 +45,6 @@ double checked(const ScalarField& fn, const char* name, double x, double y) {
 
 }  // namespace
 
-// ------------------------------------------------------------------ AnalysisSpace
-
-AnalysisSpace::AnalysisSpace(const TSplineMap& map, TMesh analysis_mesh)
-    : mesh_(std::make_unique<TMesh>(std::move(analysis_mesh))) {
-  if (!mesh_->has_topology()) throw InputError("analysis T-mesh: topology not built");
-  basis_ = std::make_unique<HierarchicalBasis>(*mesh_);
-  const TMesh& gm = map.mesh();
-  geometry_cell_.resize(mesh_->num_cells());
-  for (int c = 0; c < static_cast<int>(mesh_->num_cells()); ++c) {
-    const QuadNode& q = mesh_->node(mesh_->cell_node(c));
-    const IPoint lo = TMesh::node_min(q), hi = TMesh::node_max(q);
-    const Eigen::Vector2d centre = 0.5 * (mesh_->cell_min(c) + mesh_->cell_max(c));
-    const int g = map.basis().locate(centre);
-    bool inside = g >= 0;
-    if (inside) {
-      const QuadNode& gq = gm.node(gm.cell_node(g));
-      const IPoint glo = TMesh::node_min(gq), ghi = TMesh::node_max(gq);
-      inside = glo.x <= lo.x && glo.y <= lo.y && hi.x <= ghi.x && hi.y <= ghi.y;
-    }
-    if (!inside)
-      throw InputError("analysis T-mesh is not a refinement of the geometry T-mesh (cell " + std::to_string(c) + ")");
-    geometry_cell_[c] = g;
-  }
-}
-
 // ------------------------------------------------------------------ formulas
 
 Eigen::Matrix2d physical_hessian(const Eigen::Vector2d& grad_x, const Eigen::Matrix2d& hessian_xi,
@@ -78,19 +57,24 @@ Eigen::Matrix2d physical_hessian(const Eigen::Vector2d& grad_x, const Eigen::Mat
   return Jinv.transpose() * (hessian_xi - hs) * Jinv;
 }
 
-SolutionValue evaluate_solution(const TSplineMap& map, const PoissonSolution& sol, int c, const Eigen::Vector2d& uv,
+SolutionValue evaluate_solution(const PoissonSolution& sol, std::size_t p, int c, const Eigen::Vector2d& uv,
                                 int order) {
-  const AnalysisSpace& sp = *sol.space;
+  return evaluate_solution(sol, p, sol.space->patch(p), c, uv, order);
+}
+
+SolutionValue evaluate_solution(const PoissonSolution& sol, std::size_t p, const PatchSpace& sp, int c,
+                                const Eigen::Vector2d& uv, int order) {
+  const std::span<const int> dofs = sol.space->dofs(p);
   BasisValues bv;
   sp.basis().evaluate(c, uv, bv, order);
-  const MapDerivatives d = map.derivatives(uv, std::max(order, 1), sp.geometry_cell(c));
+  const MapDerivatives d = sol.space->map(p).derivatives(uv, std::max(order, 1), sp.geometry_cell(c));
   SolutionValue out;
   out.x = d.x;
   out.det_j = d.J.determinant();
   Eigen::Vector2d g_xi = Eigen::Vector2d::Zero();
   Eigen::Matrix2d h_xi = Eigen::Matrix2d::Zero();
   for (std::size_t k = 0; k < bv.ids.size(); ++k) {
-    const double ca = sol.coefficients[bv.ids[k]];
+    const double ca = sol.coefficients[dofs[bv.ids[k]]];
     out.u += ca * bv.R[k];
     if (order >= 1) g_xi += ca * Eigen::Vector2d(bv.R_xi[k], bv.R_eta[k]);
     if (order >= 2) {
@@ -105,54 +89,108 @@ SolutionValue evaluate_solution(const TSplineMap& map, const PoissonSolution& so
   return out;
 }
 
+SolutionValue evaluate_solution(const PoissonSolution& sol, std::size_t p, const Eigen::Vector2d& uv, int order) {
+  return evaluate_solution(sol, p, sol.space->patch(p).basis().locate(uv), uv, order);
+}
+
 // ------------------------------------------------------------------ solve
 
 namespace {
 
-/// Coefficients of the boundary functions: L2 projection of g o S onto their
-/// traces on the border of the parameter square (see poisson.h).
-void project_dirichlet(const TSplineMap& map, const AnalysisSpace& sp, const ScalarField& g, PoissonSolution& sol) {
-  const HierarchicalBasis& basis = sp.basis();
-  const TMesh& mesh = sp.mesh();
-  const int n = static_cast<int>(basis.size());
+/// Gauss points of the edges of analysis cell c on `side` of the parameter
+/// square (none if c does not touch it): parametric points and weights.
+void side_quadrature(const TMesh& mesh, int c, int side, const std::vector<double>& gp, const std::vector<double>& gw,
+                     std::vector<std::pair<Eigen::Vector2d, double>>& out) {
+  out.clear();
+  const Eigen::Vector2d lo = mesh.cell_min(c), hi = mesh.cell_max(c);
+  Eigen::Vector2d p0, dir;
+  switch (static_cast<Side>(side)) {
+    case Side::Bottom:
+      if (lo.y() != 0.0) return;
+      p0 = lo, dir = {hi.x() - lo.x(), 0.0};
+      break;
+    case Side::Right:
+      if (hi.x() != 1.0) return;
+      p0 = {1.0, lo.y()}, dir = {0.0, hi.y() - lo.y()};
+      break;
+    case Side::Top:
+      if (hi.y() != 1.0) return;
+      p0 = {lo.x(), 1.0}, dir = {hi.x() - lo.x(), 0.0};
+      break;
+    case Side::Left:
+      if (lo.x() != 0.0) return;
+      p0 = lo, dir = {0.0, hi.y() - lo.y()};
+      break;
+  }
+  for (std::size_t q = 0; q < gp.size(); ++q) out.emplace_back(p0 + gp[q] * dir, gw[q] * dir.norm());
+}
+
+/// Coefficients of the Dirichlet DOFs: L2 projection of g onto their traces on
+/// the domain's boundary, physical arc length (see poisson_solver.h). With
+/// `distributed`, each process integrates the border edges of its share of the
+/// cells, the entries are gathered, and every process solves the (small) system.
+void project_dirichlet(const AnalysisSpace& space, const ScalarField& g, PoissonSolution& sol,
+                       const InteriorSystemSolver* distributed) {
+  const int n = static_cast<int>(space.num_dofs());
   std::vector<int> bidx(n, -1);
   int nb = 0;
   for (int a = 0; a < n; ++a)
-    if (basis.function(a).on_border) {
+    if (space.is_dirichlet(a)) {
       bidx[a] = nb++;
       sol.is_boundary[a] = true;
     }
   if (nb == 0) return;
-  // 5 Gauss points integrate the degree-6 products of the traces exactly.
+  // 5 Gauss points: exact for the parametric mass matrix (degree 6); the
+  // physical arc length makes the integrand smooth, not polynomial.
   std::vector<double> gp, gw;
   detail::gauss_points_01(5, gp, gw);
   std::vector<Eigen::Triplet<double>> trip;
   Eigen::VectorXd rhs = Eigen::VectorXd::Zero(nb);
   BasisValues bv;
   std::vector<std::pair<int, double>> active;
-  for (int c = 0; c < static_cast<int>(mesh.num_cells()); ++c) {
-    const Eigen::Vector2d lo = mesh.cell_min(c), hi = mesh.cell_max(c);
-    // The cell's edges on the border: start point, direction (length included).
-    std::vector<std::pair<Eigen::Vector2d, Eigen::Vector2d>> edges;
-    if (lo.y() == 0.0) edges.push_back({lo, {hi.x() - lo.x(), 0.0}});
-    if (hi.y() == 1.0) edges.push_back({{lo.x(), 1.0}, {hi.x() - lo.x(), 0.0}});
-    if (lo.x() == 0.0) edges.push_back({lo, {0.0, hi.y() - lo.y()}});
-    if (hi.x() == 1.0) edges.push_back({{1.0, lo.y()}, {0.0, hi.y() - lo.y()}});
-    for (const auto& [p0, dir] : edges)
-      for (std::size_t q = 0; q < gp.size(); ++q) {
-        const Eigen::Vector2d p = p0 + gp[q] * dir;
-        const double w = gw[q] * dir.norm();
-        basis.evaluate(c, p, bv, 0);
-        active.clear();
-        for (std::size_t k = 0; k < bv.ids.size(); ++k)
-          if (bidx[bv.ids[k]] >= 0 && bv.R[k] != 0.0) active.emplace_back(bidx[bv.ids[k]], bv.R[k]);
-        const Eigen::Vector2d x = map.derivatives(p, 0, sp.geometry_cell(c)).x;
-        const double gv = checked(g, "g", x.x(), x.y());
-        for (const auto& [r, vr] : active) {
-          rhs[r] += w * gv * vr;
-          for (const auto& [s, vs] : active) trip.emplace_back(r, s, w * vr * vs);
+  std::vector<std::pair<Eigen::Vector2d, double>> points;
+  const int nc = static_cast<int>(space.num_cells());
+  const auto [first, last] = distributed ? distributed->cell_share(nc) : std::pair<int, int>{0, nc};
+  for (int gcell = first; gcell < last; ++gcell) {
+    const auto [p, c] = space.cell(static_cast<std::size_t>(gcell));
+    const PatchSpace& sp = space.patch(p);
+    const TSplineMap& map = space.map(p);
+    const std::span<const int> dofs = space.dofs(p);
+    for (int side = 0; side < 4; ++side) {
+      if (space.is_interface_side(p, side)) continue;
+      {
+        side_quadrature(sp.mesh(), c, side, gp, gw, points);
+        for (const auto& [uv, wt] : points) {
+          const MapDerivatives d = map.derivatives(uv, 1, sp.geometry_cell(c));
+          const double w = wt * (side % 2 == 0 ? d.J.col(0) : d.J.col(1)).norm();
+          sp.basis().evaluate(c, uv, bv, 0);
+          active.clear();
+          for (std::size_t k = 0; k < bv.ids.size(); ++k)
+            if (bv.R[k] != 0.0 && bidx[dofs[bv.ids[k]]] >= 0) active.emplace_back(bidx[dofs[bv.ids[k]]], bv.R[k]);
+          const double gv = checked(g, "g", d.x.x(), d.x.y());
+          for (const auto& [r, vr] : active) {
+            rhs[r] += w * gv * vr;
+            for (const auto& [s2, vs] : active) trip.emplace_back(r, s2, w * vr * vs);
+          }
         }
       }
+    }
+  }
+  if (distributed && distributed->processes() > 1) {  // every process gets every entry
+    std::vector<double> mine;
+    mine.reserve(3 * trip.size() + static_cast<std::size_t>(nb) + 1);
+    mine.push_back(static_cast<double>(trip.size()));
+    for (const auto& t : trip) mine.insert(mine.end(), {double(t.row()), double(t.col()), t.value()});
+    mine.insert(mine.end(), rhs.data(), rhs.data() + nb);
+    const std::vector<double> all = distributed->gather_to_all(mine);
+    trip.clear();
+    rhs.setZero();
+    for (std::size_t k = 0; k < all.size();) {  // each process's part: count, triplets, rhs
+      const auto count = static_cast<std::size_t>(all[k++]);
+      for (std::size_t t = 0; t < count; ++t, k += 3)
+        trip.emplace_back(static_cast<int>(all[k]), static_cast<int>(all[k + 1]), all[k + 2]);
+      for (int r = 0; r < nb; ++r) rhs[r] += all[k++];
+    }
   }
   Eigen::SparseMatrix<double> M(nb, nb);
   M.setFromTriplets(trip.begin(), trip.end());
@@ -228,32 +266,38 @@ SolverStats solve_spd(const Eigen::SparseMatrix<double>& K, const Eigen::VectorX
 /// column j holds the rows i >= j of the interior DOFs sharing a cell with j),
 /// built from the cell function lists without forming triplets (which would
 /// cost 16^2 entries per cell: 4 GB at 1e6 cells).
-Eigen::SparseMatrix<double> stiffness_pattern(const AnalysisSpace& sp, const std::vector<int>& dof, int ni) {
-  const HierarchicalBasis& basis = sp.basis();
-  const int nc = static_cast<int>(sp.mesh().num_cells());
+Eigen::SparseMatrix<double> stiffness_pattern(const AnalysisSpace& space, const std::vector<int>& interior, int ni) {
+  const std::size_t nc = space.num_cells();
+  std::vector<int> g;
   std::vector<std::int64_t> start(static_cast<std::size_t>(ni) + 1, 0);  // DOF -> cells (CSR)
-  for (int c = 0; c < nc; ++c)
-    for (int a : basis.functions_on_cell(c))
-      if (dof[a] >= 0) ++start[dof[a] + 1];
+  for (std::size_t c = 0; c < nc; ++c) {
+    space.cell_dofs(c, g);
+    for (int a : g)
+      if (interior[a] >= 0) ++start[interior[a] + 1];
+  }
   for (int j = 0; j < ni; ++j) start[j + 1] += start[j];
   std::vector<int> cells(static_cast<std::size_t>(start[ni]));
   {
     std::vector<std::int64_t> fill(start.begin(), start.end() - 1);
-    for (int c = 0; c < nc; ++c)
-      for (int a : basis.functions_on_cell(c))
-        if (dof[a] >= 0) cells[fill[dof[a]]++] = c;
+    for (std::size_t c = 0; c < nc; ++c) {
+      space.cell_dofs(c, g);
+      for (int a : g)
+        if (interior[a] >= 0) cells[fill[interior[a]]++] = static_cast<int>(c);
+    }
   }
   std::vector<int> outer(static_cast<std::size_t>(ni) + 1, 0), inner, mark(ni, -1), rows;
   for (int j = 0; j < ni; ++j) {
     rows.clear();
-    for (std::int64_t k = start[j]; k < start[j + 1]; ++k)
-      for (int a : basis.functions_on_cell(cells[k])) {
-        const int i = dof[a];
+    for (std::int64_t k = start[j]; k < start[j + 1]; ++k) {
+      space.cell_dofs(static_cast<std::size_t>(cells[k]), g);
+      for (int a : g) {
+        const int i = interior[a];
         if (i >= j && mark[i] != j) {
           mark[i] = j;
           rows.push_back(i);
         }
       }
+    }
     std::sort(rows.begin(), rows.end());
     inner.insert(inner.end(), rows.begin(), rows.end());
     outer[j + 1] = static_cast<int>(inner.size());
@@ -263,37 +307,39 @@ Eigen::SparseMatrix<double> stiffness_pattern(const AnalysisSpace& sp, const std
                                                        inner.data(), zeros.data());
 }
 
-/// The element system of analysis cell c: Kloc (lower triangle) and floc, one
-/// row per function of the cell (basis.functions_on_cell(c), ascending), with
-/// the Dirichlet lift subtracted from floc: floc_r -= sum_{s Dirichlet} K_rs g_s.
+/// The element system of global analysis cell gc: Kloc (lower triangle) and
+/// floc, one row per function of the cell (its patch's
+/// basis().functions_on_cell, ascending), with the Dirichlet lift subtracted
+/// from floc: floc_r -= sum_{s Dirichlet} K_rs g_s.
 class CellKernel {
  public:
-  CellKernel(const TSplineMap& map, const AnalysisSpace& sp, const ScalarField& f, const std::vector<int>& dof,
+  CellKernel(const AnalysisSpace& space, const ScalarField& f, const std::vector<int>& interior,
              const Eigen::VectorXd& coefficients)
-      : map_(map), sp_(sp), f_(f), dof_(dof), coefficients_(coefficients) {}
+      : space_(space), f_(f), interior_(interior), coefficients_(coefficients) {}
 
-  void compute(int c) {
-    const HierarchicalBasis& basis = sp_.basis();
-    const TMesh& mesh = sp_.mesh();
-    const Eigen::Vector2d lo = mesh.cell_min(c), hi = mesh.cell_max(c);
-    ids = basis.functions_on_cell(c);
+  void compute(std::size_t gc) {
+    const auto [p, c] = space_.cell(gc);
+    const TSplineMap& map = space_.map(p);
+    const PatchSpace& sp = space_.patch(p);
+    const std::span<const int> dofs = space_.dofs(p);
+    const TMesh& mesh = sp.mesh();
+    box_quadrature(mesh.cell_min(c), mesh.cell_max(c), 4, qp_, map.basis(), sp.geometry_cell(c));
+    cell_.set(map, sp, c, qp_, 1);
+    ids = cell_.ids;
     const std::size_t nf = ids.size();
     const auto n = static_cast<Eigen::Index>(nf);
     Kloc.setZero(n, n);
     floc.setZero(n);
-    gcell_ = sp_.geometry_cell(c);
-    box_quadrature(lo, hi, 4, qp_, map_.basis(), gcell_);
-    tabulate_factors();
     gx_.resize(nf);
     gy_.resize(nf);
     R_.resize(nf);
     for (std::size_t q = 0; q < qp_.size(); ++q) {
-      const MapDerivatives d = geometry_at(q);
+      const MapDerivatives d = cell_.geometry(q);
       const double w = qp_[q].weight * std::abs(d.J.determinant());
       const Eigen::Matrix2d JinvT = d.J.inverse().transpose();
       for (std::size_t k = 0; k < nf; ++k) {
         // R = N(x) M(y), grad_xi R = (N'(x) M(y), N(x) M'(y)); physical gradient J^{-T} grad_xi R.
-        const TensorFactors::Factor a = analysis_.x(qx_[q], k), b = analysis_.y(qy_[q], k);
+        const detail::Factor &a = cell_.x(q, k), &b = cell_.y(q, k);
         const double r_xi = a.d * b.v, r_eta = a.v * b.d;
         R_[k] = a.v * b.v;
         gx_[k] = JinvT(0, 0) * r_xi + JinvT(0, 1) * r_eta;
@@ -309,11 +355,11 @@ class CellKernel {
       for (std::size_t k = 0; k < nf; ++k) floc[static_cast<Eigen::Index>(k)] += w * fv * R_[k];
     }
     rows.resize(nf);
-    for (std::size_t r = 0; r < nf; ++r) rows[r] = dof_[ids[r]];
+    for (std::size_t r = 0; r < nf; ++r) rows[r] = interior_[dofs[ids[r]]];
     // Dirichlet DOF s: lift K(r, s) g_s into the load of the interior rows r.
     for (std::size_t s = 0; s < nf; ++s) {
       if (rows[s] >= 0) continue;
-      const double gs = coefficients_[ids[s]];
+      const double gs = coefficients_[dofs[ids[s]]];
       for (std::size_t r = 0; r < nf; ++r)
         if (rows[r] >= 0) floc[static_cast<Eigen::Index>(r)] -= (r >= s ? Kloc(r, s) : Kloc(s, r)) * gs;
     }
@@ -325,144 +371,43 @@ class CellKernel {
   Eigen::VectorXd floc;
 
  private:
-  const TSplineMap& map_;
-  const AnalysisSpace& sp_;
+  const AnalysisSpace& space_;
   const ScalarField& f_;
-  const std::vector<int>& dof_;
+  const std::vector<int>& interior_;
   const Eigen::VectorXd& coefficients_;
   std::vector<QuadraturePoint> qp_;
-
-  // Tensor-product tabulation (see TensorFactors): the analysis functions and
-  // the geometry's blending functions on the cell, at its quadrature points.
-  void tabulate_factors() {
-    xs_.clear();
-    ys_.clear();
-    qx_.resize(qp_.size());
-    qy_.resize(qp_.size());
-    for (std::size_t q = 0; q < qp_.size(); ++q) {
-      qx_[q] = index_of(xs_, qp_[q].uv.x());
-      qy_[q] = index_of(ys_, qp_[q].uv.y());
-    }
-    const HierarchicalBasis& basis = sp_.basis();
-    analysis_.build(ids.size(), [&](std::size_t k) -> const auto& { return basis.function(ids[k]).knots_xi; },
-                    [&](std::size_t k) -> const auto& { return basis.function(ids[k]).knots_eta; }, xs_, ys_);
-    const TSplineBasis& gb = map_.basis();
-    const std::vector<int>& gids = gb.functions_on_cell(gcell_);
-    geometry_.build(gids.size(), [&](std::size_t k) -> const auto& { return gb.function(gids[k]).knots_xi; },
-                    [&](std::size_t k) -> const auto& { return gb.function(gids[k]).knots_eta; }, xs_, ys_);
-  }
-
-  /// S and J at quadrature point q from the tabulated blending functions N_a
-  /// of the geometry cell: R_a = N_a / W, W = sum_b N_b, grad R_a = (grad N_a -
-  /// R_a grad W) / W (the formulas of TSplineBasis::evaluate, order 1).
-  MapDerivatives geometry_at(std::size_t q) const {
-    const std::vector<int>& gids = map_.basis().functions_on_cell(gcell_);
-    const std::vector<Eigen::Vector2d>& P = map_.control_points();
-    double W = 0, Wx = 0, Wy = 0;
-    Eigen::Vector2d x = Eigen::Vector2d::Zero(), dx = x, dy = x;  // sums of N P, N_xi P, N_eta P
-    for (std::size_t k = 0; k < gids.size(); ++k) {
-      const TensorFactors::Factor a = geometry_.x(qx_[q], k), b = geometry_.y(qy_[q], k);
-      const double n = a.v * b.v, nx = a.d * b.v, ny = a.v * b.d;
-      W += n;
-      Wx += nx;
-      Wy += ny;
-      x += n * P[gids[k]];
-      dx += nx * P[gids[k]];
-      dy += ny * P[gids[k]];
-    }
-    if (!(W > 0.0)) throw std::logic_error("Poisson assembly: the blending functions vanish at a quadrature point");
-    // S = x / W; dS/dxi = (dx - S Wx) / W, dS/deta = (dy - S Wy) / W.
-    MapDerivatives d;
-    d.x = x / W;
-    d.J.col(0) = (dx - d.x * Wx) / W;
-    d.J.col(1) = (dy - d.x * Wy) / W;
-    return d;
-  }
-
-  template <class List, class T>
-  static std::size_t index_of(List& list, const T& value) {
-    for (std::size_t i = 0; i < list.size(); ++i)
-      if (list[i] == value) return i;
-    list.push_back(value);
-    return list.size() - 1;
-  }
-
-  // Every function here (analysis or geometry) is a product N[knots_xi](x)
-  // N[knots_eta](y). The functions of a cell share few distinct knot vectors
-  // (4 per direction and level for the analysis functions), and the quadrature
-  // points of the cell's pieces lie on few distinct x and y lines. So each
-  // distinct factor is evaluated (cubic_bspline, as the bases do) once per
-  // distinct coordinate, instead of twice per function and point.
-  class TensorFactors {
-   public:
-    struct Factor {
-      double v = 0.0, d = 0.0;  // value and first derivative
-    };
-    template <class KnotsX, class KnotsY>
-    void build(std::size_t nf, KnotsX knots_x, KnotsY knots_y, const std::vector<double>& xs,
-               const std::vector<double>& ys) {
-      knx_.clear();
-      kny_.clear();
-      kx_.resize(nf);
-      ky_.resize(nf);
-      for (std::size_t k = 0; k < nf; ++k) {
-        kx_[k] = index_of(knx_, knots_x(k));
-        ky_[k] = index_of(kny_, knots_y(k));
-      }
-      tabulate(knx_, xs, ux_);
-      tabulate(kny_, ys, uy_);
-    }
-    /// Factor in x of function k at distinct coordinate i (and in y).
-    Factor x(std::size_t i, std::size_t k) const { return ux_[i * knx_.size() + kx_[k]]; }
-    Factor y(std::size_t i, std::size_t k) const { return uy_[i * kny_.size() + ky_[k]]; }
-
-   private:
-    static void tabulate(const std::vector<std::array<double, 5>>& knots, const std::vector<double>& ts,
-                         std::vector<Factor>& out) {
-      out.resize(ts.size() * knots.size());
-      for (std::size_t i = 0; i < ts.size(); ++i)
-        for (std::size_t j = 0; j < knots.size(); ++j) {
-          Factor& u = out[i * knots.size() + j];
-          u.v = cubic_bspline(knots[j], ts[i], &u.d);
-        }
-    }
-    std::vector<std::array<double, 5>> knx_, kny_;  // distinct knot vectors in x and y
-    std::vector<std::size_t> kx_, ky_;              // per function: its factors
-    std::vector<Factor> ux_, uy_;                   // [coordinate][factor]
-  };
-
-  int gcell_ = -1;                    // the geometry cell of the analysis cell
-  std::vector<double> xs_, ys_;       // distinct quadrature coordinates
-  std::vector<std::size_t> qx_, qy_;  // per quadrature point: its coordinates
-  TensorFactors analysis_, geometry_;
+  detail::CellTabulation cell_;
   std::vector<double> gx_, gy_, R_;
 };
 
 /// Interior stiffness matrix (lower triangle) and load vector, with the
 /// Dirichlet coefficients (already in `coefficients`) lifted into the load.
-Eigen::SparseMatrix<double> assemble_stiffness(const TSplineMap& map, const AnalysisSpace& sp, const ScalarField& f,
-                                               const std::vector<int>& dof, int ni,
+Eigen::SparseMatrix<double> assemble_stiffness(const AnalysisSpace& space, const ScalarField& f,
+                                               const std::vector<int>& interior, int ni,
                                                const Eigen::VectorXd& coefficients, Eigen::VectorXd& rhs) {
-  Eigen::SparseMatrix<double> K = stiffness_pattern(sp, dof, ni);
+  Eigen::SparseMatrix<double> K = stiffness_pattern(space, interior, ni);
   const int* outer = K.outerIndexPtr();
   const int* inner = K.innerIndexPtr();
   double* values = K.valuePtr();
   rhs = Eigen::VectorXd::Zero(ni);
-  CellKernel cell(map, sp, f, dof, coefficients);
-  for (int c = 0; c < static_cast<int>(sp.mesh().num_cells()); ++c) {
+  CellKernel cell(space, f, interior, coefficients);
+  std::vector<std::pair<int, int>> order;  // (interior number, row of Kloc), ascending
+  for (std::size_t c = 0; c < space.num_cells(); ++c) {
     cell.compute(c);
-    const std::size_t nf = cell.rows.size();
-    // ids ascending => interior DOF numbers ascending, like the rows of a column.
-    for (std::size_t s = 0; s < nf; ++s) {
-      const int js = cell.rows[s];
-      if (js < 0) continue;
-      rhs[js] += cell.floc[static_cast<Eigen::Index>(s)];
+    order.clear();
+    for (std::size_t r = 0; r < cell.rows.size(); ++r)
+      if (cell.rows[r] >= 0) order.emplace_back(cell.rows[r], static_cast<int>(r));
+    // Glued DOFs are not numbered in the order of a patch's functions: sort, so
+    // that the rows of a column are met in the order of the pattern.
+    std::sort(order.begin(), order.end());
+    for (std::size_t s = 0; s < order.size(); ++s) {
+      const auto [js, ks] = order[s];
+      rhs[js] += cell.floc[ks];
       int p = outer[js];
-      for (std::size_t r = s; r < nf; ++r) {
-        const int ir = cell.rows[r];
-        if (ir < 0) continue;
+      for (std::size_t r = s; r < order.size(); ++r) {
+        const auto [ir, kr] = order[r];
         while (inner[p] != ir) ++p;  // present by construction of the pattern
-        values[p] += cell.Kloc(r, s);
+        values[p] += kr >= ks ? cell.Kloc(kr, ks) : cell.Kloc(ks, kr);
       }
     }
   }
@@ -472,15 +417,14 @@ Eigen::SparseMatrix<double> assemble_stiffness(const TSplineMap& map, const Anal
 /// The same system handed cell by cell to an external solver, for the cells it
 /// asks for. An exception on this process (e.g. f not finite) is rethrown only
 /// after end_assembly, so that the other processes are not left waiting.
-void assemble_external(const TSplineMap& map, const AnalysisSpace& sp, const ScalarField& f,
-                       const std::vector<int>& dof, int ni, const Eigen::VectorXd& coefficients,
-                       InteriorSystemSolver& solver) {
-  const std::vector<int> cells = solver.begin(sp, dof, ni);
+void assemble_external(const AnalysisSpace& space, const ScalarField& f, const std::vector<int>& interior, int ni,
+                       const Eigen::VectorXd& coefficients, InteriorSystemSolver& solver) {
+  const std::vector<int> cells = solver.begin(space, interior, ni);
   std::exception_ptr failure;
   try {
-    CellKernel cell(map, sp, f, dof, coefficients);
+    CellKernel cell(space, f, interior, coefficients);
     for (int c : cells) {
-      cell.compute(c);
+      cell.compute(static_cast<std::size_t>(c));
       solver.add_cell(cell.rows, cell.Kloc, cell.floc);
     }
   } catch (...) {
@@ -494,57 +438,55 @@ void assemble_external(const TSplineMap& map, const AnalysisSpace& sp, const Sca
 }  // namespace
 
 PoissonSolution solve_poisson(const TSplineMap& map, const TMesh& analysis_mesh, const PoissonProblem& problem) {
-  return solve_poisson(map, std::make_shared<const AnalysisSpace>(map, analysis_mesh), problem);
+  return solve_poisson(std::make_shared<const AnalysisSpace>(map, analysis_mesh), problem);
 }
 
-PoissonSolution solve_poisson(const TSplineMap& map, std::shared_ptr<const AnalysisSpace> space,
-                              const PoissonProblem& problem) {
-  return solve_poisson(map, std::move(space), problem, nullptr);
-}
-
-PoissonSolution solve_poisson(const TSplineMap& map, std::shared_ptr<const AnalysisSpace> space,
-                              const PoissonProblem& problem, InteriorSystemSolver* solver) {
+PoissonSolution solve_poisson(std::shared_ptr<const AnalysisSpace> space, const PoissonProblem& problem,
+                              InteriorSystemSolver* solver) {
   if (!problem.f) throw InputError("Poisson problem: the source f is missing");
   if (!problem.g) throw InputError("Poisson problem: the Dirichlet data g is missing");
   PoissonSolution sol;
-  sol.space = std::move(space);
-  const AnalysisSpace& sp = *sol.space;
-  const int n = static_cast<int>(sp.basis().size());
+  sol.space = space;
+  const AnalysisSpace& sp = *space;
+  const int n = static_cast<int>(sp.num_dofs());
   sol.coefficients = Eigen::VectorXd::Zero(n);
   sol.is_boundary.assign(n, false);
 
   auto t0 = Clock::now();
-  project_dirichlet(map, sp, problem.g, sol);
+  project_dirichlet(sp, problem.g, sol, solver);
   sol.dirichlet_seconds = seconds_since(t0);
 
   // Interior numbering.
-  std::vector<int> dof(n, -1);
+  std::vector<int> interior(n, -1);
   int ni = 0;
   for (int a = 0; a < n; ++a)
-    if (!sol.is_boundary[a]) dof[a] = ni++;
+    if (!sol.is_boundary[a]) interior[a] = ni++;
   sol.interior_dofs = static_cast<std::size_t>(ni);
 
   if (ni > 0 && solver != nullptr && solver->accepts(static_cast<std::size_t>(ni))) {
     t0 = Clock::now();
-    assemble_external(map, sp, problem.f, dof, ni, sol.coefficients, *solver);
+    assemble_external(sp, problem.f, interior, ni, sol.coefficients, *solver);
     sol.assembly_seconds = seconds_since(t0);
     Eigen::VectorXd u;
     sol.solver = solver->solve(u);
     for (int a = 0; a < n; ++a)
-      if (dof[a] >= 0) sol.coefficients[a] = u[dof[a]];
+      if (interior[a] >= 0) sol.coefficients[a] = u[interior[a]];
     return sol;
   }
 
+  // The built-in direct solver assembles every cell (on every process, redundantly).
+  if (!sp.holds_all()) sol.space = sp.completed();
   t0 = Clock::now();
   Eigen::VectorXd rhs;
-  const Eigen::SparseMatrix<double> K = assemble_stiffness(map, sp, problem.f, dof, ni, sol.coefficients, rhs);
+  const Eigen::SparseMatrix<double> K =
+      assemble_stiffness(*sol.space, problem.f, interior, ni, sol.coefficients, rhs);
   sol.assembly_seconds = seconds_since(t0);
 
   if (ni > 0) {
     Eigen::VectorXd u;
     sol.solver = solve_spd(K, rhs, u);
     for (int a = 0; a < n; ++a)
-      if (dof[a] >= 0) sol.coefficients[a] = u[dof[a]];
+      if (interior[a] >= 0) sol.coefficients[a] = u[interior[a]];
   } else {
     sol.solver.kind = "none";
   }

@@ -1,5 +1,5 @@
-// Errors, residual estimator, marking, refinement and the adaptive loop of the
-// IGA Poisson solver (see poisson.h).
+// Errors, interface jumps, residual estimator and marking of the IGA Poisson
+// solver (see poisson_solver.h, poisson_estimator.h).
 #include <Eigen/Dense>
 #include <algorithm>
 #include <array>
@@ -9,17 +9,17 @@
 #include <stdexcept>
 #include <vector>
 
+#include "tspline/boundary/border_knots.h"
+#include "tspline/multipatch/multipatch_parameterization.h"
 #include "tspline/spline/bezier_extraction.h"
 #include "tspline/errors.h"
 #include "tspline/validity/map_quality.h"
 #include "tspline/analysis/poisson.h"
+#include "cell_tabulation.h"
 
 namespace tspline {
 
 namespace {
-
-using Clock = std::chrono::steady_clock;
-double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
 
 Eigen::Vector2d exact_gradient(const PoissonProblem& p, double x, double y) {
   if (p.exact_gradient) return p.exact_gradient(x, y);
@@ -27,81 +27,39 @@ Eigen::Vector2d exact_gradient(const PoissonProblem& p, double x, double y) {
   return {(p.exact(x + h, y) - p.exact(x - h, y)) / (2 * h), (p.exact(x, y + h) - p.exact(x, y - h)) / (2 * h)};
 }
 
+/// This process's share of the cells: all of them, or the distributed solver's.
+std::pair<int, int> cell_share(const AnalysisSpace& space, const InteriorSystemSolver* distributed) {
+  const int nc = static_cast<int>(space.num_cells());
+  return distributed ? distributed->cell_share(nc) : std::pair<int, int>{0, nc};
+}
+
 /// u_h and the map at the quadrature points of one analysis cell, from
-/// tabulated univariate factors: the same values as evaluate_solution() (up to
-/// the order of the additions), without evaluating both bases at every point.
-/// Every function here, analysis or geometry, is a product N[kx](x) N[ky](y);
-/// a cell's functions share few distinct knot vectors and its quadrature points
-/// lie on few distinct x and y lines, so each distinct factor is evaluated once
-/// per distinct coordinate (as the assembly's CellKernel does).
+/// tabulated univariate factors (cell_tabulation.h): the same values as
+/// evaluate_solution() (up to the order of the additions), without evaluating
+/// both bases at every point.
 class CellEvaluator {
  public:
-  CellEvaluator(const TSplineMap& map, const PoissonSolution& sol) : map_(map), sol_(sol) {}
+  explicit CellEvaluator(const PoissonSolution& sol) : sol_(sol) {}
 
-  /// Tabulates cell c at the points qp, derivatives up to `order` (1 or 2).
-  void set_cell(int c, const std::vector<QuadraturePoint>& qp, int order) {
+  /// Tabulates global cell gc at n x n Gauss points per piece (box_quadrature),
+  /// derivatives up to `order` (1 or 2); returns the points.
+  const std::vector<QuadraturePoint>& set_cell(std::size_t gc, int n, int order) {
     order_ = order;
-    xs_.clear();
-    ys_.clear();
-    qx_.resize(qp.size());
-    qy_.resize(qp.size());
-    for (std::size_t q = 0; q < qp.size(); ++q) {
-      qx_[q] = index_of(xs_, qp[q].uv.x());
-      qy_[q] = index_of(ys_, qp[q].uv.y());
-    }
-    const HierarchicalBasis& basis = sol_.space->basis();
-    ids_ = basis.functions_on_cell(c);
-    coef_.resize(ids_.size());
-    for (std::size_t k = 0; k < ids_.size(); ++k) coef_[k] = sol_.coefficients[ids_[k]];
-    analysis_.build(
-        ids_.size(), [&](std::size_t k) -> const auto& { return basis.function(ids_[k]).knots_xi; },
-        [&](std::size_t k) -> const auto& { return basis.function(ids_[k]).knots_eta; }, xs_, ys_, order);
-    const TSplineBasis& gb = map_.basis();
-    gids_ = &gb.functions_on_cell(sol_.space->geometry_cell(c));
-    geometry_.build(
-        gids_->size(), [&](std::size_t k) -> const auto& { return gb.function((*gids_)[k]).knots_xi; },
-        [&](std::size_t k) -> const auto& { return gb.function((*gids_)[k]).knots_eta; }, xs_, ys_, order);
+    const auto [p, c] = sol_.space->cell(gc);
+    const PatchSpace& sp = sol_.space->patch(p);
+    const TSplineMap& map = sol_.space->map(p);
+    box_quadrature(sp.mesh().cell_min(c), sp.mesh().cell_max(c), n, qp_, map.basis(), sp.geometry_cell(c));
+    cell_.set(map, sp, c, qp_, order);
+    const std::span<const int> dofs = sol_.space->dofs(p);
+    coef_.resize(cell_.ids.size());
+    for (std::size_t k = 0; k < cell_.ids.size(); ++k) coef_[k] = sol_.coefficients[dofs[cell_.ids[k]]];
+    return qp_;
   }
 
-  /// evaluate_solution(map, sol, c, qp[q].uv, order) of the current cell.
+  /// evaluate_solution(sol, p, c, qp[q].uv, order) of the current cell.
   SolutionValue at(std::size_t q) const {
     const bool d2 = order_ >= 2;
-    // S = A / W with A = sum N_a P_a, W = sum N_a (TSplineBasis: R_a = N_a / W);
-    // differentiating A = S W: S_i = (A_i - S W_i) / W,
-    // S_ij = (A_ij - S_i W_j - S_j W_i - S W_ij) / W.
-    const std::vector<Eigen::Vector2d>& P = map_.control_points();
-    double W = 0, Wx = 0, Wy = 0, Wxx = 0, Wxy = 0, Wyy = 0;
-    Eigen::Vector2d A = Eigen::Vector2d::Zero(), Ax = A, Ay = A, Axx = A, Axy = A, Ayy = A;
-    for (std::size_t k = 0; k < gids_->size(); ++k) {
-      const Factor a = geometry_.x(qx_[q], k), b = geometry_.y(qy_[q], k);
-      const Eigen::Vector2d& p = P[(*gids_)[k]];
-      const double n = a.v * b.v, nx = a.d * b.v, ny = a.v * b.d;
-      W += n;
-      Wx += nx;
-      Wy += ny;
-      A += n * p;
-      Ax += nx * p;
-      Ay += ny * p;
-      if (d2) {
-        const double nxx = a.dd * b.v, nxy = a.d * b.d, nyy = a.v * b.dd;
-        Wxx += nxx;
-        Wxy += nxy;
-        Wyy += nyy;
-        Axx += nxx * p;
-        Axy += nxy * p;
-        Ayy += nyy * p;
-      }
-    }
-    if (!(W > 0.0)) throw std::logic_error("Poisson errors: the blending functions vanish at a quadrature point");
-    MapDerivatives d;
-    d.x = A / W;
-    d.J.col(0) = (Ax - d.x * Wx) / W;
-    d.J.col(1) = (Ay - d.x * Wy) / W;
-    if (d2) {
-      d.xixi = (Axx - 2.0 * d.J.col(0) * Wx - d.x * Wxx) / W;
-      d.xieta = (Axy - d.J.col(0) * Wy - d.J.col(1) * Wx - d.x * Wxy) / W;
-      d.etaeta = (Ayy - 2.0 * d.J.col(1) * Wy - d.x * Wyy) / W;
-    }
+    const MapDerivatives d = cell_.geometry(q);
     // u_h = sum c_a X_a(x) Y_a(y) (hierarchical B-splines are not normalized).
     SolutionValue out;
     out.x = d.x;
@@ -109,7 +67,7 @@ class CellEvaluator {
     Eigen::Vector2d g_xi = Eigen::Vector2d::Zero();
     Eigen::Matrix2d h_xi = Eigen::Matrix2d::Zero();
     for (std::size_t k = 0; k < coef_.size(); ++k) {
-      const Factor a = analysis_.x(qx_[q], k), b = analysis_.y(qy_[q], k);
+      const detail::Factor &a = cell_.x(q, k), &b = cell_.y(q, k);
       const double ca = coef_[k];
       out.u += ca * a.v * b.v;
       g_xi += ca * Eigen::Vector2d(a.d * b.v, a.v * b.d);
@@ -126,75 +84,24 @@ class CellEvaluator {
   }
 
  private:
-  struct Factor {
-    double v = 0.0, d = 0.0, dd = 0.0;  // value, first and second derivative
-  };
-  template <class List, class T>
-  static std::size_t index_of(List& list, const T& value) {
-    for (std::size_t i = 0; i < list.size(); ++i)
-      if (list[i] == value) return i;
-    list.push_back(value);
-    return list.size() - 1;
-  }
-  class TensorFactors {
-   public:
-    template <class KnotsX, class KnotsY>
-    void build(std::size_t nf, KnotsX knots_x, KnotsY knots_y, const std::vector<double>& xs,
-               const std::vector<double>& ys, int order) {
-      knx_.clear();
-      kny_.clear();
-      kx_.resize(nf);
-      ky_.resize(nf);
-      for (std::size_t k = 0; k < nf; ++k) {
-        kx_[k] = index_of(knx_, knots_x(k));
-        ky_[k] = index_of(kny_, knots_y(k));
-      }
-      tabulate(knx_, xs, ux_, order);
-      tabulate(kny_, ys, uy_, order);
-    }
-    Factor x(std::size_t i, std::size_t k) const { return ux_[i * knx_.size() + kx_[k]]; }
-    Factor y(std::size_t i, std::size_t k) const { return uy_[i * kny_.size() + ky_[k]]; }
-
-   private:
-    static void tabulate(const std::vector<std::array<double, 5>>& knots, const std::vector<double>& ts,
-                         std::vector<Factor>& out, int order) {
-      out.resize(ts.size() * knots.size());
-      for (std::size_t i = 0; i < ts.size(); ++i)
-        for (std::size_t j = 0; j < knots.size(); ++j) {
-          Factor& u = out[i * knots.size() + j];
-          u.v = cubic_bspline(knots[j], ts[i], &u.d, order >= 2 ? &u.dd : nullptr);
-        }
-    }
-    std::vector<std::array<double, 5>> knx_, kny_;
-    std::vector<std::size_t> kx_, ky_;
-    std::vector<Factor> ux_, uy_;
-  };
-
-  const TSplineMap& map_;
   const PoissonSolution& sol_;
   int order_ = 1;
-  std::span<const int> ids_;
-  const std::vector<int>* gids_ = nullptr;
-  std::vector<double> coef_, xs_, ys_;
-  std::vector<std::size_t> qx_, qy_;
-  TensorFactors analysis_, geometry_;
+  std::vector<QuadraturePoint> qp_;
+  detail::CellTabulation cell_;
+  std::vector<double> coef_;
 };
 
 }  // namespace
 
-PoissonErrors compute_errors(const TSplineMap& map, const PoissonSolution& sol, const PoissonProblem& problem,
+PoissonErrors compute_errors(const PoissonSolution& sol, const PoissonProblem& problem,
                              const InteriorSystemSolver* distributed) {
   if (!problem.exact) throw InputError("Poisson errors: no exact solution given");
-  const TMesh& mesh = sol.space->mesh();
-  std::vector<QuadraturePoint> qp;
   PoissonErrors e;
   double l2 = 0, h1 = 0, l2u = 0, h1u = 0;
-  const int nc = static_cast<int>(mesh.num_cells());
-  const auto [first, last] = distributed ? distributed->cell_share(nc) : std::pair<int, int>{0, nc};
-  CellEvaluator cell(map, sol);
-  for (int c = first; c < last; ++c) {
-    box_quadrature(mesh.cell_min(c), mesh.cell_max(c), 6, qp, map.basis(), sol.space->geometry_cell(c));
-    cell.set_cell(c, qp, 1);
+  const auto [first, last] = cell_share(*sol.space, distributed);
+  CellEvaluator cell(sol);
+  for (int gc = first; gc < last; ++gc) {
+    const std::vector<QuadraturePoint>& qp = cell.set_cell(static_cast<std::size_t>(gc), 6, 1);
     for (std::size_t iq = 0; iq < qp.size(); ++iq) {
       const QuadraturePoint& q = qp[iq];
       const SolutionValue v = cell.at(iq);
@@ -224,26 +131,48 @@ PoissonErrors compute_errors(const TSplineMap& map, const PoissonSolution& sol, 
   return e;
 }
 
-std::vector<double> estimate_cells(const TSplineMap& map, const PoissonSolution& sol, const PoissonProblem& problem,
+double interface_jump(const PoissonSolution& sol, const InteriorSystemSolver* distributed) {
+  const AnalysisSpace& space = *sol.space;
+  // With several processes: the interfaces of the patches of this process's
+  // block (it holds their neighbours too), the maximum taken over the processes.
+  std::vector<char> mine(space.num_patches(), 1);
+  if (distributed) {
+    const auto [first, last] = distributed->cell_share(static_cast<int>(space.num_cells()));
+    for (std::size_t p = 0; p < mine.size(); ++p)
+      mine[p] = static_cast<int>(space.cell_offset(p)) < last && first < static_cast<int>(space.cell_offset(p + 1));
+  }
+  double jump = 0.0;
+  for (const Interface& f : space.geometry().interfaces)
+    for (int k = 0; k <= 32 && mine[f.patch_a]; ++k) {
+      const double t = k / 32.0;
+      const double ua = evaluate_solution(sol, f.patch_a, side_point_uv(f.side_a, t), 0).u;
+      const double ub = evaluate_solution(sol, f.patch_b, side_point_uv(f.side_b, reversed_param(t)), 0).u;
+      jump = std::max(jump, std::abs(ua - ub));
+    }
+  if (distributed) distributed->max_over_processes({&jump, 1});
+  return jump;
+}
+
+std::vector<double> estimate_cells(const PoissonSolution& sol, const PoissonProblem& problem,
                                    std::vector<double>* eta_scale, const InteriorSystemSolver* distributed) {
-  const TMesh& mesh = sol.space->mesh();
-  std::vector<QuadraturePoint> qp;
-  std::vector<double> eta(mesh.num_cells(), 0.0);
-  if (eta_scale) eta_scale->assign(mesh.num_cells(), 0.0);
-  const int nc = static_cast<int>(mesh.num_cells());
-  const auto [first, last] = distributed ? distributed->cell_share(nc) : std::pair<int, int>{0, nc};
-  CellEvaluator cell(map, sol);
-  for (int c = first; c < last; ++c) {
+  const AnalysisSpace& space = *sol.space;
+  std::vector<double> eta(space.num_cells(), 0.0);
+  if (eta_scale) eta_scale->assign(space.num_cells(), 0.0);
+  const auto [first, last] = cell_share(space, distributed);
+  CellEvaluator cell(sol);
+  for (int gc = first; gc < last; ++gc) {
+    const auto [p, c] = space.cell(static_cast<std::size_t>(gc));
+    const TMesh& mesh = space.patch(p).mesh();
+    const TSplineMap& map = space.map(p);
     const Eigen::Vector2d lo = mesh.cell_min(c), hi = mesh.cell_max(c);
-    const int g = sol.space->geometry_cell(c);
+    const int g = space.patch(p).geometry_cell(c);
     // h_e: the longer diagonal of the image of the cell's corners.
     const Eigen::Vector2d p00 = map.derivatives(lo, 0, g).x, p11 = map.derivatives(hi, 0, g).x;
     const Eigen::Vector2d p10 = map.derivatives({hi.x(), lo.y()}, 0, g).x;
     const Eigen::Vector2d p01 = map.derivatives({lo.x(), hi.y()}, 0, g).x;
     const double h = std::max((p11 - p00).norm(), (p01 - p10).norm());
     double s = 0, scale = 0;
-    box_quadrature(lo, hi, 4, qp, map.basis(), g);
-    cell.set_cell(c, qp, 2);
+    const std::vector<QuadraturePoint>& qp = cell.set_cell(static_cast<std::size_t>(gc), 4, 2);
     for (std::size_t iq = 0; iq < qp.size(); ++iq) {
       const QuadraturePoint& q = qp[iq];
       const SolutionValue v = cell.at(iq);
@@ -253,8 +182,8 @@ std::vector<double> estimate_cells(const TSplineMap& map, const PoissonSolution&
       s += w * r * r;
       scale += w * (fv * fv + lap * lap);
     }
-    eta[c] = h * std::sqrt(s);
-    if (eta_scale) (*eta_scale)[c] = h * std::sqrt(scale);
+    eta[gc] = h * std::sqrt(s);
+    if (eta_scale) (*eta_scale)[gc] = h * std::sqrt(scale);
   }
   if (distributed) {  // every process gets every cell's value (the others' are 0 here)
     distributed->sum_over_processes(eta);
@@ -297,81 +226,6 @@ std::vector<int> mark_cells(const std::vector<double>& eta, double gamma) {
   for (int c = 0; c < static_cast<int>(eta.size()); ++c)
     if (eta[c] > gamma * m) marked.push_back(c);
   return marked;
-}
-
-std::string describe(AdaptiveSolveStop stop, const AdaptiveSolveOptions& options) {
-  switch (stop) {
-    case AdaptiveSolveStop::AllSteps: return "all " + std::to_string(options.steps) + " steps done";
-    case AdaptiveSolveStop::EstimatorAtRoundoff:
-      return "the estimator is at round-off (u_h solves the problem exactly): nothing to refine";
-    case AdaptiveSolveStop::NothingMarked: return "no cell marked (eta = 0 everywhere)";
-    case AdaptiveSolveStop::MaxDofs:
-      return "the next space would have more than " + std::to_string(options.max_dofs) + " DOFs (max_dofs)";
-  }
-  return "unknown";
-}
-
-AdaptiveSolveResult solve_adaptive(const TSplineMap& map, const PoissonProblem& problem,
-                                   const AdaptiveSolveOptions& options, const PoissonStepCallback& callback) {
-  if (options.steps < 1) throw InputError("Poisson: steps must be at least 1");
-  if (!(options.gamma >= 0.0 && options.gamma <= 1.0))
-    throw InputError("gamma must lie in [0, 1], got " + std::to_string(options.gamma));
-  AdaptiveSolveResult result;
-  std::vector<PoissonStep>& steps = result.steps;
-  TMesh mesh = map.mesh();
-  for (int k = 0; k < options.steps; ++k) {
-    const auto t0 = Clock::now();
-    auto space = std::make_shared<const AnalysisSpace>(map, mesh);
-    if (k > 0 && space->num_dofs() > options.max_dofs) {
-      result.stop = AdaptiveSolveStop::MaxDofs;
-      break;
-    }
-    const PoissonSolution sol = solve_poisson(map, space, problem, options.solver);
-    PoissonStep st;
-    st.step = k;
-    st.dofs = space->num_dofs();
-    st.cells = space->mesh().num_cells();
-    st.solver = sol.solver;
-    st.assembly_seconds = sol.assembly_seconds;
-    if (problem.exact) {
-      st.has_errors = true;
-      st.errors = compute_errors(map, sol, problem, options.solver);
-    }
-    std::vector<double> scale;
-    const std::vector<double> eta = estimate_cells(map, sol, problem, &scale, options.solver);
-    double s = 0, s_scale = 0;
-    for (std::size_t c = 0; c < eta.size(); ++c) {
-      s += eta[c] * eta[c];
-      s_scale += scale[c] * scale[c];
-    }
-    st.eta = std::sqrt(s);
-    // The residual f + Laplace(u_h) is a difference of two terms of size ~scale:
-    // below kRoundoffResidual * scale it is round-off (u_h solves the problem
-    // exactly, e.g. a solution in the discrete space) and there is nothing to refine.
-    st.eta_at_roundoff = st.eta <= kRoundoffResidual * std::sqrt(s_scale);
-    std::vector<int> marked;
-    if (options.refine == AdaptiveSolveOptions::Refine::Uniform) {
-      marked.resize(eta.size());
-      for (int c = 0; c < static_cast<int>(eta.size()); ++c) marked[c] = c;
-    } else if (!st.eta_at_roundoff) {
-      marked = mark_cells(eta, options.gamma);
-      st.marked = marked.size();
-      marked = refinement_patch(mesh, marked);
-    }
-    if (options.refine == AdaptiveSolveOptions::Refine::Uniform) st.marked = marked.size();
-    st.refined = marked.size();
-    st.seconds = seconds_since(t0);
-    steps.push_back(st);
-    if (callback) callback(st, sol, eta);
-    if (k + 1 < options.steps) {
-      if (marked.empty()) {  // nothing to refine
-        result.stop = st.eta_at_roundoff ? AdaptiveSolveStop::EstimatorAtRoundoff : AdaptiveSolveStop::NothingMarked;
-        break;
-      }
-      mesh = refine_cells(mesh, marked);
-    }
-  }
-  return result;
 }
 
 }  // namespace tspline

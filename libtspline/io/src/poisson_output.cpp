@@ -12,6 +12,7 @@
 #include "toolkit/io/atomic_file.h"
 #include "tspline/io/cell_grid.h"
 #include "tspline/io/convergence_plot.h"
+#include "tspline/io/multipatch_output.h"
 #include "tspline/io/output_files.h"
 
 namespace tspline::io {
@@ -36,28 +37,34 @@ json rate(double e1, double e2, std::size_t n1, std::size_t n2) {
 
 }  // namespace
 
-toolkit::io::VtuMesh solution_vtu(const TSplineMap& map, const PoissonSolution& sol, const PoissonProblem& problem,
+toolkit::io::VtuMesh solution_vtu(const PoissonSolution& sol, const PoissonProblem& problem,
                                   const std::vector<double>& eta, int k) {
-  const TMesh& mesh = sol.space->mesh();
-  std::vector<double> uh, ue, err, cell_eta;
-  toolkit::io::VtuMesh out = cell_grid_vtu(mesh, k, [&](int c, const Eigen::Vector2d& uv) {
-    const SolutionValue v = evaluate_solution(map, sol, c, uv, 0);
-    uh.push_back(v.u);
+  std::vector<toolkit::io::VtuMesh> parts;
+  for (std::size_t p = 0; p < sol.space->num_patches(); ++p) {
+    std::vector<double> uh, ue, err, cell_eta;
+    // Built here if this process does not hold it (a distributed run's rank 0), one patch at a time.
+    const std::shared_ptr<const PatchSpace> space = sol.space->patch_space(p);
+    toolkit::io::VtuMesh part = cell_grid_vtu(space->mesh(), k, [&](int c, const Eigen::Vector2d& uv) {
+      const SolutionValue v = evaluate_solution(sol, p, *space, c, uv, 0);
+      uh.push_back(v.u);
+      if (problem.exact) {
+        const double u = problem.exact(v.x.x(), v.x.y());
+        ue.push_back(u);
+        err.push_back(v.u - u);
+      }
+      return v.x;
+    });
+    const std::size_t offset = sol.space->cell_offset(p);
+    for (int c : part.cell_ints["cell"]) cell_eta.push_back(eta[offset + static_cast<std::size_t>(c)]);
+    part.point_scalars["u_h"] = std::move(uh);
     if (problem.exact) {
-      const double u = problem.exact(v.x.x(), v.x.y());
-      ue.push_back(u);
-      err.push_back(v.u - u);
+      part.point_scalars["u_exact"] = std::move(ue);
+      part.point_scalars["error"] = std::move(err);
     }
-    return v.x;
-  });
-  for (int c : out.cell_ints["cell"]) cell_eta.push_back(eta[c]);
-  out.point_scalars["u_h"] = std::move(uh);
-  if (problem.exact) {
-    out.point_scalars["u_exact"] = std::move(ue);
-    out.point_scalars["error"] = std::move(err);
+    part.cell_scalars["eta"] = std::move(cell_eta);
+    parts.push_back(std::move(part));
   }
-  out.cell_scalars["eta"] = std::move(cell_eta);
-  return out;
+  return merge_patches(parts);
 }
 
 std::string short_solver_name(const SolverStats& s) {
@@ -69,9 +76,8 @@ std::string short_solver_name(const SolverStats& s) {
   return s.kind;
 }
 
-PoissonOutputWriter::PoissonOutputWriter(std::string out_dir, int samples, const TSplineMap& map,
-                                         const PoissonProblem& problem, json report)
-    : out_dir_(std::move(out_dir)), samples_(samples), map_(map), problem_(problem), report_(std::move(report)) {
+PoissonOutputWriter::PoissonOutputWriter(std::string out_dir, int samples, const PoissonProblem& problem, json report)
+    : out_dir_(std::move(out_dir)), samples_(samples), problem_(problem), report_(std::move(report)) {
   report_["steps"] = json::array();
 }
 
@@ -87,14 +93,20 @@ json PoissonOutputWriter::add_step(const PoissonStep& st, const PoissonSolution&
   }
   char name[64];
   std::snprintf(name, sizeof name, "%s/step_%03d.vtu", std::string(output_files::kSolutionFolder).c_str(), st.step);
-  toolkit::io::write_vtu((out / name).string(), solution_vtu(map_, sol, problem_, eta, samples_));
+  toolkit::io::write_vtu((out / name).string(), solution_vtu(sol, problem_, eta, samples_));
   pvd_.push_back({static_cast<double>(st.step), name, 0});
 
+  int max_level = 0;
+  for (std::size_t p = 0; p < sol.space->num_patches(); ++p)
+    max_level = std::max(max_level, sol.space->mesh(p).max_level());
   json rec = {{"step", st.step},
               {"dofs", st.dofs},
               {"interior_dofs", sol.interior_dofs},
               {"cells", st.cells},
-              {"max_level", sol.space->mesh().max_level()},
+              {"max_level", max_level},
+              {"patches", sol.space->num_patches()},
+              {"glued_pairs", sol.space->glued_pairs()},
+              {"max_interface_jump", st.max_interface_jump},
               {"marked", st.marked},
               {"refined", st.refined},
               {"eta", st.eta},

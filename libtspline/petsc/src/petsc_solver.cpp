@@ -139,7 +139,7 @@ bool PetscPoissonSolver::accepts(std::size_t ni) const {
   return ni >= impl_->options.auto_threshold;
 }
 
-std::vector<int> PetscPoissonSolver::begin(const AnalysisSpace& space, const std::vector<int>& dof, int ni) {
+std::vector<int> PetscPoissonSolver::begin(const AnalysisSpace& space, const std::vector<int>& interior, int ni) {
   Impl& m = *impl_;
   m.release();
 #if defined(__GLIBC__)
@@ -149,16 +149,25 @@ std::vector<int> PetscPoissonSolver::begin(const AnalysisSpace& space, const std
   // (mmap'ed) and would not reuse them. Give them back first.
   malloc_trim(0);
 #endif
-  const HierarchicalBasis& basis = space.basis();
-  const int nc = static_cast<int>(space.mesh().num_cells());
+  const int nc = static_cast<int>(space.num_cells());
   const int P = process_count(), R = process_rank();
+  // The interior numbers of the functions of global cell c (-1: Dirichlet).
+  std::vector<int> cell_rows;
+  const auto rows_of = [&](int c) -> const std::vector<int>& {
+    space.cell_dofs(static_cast<std::size_t>(c), cell_rows);
+    for (int& a : cell_rows) a = interior[a];
+    return cell_rows;
+  };
 
   // Owner of interior DOF i: the process whose block of cells
-  // [r nc / P, (r+1) nc / P) holds the first cell of its support.
-  std::vector<int> first_cell(static_cast<std::size_t>(ni), -1);
-  for (int c = 0; c < nc; ++c)
-    for (int a : basis.functions_on_cell(c))
-      if (dof[a] >= 0 && first_cell[dof[a]] < 0) first_cell[dof[a]] = c;
+  // [r nc / P, (r+1) nc / P) holds the first cell of its support. Each
+  // process finds it in its own block (whose patches it holds), the minimum
+  // over the processes is the first cell.
+  std::vector<int> first_cell(static_cast<std::size_t>(ni), std::numeric_limits<int>::max());
+  for (int c = block_start(nc, R, P); c < block_start(nc, R + 1, P); ++c)
+    for (int i : rows_of(c))
+      if (i >= 0 && first_cell[i] > c) first_cell[i] = c;
+  if (P > 1) MPI_Allreduce(MPI_IN_PLACE, first_cell.data(), ni, MPI_INT, MPI_MIN, PETSC_COMM_WORLD);
   std::vector<int> owner(static_cast<std::size_t>(ni));
   std::vector<PetscInt> count(static_cast<std::size_t>(P) + 1, 0);
   {
@@ -188,15 +197,17 @@ std::vector<int> PetscPoissonSolver::begin(const AnalysisSpace& space, const std
   // of K is sum over those cells of their element rows, so the process adds
   // them up itself and no entry is sent to another process; a cell on the
   // border of two processes' rows is computed by both (about 1 % of the cells
-  // with 2 processes at 1e6 DOFs).
+  // with 2 processes at 1e6 DOFs). Those cells lie in the patches this process
+  // holds (the patches of its block and their neighbours: analysis_space.h).
   const PetscInt nloc = m.row_end - m.row_begin;
   std::vector<std::int64_t> start(static_cast<std::size_t>(nloc) + 1, 0);  // own row -> cells (CSR)
   std::vector<int> cells_mine;
   for (int c = 0; c < nc; ++c) {
+    if (!space.holds(space.cell(static_cast<std::size_t>(c)).first)) continue;
     bool mine = false;
-    for (int a : basis.functions_on_cell(c))
-      if (dof[a] >= 0 && own(m.perm[dof[a]])) {
-        ++start[m.perm[dof[a]] - m.row_begin + 1];
+    for (int i : rows_of(c))
+      if (i >= 0 && own(m.perm[i])) {
+        ++start[m.perm[i] - m.row_begin + 1];
         mine = true;
       }
     if (mine) cells_mine.push_back(c);
@@ -206,8 +217,8 @@ std::vector<int> PetscPoissonSolver::begin(const AnalysisSpace& space, const std
   {
     std::vector<std::int64_t> fill(start.begin(), start.end() - 1);
     for (int c : cells_mine)
-      for (int a : basis.functions_on_cell(c))
-        if (dof[a] >= 0 && own(m.perm[dof[a]])) cells[fill[m.perm[dof[a]] - m.row_begin]++] = c;
+      for (int i : rows_of(c))
+        if (i >= 0 && own(m.perm[i])) cells[fill[m.perm[i] - m.row_begin]++] = c;
   }
 
   // Row k's columns: the interior functions of the cells of its support, each
@@ -217,10 +228,10 @@ std::vector<int> PetscPoissonSolver::begin(const AnalysisSpace& space, const std
   const auto row_columns = [&](PetscInt k) {
     cols.clear();
     for (std::int64_t e = start[k]; e < start[k + 1]; ++e)
-      for (int a : basis.functions_on_cell(cells[e])) {
-        if (dof[a] < 0 || mark[dof[a]] == k) continue;
-        mark[dof[a]] = k;
-        cols.push_back(m.perm[dof[a]]);
+      for (int i : rows_of(cells[e])) {
+        if (i < 0 || mark[i] == k) continue;
+        mark[i] = k;
+        cols.push_back(m.perm[i]);
       }
     std::sort(cols.begin(), cols.end());
   };
@@ -453,9 +464,19 @@ SolverStats PetscPoissonSolver::solve(Eigen::VectorXd& u) {
   return st;
 }
 
-std::pair<int, int> PetscPoissonSolver::cell_share(int nc) const {
-  const int P = process_count(), R = process_rank();
-  return {block_start(nc, R, P), block_start(nc, R + 1, P)};
+int PetscPoissonSolver::rank() const { return process_rank(); }
+int PetscPoissonSolver::processes() const { return process_count(); }
+
+std::vector<double> PetscPoissonSolver::gather_to_all(std::span<const double> v) const {
+  const int P = process_count();
+  if (P == 1) return {v.begin(), v.end()};
+  int mine = static_cast<int>(v.size());
+  std::vector<int> counts(static_cast<std::size_t>(P)), starts(static_cast<std::size_t>(P) + 1, 0);
+  MPI_Allgather(&mine, 1, MPI_INT, counts.data(), 1, MPI_INT, PETSC_COMM_WORLD);
+  for (int q = 0; q < P; ++q) starts[q + 1] = starts[q] + counts[q];
+  std::vector<double> all(static_cast<std::size_t>(starts[P]));
+  MPI_Allgatherv(v.data(), mine, MPI_DOUBLE, all.data(), counts.data(), starts.data(), MPI_DOUBLE, PETSC_COMM_WORLD);
+  return all;
 }
 
 void PetscPoissonSolver::sum_over_processes(std::span<double> v) const {

@@ -35,6 +35,30 @@ double RingCurve::snap_to_vertex(double s_in, double eps) const {
   return s;
 }
 
+Eigen::Vector2d RingCurve::direction(double s_in, double dir) const {
+  const auto [i, s] = edge_at(s_in);
+  const std::size_t n = v_.size();
+  std::size_t e = i;  // the edge [e, e + 1] that leaves the point
+  if (dir < 0.0 && s <= arc_[i]) e = (i + n - 1) % n;  // at vertex i, going back: the edge before it
+  const Eigen::Vector2d d = v_[(e + 1) % n] - v_[e];
+  const double len = d.norm();
+  const Eigen::Vector2d u = len > 0.0 ? Eigen::Vector2d(d / len) : Eigen::Vector2d(1.0, 0.0);
+  return dir < 0.0 ? Eigen::Vector2d(-u) : u;
+}
+
+double RingCurve::turn(std::size_t i) const {
+  const std::size_t n = v_.size();
+  const Eigen::Vector2d a = v_[i % n] - v_[(i + n - 1) % n], b = v_[(i + 1) % n] - v_[i % n];
+  return std::atan2(a.x() * b.y() - a.y() * b.x(), a.dot(b));
+}
+
+std::size_t RingCurve::first_vertex_after(double s) const {
+  const double L = length();
+  s = std::fmod(s, L);
+  if (s < 0.0) s += L;
+  return static_cast<std::size_t>(std::upper_bound(arc_.begin(), arc_.end() - 1, s) - arc_.begin());
+}
+
 namespace {
 
 // Distance of p from the segment [a, b].

@@ -241,16 +241,7 @@ class AdaptiveRun {
         rec.control_points_optimized = false;
       }
     }
-    rec.dense_quality = dense_map_quality(map, ad_.dense_samples);
-    // The whole-map minimum is over every point looked at: where a Gauss point
-    // is worse than the dense sample, it is the minimum (at that cell's centre).
-    for (int c = 0; c < static_cast<int>(cells.size()); ++c) {
-      if (cells[c].min_mean_ratio < rec.dense_quality.min_mean_ratio) {
-        rec.dense_quality.min_mean_ratio = cells[c].min_mean_ratio;
-        rec.dense_quality.worst_at = 0.5 * (f_.mesh.cell_min(c) + f_.mesh.cell_max(c));
-      }
-      rec.dense_quality.min_scaled = std::min(rec.dense_quality.min_scaled, cells[c].min_scaled);
-    }
+    rec.dense_quality = whole_map_quality(map, cells);
     t_check_ += seconds_since(t2);
     {
       std::ostringstream s;
@@ -277,6 +268,55 @@ class AdaptiveRun {
       on_iteration_(round_, f_.mesh, x, map, cells);
     }
     return quality;
+  }
+
+  // The whole-map minimum is over every point looked at: the dense sample, and
+  // where a Gauss point is worse, that (at its cell's centre).
+  DenseMapQuality whole_map_quality(const TSplineMap& map, const std::vector<CellMapQuality>& cells) const {
+    DenseMapQuality q = dense_map_quality(map, ad_.dense_samples);
+    for (int c = 0; c < static_cast<int>(cells.size()); ++c) {
+      if (cells[c].min_mean_ratio < q.min_mean_ratio) {
+        q.min_mean_ratio = cells[c].min_mean_ratio;
+        q.worst_at = 0.5 * (f_.mesh.cell_min(c) + f_.mesh.cell_max(c));
+      }
+      q.min_scaled = std::min(q.min_scaled, cells[c].min_scaled);
+    }
+    return q;
+  }
+
+  // More quality stages for the map kept where it is certified but poor
+  // (AdaptiveOptions::polish_below); kept only if its whole-map J_r rises.
+  void polish() {
+    Snapshot& b = *best_;
+    if (!ad_.optimize_control_points || ad_.polish_stages <= 0 || b.dense.min_mean_ratio >= ad_.polish_below) return;
+    if (ad_.certify && !b.certification.certified_valid()) return;
+    const auto t1 = std::chrono::steady_clock::now();
+    MapUntanglingOptions uo = untangling_options();
+    uo.max_quality_stages = ad_.polish_stages;
+    uo.quality_power = ad_.polish_power;
+    TSplineMap map = b.map;
+    const MapUntanglingReport u = untangle_map(map, uo);
+    t_untangle_ += seconds_since(t1);
+    if (ad_.certify && !u.certified) return;
+    const auto t2 = std::chrono::steady_clock::now();
+    std::vector<CellMapQuality> cells;
+    const MapQualityStats quality = map_quality(map, ad_.gauss, &cells);
+    const DenseMapQuality dense = whole_map_quality(map, cells);
+    t_check_ += seconds_since(t2);
+    std::ostringstream s;
+    s << "polish: " << u.stages << " more quality stages, whole-map J_r " << b.dense.min_mean_ratio << " -> "
+      << dense.min_mean_ratio;
+    if (!(dense.min_mean_ratio > b.dense.min_mean_ratio && quality.nonpositive_det == 0)) {
+      log("polish", s.str() + ": not kept");
+      return;
+    }
+    log("polish", s.str());
+    b.map = std::move(map);
+    b.quality = quality;
+    b.dense = dense;
+    b.cells = std::move(cells);
+    if (ad_.certify) b.certification = u.certification;
+    b.optimized = true;
   }
 
   MapUntanglingOptions untangling_options() const {
@@ -372,6 +412,7 @@ class AdaptiveRun {
 
   // The kept iteration; its physical T-mesh is the image of the T-mesh under the map.
   void keep_best() {
+    polish();
     r_.kept_iteration = best_it_;
     f_.mesh = std::move(best_->mesh);
     r_.map.emplace(std::move(best_->map));

@@ -44,6 +44,8 @@ void validate_options(const AdaptiveOptions& ad) {
     fail("--min-jacobian must be in (0, 1], got " + str(ad.min_jacobian));
   if (ad.max_adapt < 0) fail("--max-adapt must be >= 0, got " + std::to_string(ad.max_adapt));
   if (ad.max_cells < 1) fail("--max-cells must be >= 1");
+  if (ad.polish_stages < 0 || !(ad.polish_power >= 1.0) || !std::isfinite(ad.polish_below))
+    fail("polish: polish_stages must be >= 0, polish_power >= 1 and polish_below finite");
   if (ad.gauss < 1 || ad.gauss > 6) fail("Gauss points per direction (gauss) must be in [1, 6], got " +
                                          std::to_string(ad.gauss));
   if (ad.dense_samples < 1 || ad.dense_samples > 64)

@@ -10,10 +10,14 @@
 //  3. the boundary nodes go back onto the true rings (a quad edge along the
 //     boundary becomes the ring's own polyline between its two nodes, at the
 //     same fraction of arc length as of the chord);
-//  4. checks on the true geometry: every inner node inside the domain, no inner
+//  4. the layout optimized for its patch maps: K* untangling of the inner
+//     nodes (layout_kstar.h), then every node moved to raise the worst patch
+//     corners as the maps see them (layout_optimizer.h, layout_quality.h), and
+//     edge rotations where quads stay poor (layout_topology.h);
+//  5. checks on the true geometry: every inner node inside the domain, no inner
 //     quad edge crossing a ring, the straight rings simple; where one fails,
 //     the ring pieces involved get a node more and the mesh is made again;
-//  5. the quads are the patches (patch_layout.h): the inner edges are the cuts,
+//  6. the quads are the patches (patch_layout.h): the inner edges are the cuts,
 //     the quad corners the patch corners.
 #include <Eigen/Core>
 #include <array>
@@ -47,12 +51,16 @@ struct QuadLayoutStats {
   double mean_corner_scaled_jacobian = 1.0;
   int repair_rounds = 0;
   std::size_t pillowed_rings = 0;            ///< rings given a layer of quads (a flat single-quad corner)
-  /// How far the layout was optimized: 3 all (edge rotations of flat corners
-  /// and sharp tips, smoothing, sliding, worst corners), 2 without the
-  /// rotations, 1 smoothing and sliding,
-  /// 0 the mesher's own nodes (a level is dropped where it tangles the layout
-  /// or turns a patch corner reflex).
-  int optimization_level = 3;
+  /// How far the layout was optimized: 2 all (node optimization and edge
+  /// rotations, layout_optimizer.h and layout_topology.h), 1 nodes only, 0 the
+  /// mesher's own nodes (a level is dropped where it leaves a patch corner
+  /// outside 1-170 degrees or the cuts crossing).
+  int optimization_level = 2;
+  std::size_t rotations = 0;       ///< edge rotations kept
+  int optimization_sweeps = 0;     ///< node optimization sweeps, all passes
+  /// The worst patch corner as the patch maps see it (layout_quality.h): J_r
+  /// and the scaled Jacobian there, upper bounds of the map's whole-map figures.
+  double corner_mean_ratio = 1.0, corner_scaled_jacobian = 1.0;
   double min_size = 0.0, max_size = 0.0;     ///< of the size field, absolute
   double seconds = 0.0;
 };

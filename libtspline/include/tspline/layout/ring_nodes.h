@@ -41,6 +41,15 @@ class RingCurve {
   /// (so that a node never lies a hair's breadth from a vertex: the patch
   /// polygon would have a needle edge there), else s; in [0, length).
   double snap_to_vertex(double s, double eps) const;
+  /// Unit direction in which the ring leaves the point at arc length s going
+  /// forward (dir > 0: the edge after s) or backward (dir < 0: the edge before
+  /// s, reversed); at a vertex the two differ.
+  Eigen::Vector2d direction(double s, double dir) const;
+  /// Signed turn at vertex i in (-pi, pi], counter-clockwise positive.
+  double turn(std::size_t i) const;
+  /// Index of the first vertex with arc length strictly greater than s (mod
+  /// length), in [0, size()]; size() wraps to vertex 0 of the next lap.
+  std::size_t first_vertex_after(double s) const;
 
  private:
   /// The edge i with arc(i) <= s < arc(i + 1), and s reduced to [0, length).

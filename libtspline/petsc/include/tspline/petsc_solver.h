@@ -9,8 +9,10 @@
 // and finalizes PETSc (PetscInitialize / PetscFinalize; the tspline program does
 // it in apps/petsc_session.h). No I/O: errors are exceptions (tspline/errors.h).
 //
-// Distribution. Every process holds the whole analysis space (T-mesh and
-// basis). The cells are split into contiguous blocks [r nc / P, (r+1) nc / P).
+// Distribution. Every process holds the analysis spaces of the patches that
+// its block of cells touches and of their neighbours (analysis_space.h; all
+// of a single patch). The global cells are split into contiguous blocks
+// [r nc / P, (r+1) nc / P).
 // The matrix rows are distributed by ranges of a renumbering of the interior
 // DOFs: a DOF belongs to the process whose block holds the first cell (lowest
 // cell number) of its support, and the DOFs are numbered process by process.
@@ -108,13 +110,16 @@ class PetscPoissonSolver final : public InteriorSystemSolver {
   PetscPoissonSolver& operator=(const PetscPoissonSolver&) = delete;
 
   bool accepts(std::size_t ni) const override;
-  std::vector<int> begin(const AnalysisSpace& space, const std::vector<int>& dof, int ni) override;
+  std::vector<int> begin(const AnalysisSpace& space, const std::vector<int>& interior, int ni) override;
   void add_cell(std::span<const int> rows, const Eigen::MatrixXd& Kloc, const Eigen::VectorXd& floc) override;
   bool end_assembly(bool ok) override;
   /// \throw NumericalError if CG does not reach rtol within max_iterations (or diverges).
   SolverStats solve(Eigen::VectorXd& u) override;
-  /// Process r of P: the cells [r nc / P, (r+1) nc / P) (its assembly block).
-  std::pair<int, int> cell_share(int nc) const override;
+  /// This process in PETSC_COMM_WORLD.
+  int rank() const override;
+  int processes() const override;
+  /// MPI_Allgatherv over PETSC_COMM_WORLD.
+  std::vector<double> gather_to_all(std::span<const double> v) const override;
   /// MPI_Allreduce over PETSC_COMM_WORLD.
   void sum_over_processes(std::span<double> v) const override;
   void max_over_processes(std::span<double> v) const override;

@@ -1,7 +1,9 @@
 #pragma once
-// The adaptive loop of the IGA Poisson solver: solve (poisson_solver.h),
-// estimate (poisson_estimator.h), mark the cells with eta_e > gamma max eta and
-// split them with their refinement patch, or split every cell (uniform), repeat.
+// The adaptive loop of the IGA Poisson solver, for maps of 1 to n patches:
+// solve (poisson_solver.h), estimate (poisson_estimator.h), mark the cells
+// with eta_e > gamma max eta over all patches and split them with their
+// refinement patch, or split every cell (uniform), make the interfaces
+// conforming again (refine_conforming), repeat.
 #include <cstddef>
 #include <functional>
 #include <string>
@@ -17,14 +19,14 @@ struct AdaptiveSolveOptions {
   Refine refine = Refine::Adaptive;
   int steps = 5;                ///< number of solves (>= 1)
   double gamma = 0.5;           ///< marking parameter in [0,1]
-  std::size_t max_dofs = 200000;  ///< stop before a solve on a space with more DOFs
+  std::size_t max_dofs = 200000;  ///< stop before assembling a space with more DOFs (steps after the first)
   InteriorSystemSolver* solver = nullptr;  ///< external solver (see solve_poisson); not owned
 };
 
 struct PoissonStep {
   int step = 0;
-  std::size_t dofs = 0;
-  std::size_t cells = 0;
+  std::size_t dofs = 0;   ///< global DOFs (glued across interfaces)
+  std::size_t cells = 0;  ///< analysis cells of every patch
   double eta = 0.0;  ///< sqrt(sum eta_e^2)
   bool has_errors = false;
   PoissonErrors errors;
@@ -34,9 +36,11 @@ struct PoissonStep {
   std::size_t marked = 0;   ///< cells marked by the estimator (all cells for uniform refinement)
   std::size_t refined = 0;  ///< cells split for the next step (marked cells and their refinement patch)
   bool eta_at_roundoff = false;  ///< estimator below kRoundoffResidual of its scale: nothing refined
+  double max_interface_jump = 0.0;  ///< interface_jump (0 for one patch)
 };
 
-/// Called after each step with its record, the solution and the per-cell eta.
+/// Called after each step with its record, the solution and the per-cell eta
+/// (global cell numbering of the step's AnalysisSpace).
 using PoissonStepCallback =
     std::function<void(const PoissonStep&, const PoissonSolution&, const std::vector<double>& eta)>;
 
@@ -56,8 +60,12 @@ struct AdaptiveSolveResult {
   AdaptiveSolveStop stop = AdaptiveSolveStop::AllSteps;
 };
 
-/// Solve, estimate, mark (adaptive) or split all cells (uniform), repeat.
-/// \throw InputError for bad options (steps < 1, gamma outside [0,1]).
+/// Solve, estimate, mark (adaptive) or split all cells (uniform), repeat, on
+/// the map of `geometry` (any number of patches), starting from its geometry
+/// T-meshes. \throw InputError for bad options (steps < 1, gamma outside [0,1]).
+AdaptiveSolveResult solve_adaptive(const AnalysisGeometry& geometry, const PoissonProblem& problem,
+                                   const AdaptiveSolveOptions& options, const PoissonStepCallback& callback = {});
+/// The same on a single map.
 AdaptiveSolveResult solve_adaptive(const TSplineMap& map, const PoissonProblem& problem,
                                    const AdaptiveSolveOptions& options, const PoissonStepCallback& callback = {});
 

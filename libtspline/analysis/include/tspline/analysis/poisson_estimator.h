@@ -13,11 +13,12 @@
 
 namespace tspline {
 
-/// eta_e per analysis cell (not squared). If eta_scale is given it receives per
+/// eta_e per analysis cell (not squared; global cell numbering of
+/// AnalysisSpace, every patch). If eta_scale is given it receives per
 /// cell h_e (||f||^2 + ||Laplace u_h||^2)^{1/2} over the cell's image: the size of
 /// the two terms whose sum is the residual, to recognize a residual at round-off.
 /// With `distributed`, as compute_errors: each process its share, every process gets all cells.
-std::vector<double> estimate_cells(const TSplineMap& map, const PoissonSolution& sol, const PoissonProblem& problem,
+std::vector<double> estimate_cells(const PoissonSolution& sol, const PoissonProblem& problem,
                                    std::vector<double>* eta_scale = nullptr,
                                    const InteriorSystemSolver* distributed = nullptr);
 
@@ -25,8 +26,8 @@ std::vector<double> estimate_cells(const TSplineMap& map, const PoissonSolution&
 /// the adaptive loop then refines nothing. (Discrete solutions measure ~1e-15.)
 inline constexpr double kRoundoffResidual = 1e-10;
 
-/// The cells to split for the marked cells: each marked cell and every leaf at
-/// most as fine that touches it (edge or corner). Splitting a cell alone adds no
+/// The cells to split for the marked cells of one patch's T-mesh: each marked
+/// cell and every leaf at most as fine that touches it (edge or corner). Splitting a cell alone adds no
 /// hierarchical B-spline: a level-(l+1) function needs 4x4 level-(l+1) cells, i.e.
 /// 2x2 split level-l cells; the 3x3 patch around a marked cell adds nine.
 std::vector<int> refinement_patch(const TMesh& mesh, const std::vector<int>& marked);

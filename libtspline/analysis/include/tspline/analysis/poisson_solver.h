@@ -7,12 +7,13 @@
 //
 //   -Laplace(u) = f in Omega = S([0,1]^2),   u = g on the boundary of Omega.
 //
-// Analysis space: cubic hierarchical B-splines (hierarchical_basis.h) on an
-// ANALYSIS T-mesh. It starts equal to the geometry's T-mesh and is refined
-// independently; the geometry map S stays the one of the parameterization, so
-// the method is NOT isoparametric (as in the paper). Every analysis cell lies
-// inside one geometry cell, located once per cell, so that S and its derivatives
-// are evaluated with the geometry cell's function list.
+// Analysis space (analysis_space.h): on a map of 1 to n patches, cubic
+// hierarchical B-splines (hierarchical_basis.h) per patch on an ANALYSIS
+// T-mesh, glued C0 across the interfaces (one unknown per glued pair). The
+// analysis T-meshes start as the geometry's T-meshes refined to their Bezier
+// elements (AnalysisGeometry::meshes) and are refined independently; the geometry map S stays the one of the parameterization, so
+// the method is NOT isoparametric (as in the paper). A single map is the case
+// of one patch; there is no other path.
 // Deviation from the paper (which uses the T-spline blending functions of the
 // analysis T-mesh): on T-meshes with hanging vertices those do not reproduce
 // linear functions and are not nested under refinement, which costs the
@@ -27,14 +28,15 @@
 //    bezier_extraction.h), so that S is smooth on every piece; the analysis
 //    functions are polynomial on the whole cell. grad_x R = J^{-T} grad_xi R,
 //    weight |det J|.
-//  * Dirichlet data by L2 PROJECTION on the border: the boundary functions B are
-//    those that do not vanish on the border of [0,1]^2 (HierarchicalFunction::
-//    on_border); their coefficients solve  sum_{b in B} c_b <R_b, R_a> = <g o S, R_a>,
-//    a in B, with <u, v> the integral over the border of the parameter square
-//    (parametric arc length, 5 Gauss points per border cell edge, exact for the
-//    mass matrix). Interior functions vanish on the border, so they do not
-//    enter. Those DOFs are then eliminated (lifted into the right-hand side); the
-//    interior system is symmetric positive definite.
+//  * Dirichlet data by L2 PROJECTION on the domain's boundary: the Dirichlet
+//    DOFs B are the global functions non-zero on a patch side that is not an
+//    interface (AnalysisSpace::is_dirichlet); their coefficients solve
+//    sum_{b in B} c_b <R_b, R_a> = <g, R_a>, a in B, with <u, v> the integral
+//    over those sides with PHYSICAL arc length (5 Gauss points per border cell
+//    edge), so that a DOF shared by two patches gets one value whatever their
+//    parameterizations. The other functions vanish there. Those DOFs are then
+//    eliminated (lifted into the right-hand side); the interior system is
+//    symmetric positive definite.
 //  * Solve: CHOLMOD's supernodal Cholesky (SuiteSparse); if it fails, Eigen's
 //    SimplicialLDLT; if that fails too, conjugate gradients
 //    with an incomplete Cholesky preconditioner. Or, when an InteriorSystemSolver
@@ -47,6 +49,7 @@
 // differences with the absolute step kGradientStep (error ~ step^2 |u'''|/6 plus
 // round-off ~ eps |u| / step).
 //
+// Cells are visited in the global numbering of AnalysisSpace (patch by patch).
 // Errors and estimator (poisson_estimator.h) evaluate u_h and S per cell from
 // the univariate B-spline factors tabulated at the distinct quadrature
 // coordinates (the values of evaluate_solution()); with a distributed solver
@@ -55,6 +58,7 @@
 
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
+#include <cstdint>
 #include <functional>
 #include <memory>
 #include <span>
@@ -62,7 +66,7 @@
 #include <utility>
 #include <vector>
 
-#include "tspline/analysis/hierarchical_basis.h"
+#include "tspline/analysis/analysis_space.h"
 #include "tspline/spline/tspline_map.h"
 #include "tspline/tmesh/tmesh.h"
 
@@ -80,23 +84,6 @@ struct PoissonProblem {
   ScalarField g;               ///< Dirichlet data (required)
   ScalarField exact;           ///< exact solution (optional: enables errors)
   VectorField exact_gradient;  ///< its gradient (optional: central differences if absent)
-};
-
-/// The analysis space: T-mesh, its basis, and per analysis cell its geometry cell.
-class AnalysisSpace {
- public:
-  /// \pre analysis_mesh has topology and refines map.mesh() (each cell inside one
-  /// geometry cell). \throw InputError otherwise.
-  AnalysisSpace(const TSplineMap& map, TMesh analysis_mesh);
-  const TMesh& mesh() const { return *mesh_; }
-  const HierarchicalBasis& basis() const { return *basis_; }
-  int geometry_cell(int c) const { return geometry_cell_[c]; }
-  std::size_t num_dofs() const { return basis_->size(); }
-
- private:
-  std::unique_ptr<TMesh> mesh_;  // heap: the basis keeps a pointer to it
-  std::unique_ptr<HierarchicalBasis> basis_;
-  std::vector<int> geometry_cell_;
 };
 
 struct SolverStats {
@@ -117,11 +104,12 @@ class InteriorSystemSolver {
   virtual ~InteriorSystemSolver() = default;
   /// Whether it solves a system of ni unknowns; if not, the built-in direct solver does.
   virtual bool accepts(std::size_t ni) const = 0;
-  /// Starts the system: dof[a] = interior number of basis function a (-1 for a
-  /// Dirichlet function), ni unknowns. Returns the cells this process
-  /// assembles, ascending (a distributed solver may ask two processes for the
-  /// same cell, each keeping the rows it owns).
-  virtual std::vector<int> begin(const AnalysisSpace& space, const std::vector<int>& dof, int ni) = 0;
+  /// Starts the system: interior[g] = interior number of global DOF g of the
+  /// space (-1 for a Dirichlet DOF), ni unknowns. Returns the global cells
+  /// (AnalysisSpace numbering) this process assembles, ascending (a
+  /// distributed solver may ask two processes for the same cell, each keeping
+  /// the rows it owns).
+  virtual std::vector<int> begin(const AnalysisSpace& space, const std::vector<int>& interior, int ni) = 0;
   /// One cell's contribution: rows[k] = interior number of the cell's k-th
   /// function (-1: Dirichlet, to be ignored); Kloc its element stiffness matrix
   /// (LOWER triangle filled, K(r, s) for r >= s); floc its load with the
@@ -133,9 +121,20 @@ class InteriorSystemSolver {
   /// Solves; u receives all ni interior values (on every process). \throw
   /// NumericalError if the solve does not converge.
   virtual SolverStats solve(Eigen::VectorXd& u) = 0;
-  /// The share [first, last) of nc cells whose error and estimator terms this
-  /// process computes (compute_errors, estimate_cells); default: all of them.
-  virtual std::pair<int, int> cell_share(int nc) const { return {0, nc}; }
+  /// This process and the number of processes (default: 0 of 1); the spaces
+  /// of the adaptive loop are distributed accordingly (analysis_space.h).
+  virtual int rank() const { return 0; }
+  virtual int processes() const { return 1; }
+  /// The share [first, last) of nc cells whose error, estimator and Dirichlet
+  /// terms this process computes: AnalysisSpace::block(rank()).
+  std::pair<int, int> cell_share(int nc) const {
+    const auto share = [&](int r) {
+      return static_cast<int>(static_cast<std::int64_t>(nc) * r / processes());
+    };
+    return {share(rank()), share(rank() + 1)};
+  }
+  /// Every process's v, concatenated in rank order, on every process (collective).
+  virtual std::vector<double> gather_to_all(std::span<const double> v) const { return {v.begin(), v.end()}; }
   /// Sums (or takes the maximum of) v element-wise over the processes, in place,
   /// the result on every process (collective); default: one process, v stays.
   virtual void sum_over_processes(std::span<double> v) const { (void)v; }
@@ -144,7 +143,7 @@ class InteriorSystemSolver {
 
 struct PoissonSolution {
   std::shared_ptr<const AnalysisSpace> space;
-  Eigen::VectorXd coefficients;        ///< one per basis function (size space->num_dofs())
+  Eigen::VectorXd coefficients;        ///< one per global DOF (size space->num_dofs())
   std::vector<bool> is_boundary;       ///< Dirichlet DOFs
   std::size_t interior_dofs = 0;       ///< unknowns of the solved system
   SolverStats solver;
@@ -168,21 +167,24 @@ struct SolutionValue {
 Eigen::Matrix2d physical_hessian(const Eigen::Vector2d& grad_x, const Eigen::Matrix2d& hessian_xi,
                                  const MapDerivatives& d);
 
-/// Solves the problem on the given analysis T-mesh (a refinement of map.mesh()).
+/// Solves the problem on a space; with an external solver of the interior
+/// system (null: the built-in direct solver), used if it accepts the number of unknowns.
 /// \throw InputError if f or g are missing or produce a non-finite value;
-/// NumericalError if the Dirichlet system or both solvers fail.
+/// NumericalError if the Dirichlet system or the solvers fail.
+PoissonSolution solve_poisson(std::shared_ptr<const AnalysisSpace> space, const PoissonProblem& problem,
+                              InteriorSystemSolver* solver = nullptr);
+/// Same on a single map and its analysis T-mesh (a refinement of map.mesh()).
 PoissonSolution solve_poisson(const TSplineMap& map, const TMesh& analysis_mesh, const PoissonProblem& problem);
-/// Same on an already built analysis space (built with the same map).
-PoissonSolution solve_poisson(const TSplineMap& map, std::shared_ptr<const AnalysisSpace> space,
-                              const PoissonProblem& problem);
-/// Same, with an external solver of the interior system (null: the built-in
-/// direct solver); it is used if it accepts the number of unknowns.
-PoissonSolution solve_poisson(const TSplineMap& map, std::shared_ptr<const AnalysisSpace> space,
-                              const PoissonProblem& problem, InteriorSystemSolver* solver);
 
-/// u_h at parametric point uv of analysis cell c (order 0, 1 or 2).
-SolutionValue evaluate_solution(const TSplineMap& map, const PoissonSolution& sol, int c, const Eigen::Vector2d& uv,
+/// u_h at parametric point uv of analysis cell c of patch p (order 0, 1 or 2).
+SolutionValue evaluate_solution(const PoissonSolution& sol, std::size_t p, int c, const Eigen::Vector2d& uv,
                                 int order = 1);
+/// u_h at parametric point uv of patch p (the cell located first).
+SolutionValue evaluate_solution(const PoissonSolution& sol, std::size_t p, const Eigen::Vector2d& uv, int order = 0);
+/// The same with patch p's space given (AnalysisSpace::patch_space: also for
+/// a patch this process does not hold).
+SolutionValue evaluate_solution(const PoissonSolution& sol, std::size_t p, const PatchSpace& space, int c,
+                                const Eigen::Vector2d& uv, int order = 1);
 
 struct PoissonErrors {
   double l2 = 0.0;             ///< ||u - u_h||_L2
@@ -195,7 +197,13 @@ struct PoissonErrors {
 /// \throw InputError if problem.exact is missing. With `distributed` (collective
 /// then), each process integrates its cell_share() and the sums are combined
 /// over the processes (the same result up to the order of the additions).
-PoissonErrors compute_errors(const TSplineMap& map, const PoissonSolution& sol, const PoissonProblem& problem,
+PoissonErrors compute_errors(const PoissonSolution& sol, const PoissonProblem& problem,
                              const InteriorSystemSolver* distributed = nullptr);
+
+/// The largest difference of u_h between the two sides of the interfaces,
+/// sampled at 33 points per cut (0 without interfaces): round-off on a
+/// conforming glued space. With `distributed` (collective then), each process
+/// samples the interfaces of the patches of its block of cells.
+double interface_jump(const PoissonSolution& sol, const InteriorSystemSolver* distributed = nullptr);
 
 }  // namespace tspline

@@ -16,10 +16,11 @@
 
 namespace tspline::io {
 
-/// The solution sampled per analysis cell with k x k sub-quads. Point data
-/// u_h (and u_exact, error = u_h - u_exact if the problem has an exact
-/// solution); cell data eta, cell, level.
-toolkit::io::VtuMesh solution_vtu(const TSplineMap& map, const PoissonSolution& sol, const PoissonProblem& problem,
+/// The solution sampled per analysis cell of every patch with k x k
+/// sub-quads. Point data u_h (and u_exact, error = u_h - u_exact if the
+/// problem has an exact solution); cell data eta, cell (of its patch), level,
+/// patch. `eta`: per global cell (AnalysisSpace numbering).
+toolkit::io::VtuMesh solution_vtu(const PoissonSolution& sol, const PoissonProblem& problem,
                                   const std::vector<double>& eta, int k);
 
 /// A short name of the solver of a step ("CHOLMOD", "CG+BoomerAMG", ...).
@@ -29,8 +30,7 @@ class PoissonOutputWriter {
  public:
   /// `report`: the run's description (command, input, options, problem, ...);
   /// the writer adds "steps" and "finished". Nothing is written before add_step.
-  PoissonOutputWriter(std::string out_dir, int samples, const TSplineMap& map, const PoissonProblem& problem,
-                      nlohmann::json report);
+  PoissonOutputWriter(std::string out_dir, int samples, const PoissonProblem& problem, nlohmann::json report);
 
   /// Writes the step's .vtu (creating the folder on the first step) and
   /// rewrites the tables. peak_mib: peak resident memory of every process so
@@ -54,7 +54,6 @@ class PoissonOutputWriter {
  private:
   std::string out_dir_;
   int samples_;
-  const TSplineMap& map_;
   const PoissonProblem& problem_;
   nlohmann::json report_;
   std::vector<PoissonStep> steps_;

@@ -1,0 +1,57 @@
+#pragma once
+// Node positions of a quad layout that its patch maps can live with: every
+// node moved (inner nodes in the plane, ring nodes along their ring between
+// their ring neighbours) to raise the worst corners of the layout as the
+// patch maps see them (layout_quality.h), the topology kept.
+//
+// Per corner with side vectors e1 = t1 L1, e2 = t2 L2 the energy is
+//     E = 1 / J_r + 1 / SJ = (|e1| + |e2|)^2 / (2 chi(det, eps)),
+// chi(D, eps) = (D + sqrt(eps^2 + D^2)) / 2 the regularization of Garanzha et
+// al. (2021) (so that a folded start can be unfolded; eps = 1e-4 |e|^2), and
+// a ring vertex inside a side with figure k = sin(phi / 2) adds 2 / k. Nodes
+// move one at a time (nonlinear Gauss-Seidel) to lower the sum of E^p over the
+// corners they touch (p = 4: close to the worst corner, yet smooth): inner
+// nodes by a pattern search in eight directions with a step kept per node,
+// ring nodes by sampling their arc (every ring vertex in reach, where the
+// corner angles jump, and a uniform grid, then a local refinement). A move is
+// kept only if `admissible` accepts it (the caller's check of the true
+// geometry: inner nodes inside the domain, no cut crossing a ring).
+#include <functional>
+#include <vector>
+
+#include "tspline/layout/layout_mesh.h"
+#include "tspline/layout/layout_quality.h"
+
+namespace tspline {
+
+struct LayoutOptimizationOptions {
+  int max_sweeps = 60;
+  double power = 4.0;
+  /// Stop when a sweep lowers no node's local energy by more than this, relatively.
+  double tolerance = 1e-4;
+  /// ... or when the worst corner's J_r has not risen by 0.1 % for this many sweeps.
+  int stall_sweeps = 8;
+  int ring_samples = 24;  ///< uniform samples of a ring node's reach (plus its vertices, at most max_ring_vertices)
+  int max_ring_vertices = 160;
+};
+
+struct LayoutOptimizationReport {
+  LayoutCornerQuality before, after;  ///< worst over the quads (layout_quality.h)
+  int sweeps = 0;
+  std::size_t moves = 0;
+};
+
+/// The worst corner and kink over all quads.
+LayoutCornerQuality worst_layout_quality(const LayoutMesh& m, const LayoutTopology& t, const LayoutQuality& q);
+
+using LayoutAdmissible = std::function<bool(const LayoutMesh&, const LayoutTopology&, int)>;
+
+/// \param admissible whether node n may stay where it now is (called after a
+/// tentative move that lowers the energy).
+/// \param active the nodes that may move (empty: all); the report's figures
+/// are then over the quads around them.
+LayoutOptimizationReport optimize_layout_nodes(LayoutMesh& m, const LayoutQuality& quality,
+                                               const LayoutAdmissible& admissible, const std::vector<int>& active = {},
+                                               const LayoutOptimizationOptions& options = {});
+
+}  // namespace tspline

@@ -1,0 +1,57 @@
+#pragma once
+// Topological improvement of a quad layout: edge rotations where node moves
+// alone cannot raise the worst corners.
+//
+// Two quads sharing an inner edge form a hexagon h0..h5 (the edge is h0-h3);
+// it can be split into two quads by either of the other two diagonals, h1-h4
+// or h2-h5 (Kinney, "CleanUp: improving quadrilateral finite element meshes",
+// 1997; the same move walks a flat single-quad corner along a ring or gives a
+// reflex coastal tip the cut it needs: a ring node whose domain angle phi is
+// split into k corners gets phi / k each, SJ <= sin(phi / k)). A rotation is
+// kept where, after the nodes around it are optimized again
+// (layout_optimizer.h), the worst quad around it is better than before; inner
+// nodes keep valence >= 3, and no edge is doubled.
+#include <cstddef>
+#include <functional>
+#include <vector>
+
+#include "tspline/layout/layout_mesh.h"
+#include "tspline/layout/layout_quality.h"
+
+namespace tspline {
+
+struct LayoutRotationOptions {
+  /// Quads whose figure (min of J_r and the side shape, layout_quality.h) is
+  /// below this are where rotations are tried.
+  double target = 0.45;
+  int rounds = 4;
+  int local_sweeps = 10;  ///< optimizer sweeps over the nodes of a tried rotation and their neighbours
+};
+
+struct LayoutRotationReport {
+  std::size_t tried = 0, kept = 0;
+  std::vector<int> moved;  ///< the nodes re-optimized around kept rotations
+};
+
+/// The rings with a ring node that is the corner of one quad only where the
+/// ring is nearly straight (inner angle above 150 degrees at any of the
+/// corner's scales, layout_quality.h) or reflex: a patch corner of about 180
+/// degrees or more, where no map is valid (det J at a corner of the square is
+/// the cross product of the two boundary tangents).
+std::vector<char> rings_with_flat_corners(const LayoutMesh& m, const LayoutQuality& quality);
+
+/// Pillows the rings marked: every node of such a ring moves a third of the
+/// way inside, a copy takes its place on the ring, and each quad edge along
+/// the ring gets a new quad between the two (a conforming layer; every ring
+/// node then has two quads). Returns the rings pillowed.
+std::size_t pillow_rings(LayoutMesh& m, const std::vector<char>& rings);
+
+/// The figure of quad q used to rank layouts: min(J_r, side shape) over its corners and sides.
+double layout_quad_figure(const LayoutMesh& m, const LayoutTopology& t, const LayoutQuality& Q, int q);
+
+/// \param admissible as for optimize_layout_nodes.
+LayoutRotationReport rotate_layout_edges(LayoutMesh& m, const LayoutQuality& Q,
+                                         const std::function<bool(const LayoutMesh&, const LayoutTopology&, int)>& admissible,
+                                         const LayoutRotationOptions& options = {});
+
+}  // namespace tspline

@@ -1,0 +1,270 @@
+#include "tspline/layout/layout_optimizer.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numbers>
+
+namespace tspline {
+namespace {
+
+double cross(const Eigen::Vector2d& a, const Eigen::Vector2d& b) { return a.x() * b.y() - a.y() * b.x(); }
+
+// x^p, by multiplication for the powers used (std::pow was a seventh of the layout's time).
+double power(double x, double p) {
+  if (p == 1.0) return x;
+  if (p == 4.0) {
+    const double x2 = x * x;
+    return x2 * x2;
+  }
+  return std::pow(x, p);
+}
+
+// The energy of one quad: its corners and side kinks, each E^p; eps_rel: the
+// regularization relative to |e1| |e2|.
+double quad_energy(const LayoutMesh& m, const LayoutTopology& t, const LayoutQuality& Q, int q, double p,
+                   double eps_rel) {
+  double sum = 0.0;
+  for (int j = 0; j < 4; ++j) {
+    double e = 0.0;  // the worst over the scales
+    for (const double scale : LayoutQuality::corner_scales) {
+      const auto [e1, e2] = Q.corner_vectors(m, t, q, j, scale);
+      const double det = cross(e1, e2);
+      const double n1 = e1.norm(), n2 = e2.norm();
+      const double s = n1 + n2;
+      if (!(n1 > 0.0 && n2 > 0.0)) return std::numeric_limits<double>::infinity();
+      const double eps = eps_rel * n1 * n2;
+      const double chi = 0.5 * (det + std::sqrt(eps * eps + det * det));
+      e = std::max(e, s * s / (2.0 * chi));
+      if (m.ring[m.quads[q][j]] < 0) break;  // cuts only: one scale
+    }
+    sum += power(e, p);
+    const double k = Q.side_kinks(m, t, q, j);
+    if (k < 1.0) sum += power(2.0 / std::max(k, 1e-9), p);
+    const double g = Q.side_shape(m, t, q, j);
+    if (g < 1.0) sum += power(2.0 / std::max(g, 1e-9), p);
+  }
+  return sum;
+}
+
+// Ring node n slid along its ring, between its two ring neighbours, to where
+// `local` (its energy) is least: every ring vertex in reach (where the corner
+// angles jump; the nearest max_ring_vertices), a uniform grid, then a local
+// refinement. `best` is the energy where it stands on entry, the energy
+// where it ends on return.
+template <class Local>
+void slide_ring_node(LayoutMesh& m, const LayoutTopology& t, const LayoutQuality& Q, int n, const Local& local,
+                     const LayoutAdmissible& admissible, const LayoutOptimizationOptions& o, double& best) {
+  const std::size_t nn = static_cast<std::size_t>(n);
+  const int r = m.ring[n];
+  const RingCurve& c = Q.rings().curves[r];
+  const double d = Q.rings().direction(r), L = c.length();
+  double back = -1.0, ahead = -1.0;  // arc lengths to the ring neighbours
+  for (const auto& [q, j] : t.corners_of(n)) {
+    if (t.on_ring(q, j)) ahead = Q.side_length(m, t, q, j);
+    if (t.on_ring(q, (j + 3) % 4)) back = Q.side_length(m, t, q, (j + 3) % 4);
+  }
+  if (!(back > 0.0 && ahead > 0.0)) return;
+  const double s0 = m.arc[nn];
+  const Eigen::Vector2d x0 = m.x[nn];
+  // Candidates u in (-0.9 back, 0.9 ahead): the node at arc s0 + d u.
+  const double lo = -0.9 * back, hi = 0.9 * ahead;
+  std::vector<double> cand;
+  for (int k = 0; k <= o.ring_samples; ++k) cand.push_back(lo + (hi - lo) * k / o.ring_samples);
+  {
+    std::vector<double> verts;
+    const double from = d > 0.0 ? s0 + lo : s0 - hi;  // forward arc range [from, from + hi - lo]
+    std::size_t i = c.first_vertex_after(from);
+    double base = std::fmod(from, L);
+    if (base < 0.0) base += L;
+    const double shift = from - base;  // unwrapped arcs: c.arc(i) + shift (+ L past the end)
+    for (std::size_t k = 0; k < c.size(); ++k, ++i) {
+      const double sv = (i < c.size() ? c.arc(i) : c.arc(i - c.size()) + L) + shift;
+      if (sv >= from + (hi - lo)) break;
+      verts.push_back(d > 0.0 ? sv - s0 : s0 - sv);
+    }
+    std::sort(verts.begin(), verts.end(), [](double a, double b) { return std::abs(a) < std::abs(b); });
+    if (verts.size() > static_cast<std::size_t>(o.max_ring_vertices)) verts.resize(o.max_ring_vertices);
+    cand.insert(cand.end(), verts.begin(), verts.end());
+  }
+  // Never a hair's breadth from a vertex (the patch polygon would have a needle edge).
+  const double snap = 0.02 * std::min(back, ahead);
+  auto place = [&](double u) {
+    double sv = std::fmod(s0 + d * u, L);
+    if (sv < 0.0) sv += L;
+    sv = c.snap_to_vertex(sv, snap);
+    m.arc[nn] = sv;
+    m.x[nn] = c.point(sv);
+  };
+  double best_u = 0.0;
+  for (const double u : cand) {
+    if (!(u > lo - 1e-12 && u < hi + 1e-12) || u == 0.0) continue;
+    place(u);
+    const double f = local(n);
+    if (f < best && admissible(m, t, n)) best = f, best_u = u;
+  }
+  // Local refinement around the best (the energy is smooth between vertices).
+  double h = (hi - lo) / o.ring_samples;
+  for (int it = 0; it < 12; ++it, h *= 0.5)
+    for (const double u : {best_u - h, best_u + h}) {
+      if (!(u > lo && u < hi)) continue;
+      place(u);
+      const double f = local(n);
+      if (f < best && admissible(m, t, n)) best = f, best_u = u;
+    }
+  if (best_u == 0.0) m.arc[nn] = s0, m.x[nn] = x0;
+  else place(best_u);
+}
+
+}  // namespace
+
+LayoutCornerQuality worst_layout_quality(const LayoutMesh& m, const LayoutTopology& t, const LayoutQuality& q) {
+  LayoutCornerQuality w{1.0, 1.0};
+  for (std::size_t k = 0; k < m.quads.size(); ++k) {
+    const LayoutCornerQuality c = q.quad(m, t, static_cast<int>(k));
+    w.mean_ratio = std::min(w.mean_ratio, c.mean_ratio);
+    w.scaled_jacobian = std::min(w.scaled_jacobian, c.scaled_jacobian);
+  }
+  return w;
+}
+
+LayoutOptimizationReport optimize_layout_nodes(LayoutMesh& m, const LayoutQuality& Q,
+                                               const LayoutAdmissible& admissible, const std::vector<int>& active_in,
+                                               const LayoutOptimizationOptions& o) {
+  const LayoutTopology t(m);
+  LayoutOptimizationReport report;
+  const std::size_t n_nodes = m.size();
+  std::vector<int> active = active_in;
+  if (active.empty())
+    for (std::size_t n = 0; n < n_nodes; ++n) active.push_back(static_cast<int>(n));
+  // The quads around the active nodes: where the figures are taken.
+  std::vector<int> region;
+  {
+    std::vector<char> seen(m.quads.size(), 0);
+    for (const int n : active)
+      for (const auto& [q, j] : t.corners_of(n))
+        if (!seen[q]) seen[q] = 1, region.push_back(q);
+  }
+  auto worst = [&]() {
+    LayoutCornerQuality w{1.0, 1.0};
+    for (const int q : region) {
+      const LayoutCornerQuality c = Q.quad(m, t, q);
+      w.mean_ratio = std::min(w.mean_ratio, c.mean_ratio);
+      w.scaled_jacobian = std::min(w.scaled_jacobian, c.scaled_jacobian);
+    }
+    return w;
+  };
+  report.before = worst();
+  // Untangling first: while corners are inverted, eps follows the worst of
+  // them (Garanzha et al. 2021: eps above the most negative det keeps the
+  // energy moderate, so that every corner can move), with the plain sum (p = 1);
+  // then eps = 1e-4 and p = power, close to the worst corner.
+  double p = o.power, eps_rel = 1e-4;
+  auto local = [&](int n) {
+    double sum = 0.0;
+    for (const auto& [q, j] : t.corners_of(n)) sum += quad_energy(m, t, Q, q, p, eps_rel);
+    return sum;
+  };
+  auto worst_sin = [&]() {
+    double w = 1.0;
+    for (const int q : region)
+      for (int j = 0; j < 4; ++j) w = std::min(w, Q.corner(m, t, q, j).scaled_jacobian);
+    return w;
+  };
+  // Pattern-search steps of the inner nodes, kept between sweeps.
+  std::vector<double> step(n_nodes, 0.0);
+  for (const int n : active) {
+    double shortest = std::numeric_limits<double>::infinity();
+    for (const auto& [q, j] : t.corners_of(static_cast<int>(n)))
+      for (const int k : {1, 3}) shortest = std::min(shortest, (m.x[m.quads[q][(j + k) % 4]] - m.x[n]).norm());
+    step[n] = std::isfinite(shortest) ? 0.2 * shortest : 0.0;
+  }
+  const std::vector<double> initial_step = step;
+  // The quads around each node that are poor (figure below `busy`): after the
+  // first sweeps of the quality phase, only their nodes and those nodes'
+  // neighbours move (elsewhere the worst corner is far away).
+  constexpr double busy = 0.6;
+  std::vector<int> moving = active;
+  auto refresh_moving = [&]() {
+    std::vector<char> on(n_nodes, 0);
+    for (const int q : region) {
+      LayoutCornerQuality c = Q.quad(m, t, q);
+      double f = c.mean_ratio;
+      for (int j = 0; j < 4; ++j) f = std::min(f, Q.side_shape(m, t, q, j));
+      if (f >= busy) continue;
+      for (const int v : m.quads[q])
+        for (const auto& [q2, j2] : t.corners_of(v))
+          for (const int w2 : m.quads[q2]) on[w2] = 1;
+    }
+    moving.clear();
+    for (const int n : active)
+      if (on[n]) moving.push_back(n);
+  };
+  bool untangling = false;
+  int quality_sweeps = 0;
+  double best_worst = -2.0;  // the worst J_r of the quality sweeps, and when it last rose
+  int best_sweep = 0;
+  double worst_tangled = -2.0;  // the worst corner of the tangled sweeps, and when it last rose
+  int last_rise = 0;
+  for (int sweep = 0; sweep < o.max_sweeps; ++sweep) {
+    const double w = worst_sin();
+    const bool tangled = w <= 0.0;
+    if (tangled) {
+      // Untangling that no longer raises the worst corner is stuck (a
+      // topological defect, a flat single-quad corner: the caller's business).
+      if (w > worst_tangled + 1e-6) worst_tangled = w, last_rise = sweep;
+      if (sweep - last_rise >= 6) break;
+    }
+    p = tangled ? 1.0 : o.power;
+    eps_rel = tangled ? std::max(1e-4, 2.0 * -w) : 1e-4;
+    if (untangling && !tangled)  // the steps were made for the other energy
+      for (const int n : active) step[n] = std::max(step[n], 0.25 * initial_step[n]);
+    untangling = tangled;
+    if (!tangled && ++quality_sweeps == 3) refresh_moving();
+    if (!tangled && quality_sweeps > 3 && quality_sweeps % 5 == 0) refresh_moving();
+    double gain = 0.0;
+    for (const int n : (tangled || quality_sweeps < 3 ? active : moving)) {
+      const std::size_t nn = static_cast<std::size_t>(n);
+      if (t.valence(n) == 0) continue;
+      // While the layout is tangled the rings stay where they are: sliding a
+      // ring node across a fold only drags the fold along the coast.
+      if (tangled && m.ring[n] >= 0) continue;
+      const double f0 = local(n);
+      double best = f0;
+      if (m.ring[n] < 0) {
+        // Inner node: pattern search, the best of eight directions per step.
+        for (int it = 0; it < 4 && step[nn] > 0.0; ++it) {
+          const Eigen::Vector2d start = m.x[nn];
+          Eigen::Vector2d best_x = start;
+          for (int k = 0; k < 8; ++k) {
+            const double a = k * std::numbers::pi / 4.0;
+            m.x[nn] = start + step[nn] * Eigen::Vector2d(std::cos(a), std::sin(a));
+            const double f = local(n);
+            if (f < best && admissible(m, t, n)) best = f, best_x = m.x[nn];
+          }
+          m.x[nn] = best_x;
+          if (best_x == start) step[nn] *= 0.5;
+          else step[nn] *= 1.5;
+        }
+      } else {
+        slide_ring_node(m, t, Q, n, local, admissible, o, best);
+      }
+      if (best < f0) {
+        ++report.moves;
+        gain = std::max(gain, (f0 - best) / f0);
+      }
+    }
+    report.sweeps = sweep + 1;
+    if (gain < o.tolerance && !tangled) break;
+    if (!tangled) {
+      // The worst corner is what counts: stop when it has not risen for a while.
+      const double f = worst().mean_ratio;
+      if (f > best_worst + 1e-3 * std::abs(best_worst)) best_worst = f, best_sweep = sweep;
+      if (sweep - best_sweep >= o.stall_sweeps) break;
+    }
+  }
+  report.after = worst();
+  return report;
+}
+
+}  // namespace tspline

@@ -1,0 +1,154 @@
+#include "tspline/layout/layout_quality.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
+namespace tspline {
+namespace {
+
+double cross(const Eigen::Vector2d& a, const Eigen::Vector2d& b) { return a.x() * b.y() - a.y() * b.x(); }
+
+// Arc length from a to b going in direction dir on a ring of length L, in [0, L).
+double arc_between(double a, double b, double dir, double L) {
+  double d = dir > 0.0 ? b - a : a - b;
+  d = std::fmod(d, L);
+  return d < 0.0 ? d + L : d;
+}
+
+}  // namespace
+
+LayoutQuality::LayoutQuality(const LayoutRings& rings) : rings_(rings) {
+  for (std::size_t r = 0; r < rings.curves.size(); ++r) {
+    const RingCurve& c = rings.curves[r];
+    const std::size_t n = c.size();
+    std::vector<std::vector<double>> levels(1, std::vector<double>(2 * n));
+    for (std::size_t i = 0; i < 2 * n; ++i) {
+      // The domain's inner angle: pi - turn with the domain on the left (outer
+      // ring), pi + turn with it on the right (holes).
+      const double phi = std::numbers::pi - rings.direction(static_cast<int>(r)) * c.turn(i % n);
+      const double k = std::sin(0.5 * phi);
+      levels[0][i] = k * k;
+    }
+    for (std::size_t w = 1; 2 * w <= 2 * n; w *= 2) {
+      const std::vector<double>& prev = levels.back();
+      std::vector<double> next(2 * n - 2 * w + 1);
+      for (std::size_t i = 0; i < next.size(); ++i) next[i] = std::min(prev[i], prev[i + w]);
+      levels.push_back(std::move(next));
+    }
+    table_.push_back(std::move(levels));
+  }
+}
+
+double LayoutQuality::kink_min(int r, std::size_t i0, std::size_t i1) const {
+  if (i1 <= i0) return 1.0;
+  const auto& levels = table_[r];
+  const std::size_t n = rings_.curves[r].size();
+  if (i1 - i0 > n) i1 = i0 + n;  // the whole ring
+  std::size_t k = 0;
+  while ((std::size_t{2} << k) <= i1 - i0) ++k;
+  return std::min(levels[k][i0], levels[k][i1 - (std::size_t{1} << k)]);
+}
+
+double LayoutQuality::side_length(const LayoutMesh& m, const LayoutTopology& t, int q, int j) const {
+  const int a = m.quads[q][j], b = m.quads[q][(j + 1) % 4];
+  if (!t.on_ring(q, j) || m.ring[a] < 0 || m.ring[a] != m.ring[b]) return (m.x[b] - m.x[a]).norm();
+  const int r = m.ring[a];
+  return arc_between(m.arc[a], m.arc[b], rings_.direction(r), rings_.curves[r].length());
+}
+
+std::pair<Eigen::Vector2d, Eigen::Vector2d> LayoutQuality::corner_vectors(const LayoutMesh& m,
+                                                                          const LayoutTopology& t, int q, int j,
+                                                                          double scale) const {
+  const int v = m.quads[q][j], next = m.quads[q][(j + 1) % 4], prev = m.quads[q][(j + 3) % 4];
+  const int r = m.ring[v];
+  Eigen::Vector2d e1 = m.x[next] - m.x[v], e2 = m.x[prev] - m.x[v];
+  // The ring's direction from the node, going dir, on the scale of scale x len.
+  auto along = [&](double dir, double len) -> Eigen::Vector2d {
+    const RingCurve& c = rings_.curves[r];
+    if (scale <= 0.0) return c.direction(m.arc[v], dir) * len;
+    const Eigen::Vector2d chord = c.point(m.arc[v] + dir * scale * len) - m.x[v];
+    const double l = chord.norm();
+    return l > 0.0 ? Eigen::Vector2d(chord * (len / l)) : Eigen::Vector2d(c.direction(m.arc[v], dir) * len);
+  };
+  if (r >= 0 && t.on_ring(q, j) && m.ring[next] == r) e1 = along(rings_.direction(r), side_length(m, t, q, j));
+  const int jp = (j + 3) % 4;
+  if (r >= 0 && t.on_ring(q, jp) && m.ring[prev] == r) e2 = along(-rings_.direction(r), side_length(m, t, q, jp));
+  return {e1, e2};
+}
+
+LayoutCornerQuality LayoutQuality::corner(const LayoutMesh& m, const LayoutTopology& t, int q, int j) const {
+  LayoutCornerQuality w{1.0, 1.0};
+  for (const double scale : corner_scales) {
+    const auto [e1, e2] = corner_vectors(m, t, q, j, scale);
+    const double det = cross(e1, e2), a = e1.squaredNorm(), b = e2.squaredNorm();
+    if (!(a > 0.0 && b > 0.0)) return {-1.0, -1.0};
+    w.mean_ratio = std::min(w.mean_ratio, 2.0 * det / (a + b));
+    w.scaled_jacobian = std::min(w.scaled_jacobian, det / std::sqrt(a * b));
+    if (m.ring[m.quads[q][j]] < 0) break;  // cuts only: one scale
+  }
+  return w;
+}
+
+LayoutQuality::SideVertices LayoutQuality::side_vertices(const LayoutMesh& m, const LayoutTopology& t, int q,
+                                                         int j) const {
+  const int a = m.quads[q][j], b = m.quads[q][(j + 1) % 4];
+  const int r = m.ring[a];
+  if (!t.on_ring(q, j) || r < 0 || m.ring[b] != r) return {};
+  const RingCurve& c = rings_.curves[r];
+  const double len = side_length(m, t, q, j);
+  // The side covers arc lengths (start, start + len) going forward.
+  double start = rings_.direction(r) > 0.0 ? m.arc[a] : m.arc[b];
+  start = std::fmod(start, c.length());
+  if (start < 0.0) start += c.length();
+  const std::size_t i0 = c.first_vertex_after(start);
+  // The first vertex at or past start + len, by binary search on the doubled
+  // list (vertex i >= n is vertex i - n one lap on).
+  const std::size_t n = c.size();
+  const double end = start + len;
+  auto arc_u = [&](std::size_t i) { return i < n ? c.arc(i) : c.arc(i - n) + c.length(); };
+  std::size_t lo = i0, hi = i0 + n;
+  while (lo < hi) {
+    const std::size_t mid = (lo + hi) / 2;
+    if (arc_u(mid) < end) lo = mid + 1;
+    else hi = mid;
+  }
+  return {r, i0, lo};
+}
+
+double LayoutQuality::side_kinks(const LayoutMesh& m, const LayoutTopology& t, int q, int j) const {
+  const SideVertices v = side_vertices(m, t, q, j);
+  return v.ring < 0 ? 1.0 : kink_min(v.ring, v.i0, v.i1);
+}
+
+double LayoutQuality::side_shape(const LayoutMesh& m, const LayoutTopology& t, int q, int j) const {
+  const SideVertices v = side_vertices(m, t, q, j);
+  if (v.ring < 0 || v.i1 <= v.i0) return 1.0;
+  const RingCurve& c = rings_.curves[v.ring];
+  const Eigen::Vector2d a = m.x[m.quads[q][j]], b = m.x[m.quads[q][(j + 1) % 4]];
+  const double chord = (b - a).norm();
+  if (!(chord > 0.0)) return 0.0;
+  const Eigen::Vector2d u = (b - a) / chord;
+  double in = 0.0, out = 0.0;
+  for (std::size_t i = v.i0; i < v.i1; ++i) {
+    const double d = cross(u, c.vertex(i) - a);  // > 0: inside the patch (left of a -> b)
+    in = std::max(in, d), out = std::max(out, -d);
+  }
+  const double w = std::min(side_length(m, t, q, (j + 1) % 4), side_length(m, t, q, (j + 3) % 4));
+  return std::min(w > 0.0 ? 1.0 - in / w : 0.0, 1.0 - 0.5 * out / chord);
+}
+
+LayoutCornerQuality LayoutQuality::quad(const LayoutMesh& m, const LayoutTopology& t, int q) const {
+  LayoutCornerQuality w{1.0, 1.0};
+  for (int j = 0; j < 4; ++j) {
+    const LayoutCornerQuality c = corner(m, t, q, j);
+    w.mean_ratio = std::min(w.mean_ratio, c.mean_ratio);
+    w.scaled_jacobian = std::min(w.scaled_jacobian, c.scaled_jacobian);
+    const double k = side_kinks(m, t, q, j);
+    w.mean_ratio = std::min(w.mean_ratio, k);
+    w.scaled_jacobian = std::min(w.scaled_jacobian, k);
+  }
+  return w;
+}
+
+}  // namespace tspline

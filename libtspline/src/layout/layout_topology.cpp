@@ -1,0 +1,196 @@
+#include "tspline/layout/layout_topology.h"
+
+#include <algorithm>
+#include <cstdio>
+#include <cstdlib>
+#include <array>
+#include <utility>
+#include <vector>
+
+#include "tspline/layout/layout_optimizer.h"
+
+namespace tspline {
+
+double layout_quad_figure(const LayoutMesh& m, const LayoutTopology& t, const LayoutQuality& Q, int q) {
+  double f = Q.quad(m, t, q).mean_ratio;
+  for (int j = 0; j < 4; ++j) f = std::min(f, Q.side_shape(m, t, q, j));
+  return f;
+}
+
+namespace {
+
+bool has_edge(const LayoutMesh& m, const LayoutTopology& t, int a, int b) {
+  for (const auto& [q, j] : t.corners_of(a))
+    if (m.quads[q][(j + 1) % 4] == b || m.quads[q][(j + 3) % 4] == b) return true;
+  return false;
+}
+
+// The nodes of the quads around `nodes` (their one-ring), each once.
+std::vector<int> one_ring(const LayoutMesh& m, const LayoutTopology& t, const std::vector<int>& nodes) {
+  std::vector<int> out;
+  std::vector<char> seen(m.size(), 0);
+  for (const int n : nodes)
+    for (const auto& [q, j] : t.corners_of(n))
+      for (const int v : m.quads[q])
+        if (!seen[v]) seen[v] = 1, out.push_back(v);
+  return out;
+}
+
+double region_figure(const LayoutMesh& m, const LayoutTopology& t, const LayoutQuality& Q, const std::vector<int>& nodes) {
+  double f = 1.0;
+  std::vector<int> quads;
+  for (const int n : nodes)
+    for (const auto& [q, j] : t.corners_of(n)) quads.push_back(q);
+  std::sort(quads.begin(), quads.end());
+  quads.erase(std::unique(quads.begin(), quads.end()), quads.end());
+  for (const int q : quads) f = std::min(f, layout_quad_figure(m, t, Q, q));
+  return f;
+}
+
+double corner_sj(const Eigen::Vector2d& p, const Eigen::Vector2d& next, const Eigen::Vector2d& prev) {
+  const Eigen::Vector2d e1 = next - p, e2 = prev - p;
+  const double l = e1.norm() * e2.norm();
+  return l > 0.0 ? (e1.x() * e2.y() - e1.y() * e2.x()) / l : -1.0;
+}
+
+}  // namespace
+
+std::vector<char> rings_with_flat_corners(const LayoutMesh& m, const LayoutQuality& Q) {
+  const LayoutTopology t(m);
+  std::vector<char> flat(Q.rings().curves.size(), 0);
+  for (std::size_t v = 0; v < m.size(); ++v) {
+    if (m.ring[v] < 0 || t.valence(static_cast<int>(v)) != 1) continue;
+    const auto [q, j] = t.corners_of(static_cast<int>(v)).front();
+    // Flat: an obtuse corner with sin below 1/2 (above 150 degrees), at any of
+    // the scales the corner is measured at; or reflex.
+    for (const double scale : LayoutQuality::corner_scales) {
+      const auto [e1, e2] = Q.corner_vectors(m, t, q, j, scale);
+      const double sn = corner_sj(Eigen::Vector2d::Zero(), e1, e2);
+      if (sn < 0.0 || (sn <= 0.5 && e1.dot(e2) < 0.0)) flat[m.ring[v]] = 1;
+    }
+  }
+  return flat;
+}
+
+std::size_t pillow_rings(LayoutMesh& m, const std::vector<char>& pillow) {
+  std::vector<std::array<int, 4>>& quads = m.quads;
+  std::vector<Eigen::Vector2d>& x = m.x;
+  std::vector<int>& ring = m.ring;
+  std::vector<double>& arc = m.arc;
+  std::vector<std::vector<int>> quads_of(x.size());
+  for (std::size_t q = 0; q < quads.size(); ++q)
+    for (int j = 0; j < 4; ++j) quads_of[quads[q][j]].push_back(static_cast<int>(q));
+  std::size_t count = 0;
+  for (const char p : pillow) count += p;
+  if (count == 0) return 0;
+  // Edges along the ring, as directed in their quad.
+  const LayoutTopology t(m);
+  std::vector<std::pair<int, int>> along;
+  for (std::size_t q = 0; q < quads.size(); ++q)
+    for (int j = 0; j < 4; ++j) {
+      const int v = quads[q][j], w = quads[q][(j + 1) % 4];
+      if (t.on_ring(static_cast<int>(q), j) && ring[v] >= 0 && pillow[ring[v]]) along.push_back({v, w});
+    }
+  const std::size_t n0 = x.size();
+  std::vector<int> copy(n0, -1);
+  for (std::size_t v = 0; v < n0; ++v) {
+    if (ring[v] < 0 || !pillow[ring[v]]) continue;
+    copy[v] = static_cast<int>(x.size());
+    x.push_back(x[v]);
+    ring.push_back(ring[v]);
+    arc.push_back(arc[v]);
+  }
+  // The old ring nodes move a third of the way towards the mean of their other quad corners.
+  for (std::size_t v = 0; v < n0; ++v) {
+    if (copy[v] < 0) continue;
+    Eigen::Vector2d mean = Eigen::Vector2d::Zero();
+    int k = 0;
+    for (int q : quads_of[v])
+      for (int j = 0; j < 4; ++j)
+        if (quads[q][j] != static_cast<int>(v)) mean += x[quads[q][j]], ++k;
+    if (k > 0) x[v] += (1.0 / 3.0) * (mean / k - x[v]);
+    ring[v] = -1;
+  }
+  for (const auto& [v, w] : along) quads.push_back({w, v, copy[v], copy[w]});
+  return count;
+}
+
+LayoutRotationReport rotate_layout_edges(LayoutMesh& m, const LayoutQuality& Q, const LayoutAdmissible& admissible,
+                                         const LayoutRotationOptions& o) {
+  LayoutRotationReport report;
+  LayoutOptimizationOptions lo;
+  lo.max_sweeps = o.local_sweeps;
+  for (int round = 0; round < o.rounds; ++round) {
+    LayoutTopology t(m);
+    std::vector<std::pair<double, int>> bad;
+    for (std::size_t q = 0; q < m.quads.size(); ++q) {
+      const double f = layout_quad_figure(m, t, Q, static_cast<int>(q));
+      if (f < o.target) bad.push_back({f, static_cast<int>(q)});
+    }
+    if (bad.empty()) break;
+    std::sort(bad.begin(), bad.end());
+    std::vector<char> touched(m.quads.size(), 0);
+    std::size_t kept = 0;
+    for (const auto& [f0, q] : bad) {
+      if (touched[q]) continue;
+      double best = -1e300;
+      LayoutMesh best_mesh;
+      int best_other = -1;
+      std::vector<int> best_free;
+      double before = 0.0;
+      for (int j = 0; j < 4; ++j) {
+        if (t.on_ring(q, j)) continue;
+        const auto [b, k] = t.across(q, j);
+        if (b < 0 || touched[b]) continue;
+        // The hexagon, counter-clockwise, the shared edge h0-h3.
+        const std::array<int, 4>& A = m.quads[q];
+        const std::array<int, 4>& B = m.quads[b];
+        const std::array<int, 6> h = {A[j], B[(k + 2) % 4], B[(k + 3) % 4], A[(j + 1) % 4], A[(j + 2) % 4],
+                                      A[(j + 3) % 4]};
+        {
+          std::array<int, 6> sorted = h;
+          std::sort(sorted.begin(), sorted.end());
+          if (std::adjacent_find(sorted.begin(), sorted.end()) != sorted.end()) continue;
+        }
+        const std::vector<int> hex(h.begin(), h.end());
+        const std::vector<int> free = one_ring(m, t, hex);
+        if (best == -1e300) before = region_figure(m, t, Q, free);
+        for (const int r : {1, 2}) {
+          // Diagonal h_r - h_{r+3}; the shared edge's ends lose one quad each.
+          const int d0 = h[r], d1 = h[r + 3];
+          bool ok = !has_edge(m, t, d0, d1);
+          for (const int e : {h[0], h[3]})
+            if (m.ring[e] < 0 && t.valence(e) <= 3) ok = false;
+          if (!ok) continue;
+          LayoutMesh c = m;
+          c.quads[q] = {h[r], h[r + 1], h[r + 2], h[r + 3]};
+          c.quads[b] = {h[(r + 3) % 6], h[(r + 4) % 6], h[(r + 5) % 6], h[r]};
+          optimize_layout_nodes(c, Q, admissible, free, lo);
+          ++report.tried;
+          const LayoutTopology ct(c);
+          bool valid = true;
+          for (const int n : free) valid = valid && admissible(c, ct, n);
+          if (!valid) continue;
+          const double after = region_figure(c, ct, Q, free);
+          if (std::getenv("TSPLINE_LAYOUT_DEBUG") && f0 < 0.01)
+            std::fprintf(stderr, "   rotation of quad %d edge %d (%d-%d) r %d: %.3g -> %.3g\n", q, j, h[0], h[3], r, before, after);
+          if (after > best) best = after, best_mesh = std::move(c), best_other = b, best_free = free;
+        }
+      }
+      if (best_other >= 0 && best > before + 1e-3) {
+        m = std::move(best_mesh);
+        touched[q] = touched[best_other] = 1;
+        report.moved.insert(report.moved.end(), best_free.begin(), best_free.end());
+        t = LayoutTopology(m);
+        ++kept;
+      }
+    }
+    report.kept += kept;
+    if (kept == 0) break;
+  }
+  std::sort(report.moved.begin(), report.moved.end());
+  report.moved.erase(std::unique(report.moved.begin(), report.moved.end()), report.moved.end());
+  return report;
+}
+
+}  // namespace tspline
