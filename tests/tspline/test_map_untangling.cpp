@@ -60,8 +60,9 @@ TEST_SUITE("map_untangling") {
           for (std::size_t e = 0; e < energy.num_elements(); e += 3) energy.set_sample_level(e, 1);
           const Eigen::VectorXd x = energy.variables(map);
           REQUIRE(x.size() > 10);
-          for (double eps : {1.0, 0.05}) {
-            const double power = eps == 1.0 ? 1.0 : 3.0;  // the quality phase's powered terms too
+          for (double eps : {1.0, 0.05, 0.02}) {
+            // The quality phase's powered terms too: 3 (std::pow), 8 (the pipeline's polish).
+            const double power = eps == 1.0 ? 1.0 : eps == 0.05 ? 3.0 : 8.0;
             Eigen::VectorXd g(x.size());
             energy.evaluate(x.data(), eps, g.data(), nullptr, power);
             double max_err = 0.0, max_g = 0.0;
@@ -102,7 +103,7 @@ TEST_SUITE("map_untangling") {
     const double theta = tspline::MapEnergyOptions{}.theta, L = energy.length_scale();
     const Eigen::VectorXd x = energy.variables(map);
     for (double eps : {0.3, 0.01})
-      for (double power : {1.0, 4.0}) {
+      for (double power : {1.0, 4.0, 8.0}) {
         double direct = 0.0;
         std::size_t folded = 0;
         for (std::size_t k = 0; k < ex.elements().size(); ++k) {

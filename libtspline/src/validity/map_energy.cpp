@@ -45,7 +45,7 @@ void lobatto_points_01(int n, std::vector<double>& p, std::vector<double>& w) {
 // sample's weighted term omega_q t_q^p into `term`, and with Grad the
 // derivative of that with respect to J into G00..G11 (which may alias nothing
 // read later). Returns the number of samples with det J <= 0.
-enum class Power { One, Four, Other };
+enum class Power { One, Four, Eight, Other };
 
 template <Power P, bool Grad>
 std::size_t sample_terms(std::size_t n, const double* __restrict J00, const double* __restrict J01,
@@ -76,6 +76,9 @@ std::size_t sample_terms(std::size_t n, const double* __restrict J00, const doub
     } else if constexpr (P == Power::Four) {
       const double t2 = t * t;
       tp = t2 * t2, chain = 4.0 * omega * t2 * t;
+    } else if constexpr (P == Power::Eight) {
+      const double t2 = t * t, t4 = t2 * t2;
+      tp = t4 * t4, chain = 8.0 * omega * t4 * t2 * t;
     } else {
       tp = std::pow(t, power), chain = omega * power * tp / t;
     }
@@ -104,6 +107,9 @@ std::size_t sample_terms(std::size_t n, const double* J00, const double* J01, co
   if (power == 4.0)
     return sample_terms<Power::Four, Grad>(n, J00, J01, J10, J11, weight, element_weight, eps, theta, power, term,
                                            G00, G01, G10, G11);
+  if (power == 8.0)  // the pipeline's polish (AdaptiveOptions::polish_power)
+    return sample_terms<Power::Eight, Grad>(n, J00, J01, J10, J11, weight, element_weight, eps, theta, power, term,
+                                            G00, G01, G10, G11);
   return sample_terms<Power::Other, Grad>(n, J00, J01, J10, J11, weight, element_weight, eps, theta, power, term,
                                           G00, G01, G10, G11);
 }

@@ -97,7 +97,10 @@ PhiDerivatives phi_derivatives(double j00, double j01, double j10, double j11, d
   const double tID = -(1.0 - theta) * c1 / (chi * chi);
   const double tDD = (2.0 * theta - 4.0 * theta * D * c1 / chi - t * c2 + 2.0 * t * c1 * c1 / chi) / chi;
   // phi = t^p: phi_a = p t^(p-1) t_a, phi_ab = p t^(p-1) t_ab + p (p-1) t^(p-2) t_a t_b.
-  const double tp1 = power == 1.0 ? 1.0 : power == 4.0 ? t * t * t : std::pow(t, power - 1.0);
+  const double tp1 = power == 1.0   ? 1.0
+                     : power == 4.0 ? t * t * t
+                     : power == 8.0 ? (t * t) * (t * t) * (t * t) * t
+                                    : std::pow(t, power - 1.0);
   const double d1 = power * tp1, d2 = power == 1.0 ? 0.0 : power * (power - 1.0) * tp1 / t;
   const double fI = d1 * tI, fD = d1 * tD;
   const double fII = d2 * tI * tI, fID = d1 * tID + d2 * tI * tD, fDD = d1 * tDD + d2 * tD * tD;
