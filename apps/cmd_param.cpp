@@ -270,8 +270,9 @@ void add_param_command(CLI::App& app, CommandAction& action) {
                   "Keep the interpolating map of the T-mesh (by default all interior control points are "
                   "untangled and smoothed globally until det J > 0 is certified)");
   param->add_option("--optimizer", A.optimizer,
-                    "Minimizer of the control-point untangling and smoothing: 'lbfgs' or 'newton' (projected "
-                    "Newton with CHOLMOD: fewer iterations, each a sparse Cholesky; slower on the benchmarks)")
+                    "Minimizer of the control-point untangling and smoothing: 'lbfgs' (L-BFGS, curvature kept "
+                    "across the eps stages) or 'newton' (projected Newton, Cholesky or conjugate gradients: fewer "
+                    "iterations and a higher min J_r, each iteration a Hessian assembly; slower on the benchmarks)")
       ->check(CLI::IsMember({"newton", "lbfgs"}))
       ->capture_default_str();
   param->add_option("--cert-depth", A.adaptive.certification.max_depth,

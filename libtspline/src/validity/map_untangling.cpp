@@ -277,6 +277,7 @@ MapUntanglingReport untangle_map(TSplineMap& map, const MapUntanglingOptions& op
     // The quality phase (barrier) raises each term to quality_power.
     const double power = barrier ? opt.quality_power : 1.0;
     const double E_prev = energy.evaluate(x.data(), eps, nullptr, nullptr, power);
+    double E_stage = std::numeric_limits<double>::quiet_NaN();  // E at the stage's end, if the minimizer knows it
     if (opt.optimizer == MapOptimizer::Newton) {
       newton.run(x, eps, power, opt.max_newton_iterations_per_stage, opt.newton_stage_tolerance, barrier, x_certified,
                  certified_valid, rep);
@@ -294,6 +295,7 @@ MapUntanglingReport untangle_map(TSplineMap& map, const MapUntanglingOptions& op
           lbfgs.run(x, f, std::min(opt.max_iterations_per_stage, opt.max_iterations - rep.iterations));
       rep.iterations += r.iterations;
       rep.evaluations += r.evaluations;
+      E_stage = r.value;
       x_certified = false;
     } else {
       so.max_num_iterations = std::min(opt.max_iterations_per_stage, opt.max_iterations - rep.iterations);
@@ -307,7 +309,7 @@ MapUntanglingReport untangle_map(TSplineMap& map, const MapUntanglingOptions& op
       x_certified = false;
     }
     ++rep.stages;
-    const double E = energy.evaluate(x.data(), eps, nullptr, nullptr, power);
+    const double E = std::isfinite(E_stage) ? E_stage : energy.evaluate(x.data(), eps, nullptr, nullptr, power);
     const SampleStats st = energy.stats(x.data());
     bool certified_now = false;
     x_certified = false;
