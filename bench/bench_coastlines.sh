@@ -20,8 +20,9 @@ tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 # Jr_cert / SJ_cert: certified lower bounds of J_r and of the scaled Jacobian
 # over the whole map; Jr_26 / SJ_26: minima of the 26 x 26 sample per element;
-# Jr_gauss: minimum at the Gauss points (report.json jacobian.whole_map).
-printf "%-18s %8s %7s %8s %5s %10s %8s %8s %8s %8s %9s %8s %8s %8s %4s\n" domain vertices cells elements cert det_bound Jr_cert Jr_26 SJ_cert SJ_26 Jr_gauss seconds cpu_s peak_MiB exit
+# Jr_gauss: minimum at the Gauss points (report.json jacobian.whole_map, or totals
+# for a quad layout: layout quad/P = P patches).
+printf "%-18s %-9s %8s %7s %8s %5s %10s %8s %8s %8s %8s %9s %8s %8s %8s %4s\n" domain layout vertices cells elements cert det_bound Jr_cert Jr_26 SJ_cert SJ_26 Jr_gauss seconds cpu_s peak_MiB exit
 for f in "${domains[@]}"; do
   n=$(basename "$f" .txt)
   set +e
@@ -34,16 +35,26 @@ for f in "${domains[@]}"; do
     python3 - "$tmp/$n/report.json" "$n" "$secs" "$kb" "$rc" "$cpu" <<'PY'
 import json, sys
 r = json.load(open(sys.argv[1])); n, secs, kb, rc, cpu = sys.argv[2:7]
-c = r.get("certification", {})
-w = r["jacobian"]["whole_map"]
+if "totals" in r:  # a quad layout: one map per patch, the whole map's figures in totals
+    T = r["totals"]
+    w = T["whole_map"]
+    cells, elements, cert, bound, gauss = T["cells"], T["bezier_elements"], T["certified_valid"], T["min_relative_det_lower_bound"], T["min_mean_ratio_gauss"]
+    vertices = sum(1 for line in open(r["input"]) if line.strip() and not line.lstrip().startswith("#"))
+    layout = "quad/%d" % r["patches_count"]
+else:
+    c = r.get("certification", {})
+    w = r["jacobian"]["whole_map"]
+    cells, elements, cert, bound, gauss = r["counts"]["cells"], c.get("elements", 0), r.get("certified_valid"), c.get("min_relative_det_lower_bound"), r["jacobian"]["min_mean_ratio_jacobian"]
+    vertices = r["counts"]["polygon_vertices"]
+    layout = "single"
 jr, sj = w["mean_ratio"], w["scaled_jacobian"]
-print("%-18s %8d %7d %8d %5s %10.3g %8.4f %8.4f %8.4f %8.4f %9.4f %8.2f %8s %8.0f %4s" % (
-    n, r["counts"]["polygon_vertices"], r["counts"]["cells"], c.get("elements", 0),
-    "yes" if r.get("certified_valid") else "no", c.get("min_relative_det_lower_bound") or float("nan"),
+print("%-18s %-9s %8d %7d %8d %5s %10.3g %8.4f %8.4f %8.4f %8.4f %9.4f %8.2f %8s %8.0f %4s" % (
+    n, layout, vertices, cells, elements,
+    "yes" if cert else "no", bound if bound is not None else float("nan"),
     jr["certified_lower_bound"], jr["sampled_min"], sj["certified_lower_bound"], sj["sampled_min"],
-    r["jacobian"]["min_mean_ratio_jacobian"], float(secs), cpu, int(kb) / 1024.0, rc))
+    gauss, float(secs), cpu, int(kb) / 1024.0, rc))
 PY
   else
-    printf "%-18s %8s %7s %8s %5s %10s %8s %8s %8s %8s %9s %8.2f %8s %8.0f %4s  %s\n" "$n" - - - - - - - - - - "$secs" "$cpu" "$((kb / 1024))" "$rc" "$(head -c 120 "$tmp/err")"
+    printf "%-18s %-9s %8s %7s %8s %5s %10s %8s %8s %8s %8s %9s %8.2f %8s %8.0f %4s  %s\n" "$n" - - - - - - - - - - - "$secs" "$cpu" "$((kb / 1024))" "$rc" "$(head -c 120 "$tmp/err")"
   fi
 done

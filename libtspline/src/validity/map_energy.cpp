@@ -148,6 +148,29 @@ inline void values(const detail::TensorGrid& g, const double* c, double* f, doub
   detail::tensor_values_fixed<M>(g, c, f, fs, ft, scratch);
 }
 
+// J = [S_s / hx, S_t / hy] at the n samples from X, Y and their parametric
+// derivatives. On a rational element S = X / w: S_s = (X_s - X w_s / w) / w,
+// S_t alike; rw, rs, rt hold w, w_s, w_t there and become 1/w, w_s/w, w_t/w.
+inline void sample_jacobians(std::size_t n, bool rational, double ihx, double ihy, const double* x, const double* y,
+                             const double* xs, const double* xt, const double* ys, const double* yt, double* rw,
+                             double* rs, double* rt, double* J00, double* J01, double* J10, double* J11) {
+  if (!rational) {
+    for (std::size_t q = 0; q < n; ++q) {
+      J00[q] = xs[q] * ihx, J01[q] = xt[q] * ihy;
+      J10[q] = ys[q] * ihx, J11[q] = yt[q] * ihy;
+    }
+    return;
+  }
+  for (std::size_t q = 0; q < n; ++q) {
+    const double iw = 1.0 / rw[q];
+    rw[q] = iw, rs[q] *= iw, rt[q] *= iw;
+    J00[q] = (xs[q] - x[q] * rs[q]) * iw * ihx;
+    J01[q] = (xt[q] - x[q] * rt[q]) * iw * ihy;
+    J10[q] = (ys[q] - y[q] * rs[q]) * iw * ihx;
+    J11[q] = (yt[q] - y[q] * rt[q]) * iw * ihy;
+  }
+}
+
 // One element's share of evaluate(): adds its energy to F and, if g, its
 // gradient to g; returns its samples with det J <= 0. The steps (each a loop
 // over the samples or the 16 coefficients): the Bernstein coefficients of X
@@ -171,23 +194,9 @@ std::size_t element_energy_m(const ElementKernel& in, const double* xv, double e
   values<M>(grid, X, s.x, s.xs, s.xt, s.scratch);
   values<M>(grid, Y, s.y, s.ys, s.yt, s.scratch);
   const double ihx = 1.0 / in.hx, ihy = 1.0 / in.hy;
-  if (!in.rational) {
-    for (std::size_t q = 0; q < n; ++q) {
-      s.J00[q] = s.xs[q] * ihx, s.J01[q] = s.xt[q] * ihy;
-      s.J10[q] = s.ys[q] * ihx, s.J11[q] = s.yt[q] * ihy;
-    }
-  } else {
-    // S = X / w: S_s = (X_s - X w_s / w) / w, S_t alike.
-    values<M>(grid, in.W, s.rw, s.rs, s.rt, s.scratch);
-    for (std::size_t q = 0; q < n; ++q) {
-      const double iw = 1.0 / s.rw[q];
-      s.rw[q] = iw, s.rs[q] *= iw, s.rt[q] *= iw;
-      s.J00[q] = (s.xs[q] - s.x[q] * s.rs[q]) * iw * ihx;
-      s.J01[q] = (s.xt[q] - s.x[q] * s.rt[q]) * iw * ihy;
-      s.J10[q] = (s.ys[q] - s.y[q] * s.rs[q]) * iw * ihx;
-      s.J11[q] = (s.yt[q] - s.y[q] * s.rt[q]) * iw * ihy;
-    }
-  }
+  if (in.rational) values<M>(grid, in.W, s.rw, s.rs, s.rt, s.scratch);
+  sample_jacobians(n, in.rational, ihx, ihy, s.x, s.y, s.xs, s.xt, s.ys, s.yt, s.rw, s.rs, s.rt, s.J00, s.J01, s.J10,
+                   s.J11);
   // dE/dJ goes to (xs, xt, ys, yt): X and Y at the samples are not needed any more.
   const std::size_t nonpos =
       g ? sample_terms<true>(n, s.J00, s.J01, s.J10, s.J11, in.point_weight, in.weight, eps, theta, power, s.term, s.xs,
@@ -366,24 +375,10 @@ void MapEnergy::element_samples(std::size_t k, const double* X, const double* Y,
   const std::size_t n = g.size();
   detail::tensor_values(g, X, s.x.data(), s.xs.data(), s.xt.data(), s.scratch.data());
   detail::tensor_values(g, Y, s.y.data(), s.ys.data(), s.yt.data(), s.scratch.data());
-  const double ihx = 1.0 / d.hx, ihy = 1.0 / d.hy;
-  if (!d.rational) {
-    for (std::size_t q = 0; q < n; ++q) {
-      s.J00[q] = s.xs[q] * ihx, s.J01[q] = s.xt[q] * ihy;
-      s.J10[q] = s.ys[q] * ihx, s.J11[q] = s.yt[q] * ihy;
-    }
-    return;
-  }
-  // S = X / w: S_s = (X_s - S w_s) / w = (X_s - X w_s / w) / w, S_t alike.
-  detail::tensor_values(g, d.W.data(), s.rw.data(), s.rs.data(), s.rt.data(), s.scratch.data());
-  for (std::size_t q = 0; q < n; ++q) {
-    const double iw = 1.0 / s.rw[q];
-    s.rw[q] = iw, s.rs[q] *= iw, s.rt[q] *= iw;
-    s.J00[q] = (s.xs[q] - s.x[q] * s.rs[q]) * iw * ihx;
-    s.J01[q] = (s.xt[q] - s.x[q] * s.rt[q]) * iw * ihy;
-    s.J10[q] = (s.ys[q] - s.y[q] * s.rs[q]) * iw * ihx;
-    s.J11[q] = (s.yt[q] - s.y[q] * s.rt[q]) * iw * ihy;
-  }
+  if (d.rational) detail::tensor_values(g, d.W.data(), s.rw.data(), s.rs.data(), s.rt.data(), s.scratch.data());
+  sample_jacobians(n, d.rational, 1.0 / d.hx, 1.0 / d.hy, s.x.data(), s.y.data(), s.xs.data(), s.xt.data(), s.ys.data(),
+                   s.yt.data(), s.rw.data(), s.rs.data(), s.rt.data(), s.J00.data(), s.J01.data(), s.J10.data(),
+                   s.J11.data());
 }
 
 Eigen::VectorXd MapEnergy::variables(const TSplineMap& map) const {
