@@ -65,7 +65,12 @@ int main(int argc, char** argv) {
     return 1;
   }
   tspline::ParameterizationOptions opt;
-  if (n > 1) opt.initial_level = std::atoi(args[1]);
+  if (n > 1) {
+    opt.initial_level = std::atoi(args[1]);
+    // Level 9 is 2^18 = 262,144 cells before any boundary refinement: room for 4x that.
+    if (opt.initial_level >= 0 && opt.initial_level <= 12)
+      opt.max_cells = std::max(opt.max_cells, std::size_t{4} << (2 * opt.initial_level));
+  }
   if (n > 2) opt.tolerance_relative = std::atof(args[2]);
   auto t = std::chrono::steady_clock::now();
   std::optional<tspline::TSplineMap> input;
