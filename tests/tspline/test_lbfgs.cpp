@@ -91,4 +91,22 @@ TEST_SUITE("lbfgs") {
     CHECK(std::abs(x[1]) < 1e-4);
     CHECK(std::isfinite(r.value));
   }
+
+  TEST_CASE("at a minimizer to round-off it stays put (no step that only rounding calls a decrease)") {
+    // f = 1 + |x - c|^2 / 2 from x = c + 1e-14 e_0: any move of up to ~1e-8
+    // leaves f == 1 in double, which Armijo's test would accept as a decrease.
+    const auto f = [](const double* v, double* g) {
+      g[0] = v[0] - 0.3, g[1] = v[1] + 0.7;
+      return 1.0 + 0.5 * (g[0] * g[0] + g[1] * g[1]);
+    };
+    Eigen::VectorXd x(2);
+    x << 0.3 + 1e-14, -0.7;
+    const Eigen::VectorXd x0 = x;
+    Lbfgs lbfgs;
+    const Lbfgs::Result r = lbfgs.run(x, f, 50, 0.0);
+    CHECK(r.iterations == 0);
+    CHECK(r.converged);
+    CHECK((x - x0).cwiseAbs().maxCoeff() == 0.0);
+    CHECK(r.value == 1.0);
+  }
 }

@@ -42,6 +42,12 @@ Lbfgs::Result Lbfgs::run(Eigen::VectorXd& x, const Objective& f, int max_iterati
   if (!std::isfinite(E)) return res;
   constexpr double c1 = 1e-4;  // Armijo's sufficient decrease
   while (res.iterations < max_iterations) {
+    // Stationary to round-off (the identity map of a square): a step would be
+    // noise that Armijo's test cannot tell from a decrease (1 + 1e-17 == 1).
+    if (g.cwiseAbs().maxCoeff() <= 1e-12 * std::abs(E)) {
+      res.converged = true;
+      break;
+    }
     direction(g, d);
     double slope = g.dot(d);
     if (!(slope < 0.0)) {  // the pairs went bad (round-off): start over
