@@ -1,16 +1,20 @@
-// `tspline export TSPLINE.json [--bezier OUT.json] [--msh OUT.msh]`: Bezier
-// extraction export (docs/bezier_format.md) and curved Lagrange elements for
-// Gmsh (msh_export.h).
+// `tspline export TSPLINE.json [--bezier OUT.json] [--msh OUT.msh]
+// [--vtk-bezier OUT.vtu]`: Bezier extraction export (docs/bezier_format.md),
+// curved Lagrange elements for Gmsh (msh_export.h) and rational Bezier cells
+// for ParaView (bezier_vtu.h).
 #include <iostream>
 #include <memory>
 #include <vector>
 
 #include "commands.h"
-#include "tspline/errors.h"
 #include "toolkit/io/atomic_file.h"
+#include "toolkit/io/vtu_writer.h"
+#include "tspline/errors.h"
 #include "tspline/io/bezier_export.h"
+#include "tspline/io/bezier_vtu.h"
 #include "tspline/io/msh_export.h"
 #include "tspline/io/multipatch_file.h"
+#include "tspline/io/multipatch_output.h"
 #include "tspline/io/tspline_file.h"
 
 namespace tspline_app {
@@ -18,12 +22,24 @@ namespace tspline_app {
 namespace {
 
 struct ExportArgs {
-  std::string file, bezier, msh;
+  std::string file, bezier, msh, vtk_bezier;
   bool quiet = false;
 };
 
 // Version 2: one Bezier document per patch (docs/bezier_format.md, "Multi-patch maps").
 void export_multipatch_bezier(const tspline::io::LoadedMaps& maps, const ExportArgs& a);
+
+// --vtk-bezier: every patch's Bezier cells in one file (cell data `patch`).
+void export_vtk_bezier(const tspline::io::LoadedMaps& maps, const ExportArgs& a) {
+  std::vector<toolkit::io::VtuMesh> parts;
+  for (const tspline::io::LoadedTSpline& t : maps.patches) parts.push_back(tspline::io::bezier_vtu(t.map));
+  const toolkit::io::VtuMesh cells = tspline::io::merge_patches(parts);
+  toolkit::io::write_vtu(a.vtk_bezier, cells);
+  if (!a.quiet)
+    std::cout << "wrote " << a.vtk_bezier << ": " << cells.cells.size()
+              << " rational bicubic Bezier cells (VTK_BEZIER_QUADRILATERAL) on " << maps.patches.size()
+              << (maps.patches.size() == 1 ? " patch" : " patches") << std::endl;
+}
 
 // --msh: one surface entity per patch, nodes shared along the interfaces (msh_export.h).
 int export_multipatch(const tspline::io::LoadedMaps& maps, const ExportArgs& a) {
@@ -73,11 +89,16 @@ void add_export_command(CLI::App& app, CommandAction& action) {
   cmd->add_option("--msh", a->msh,
                   "Output Gmsh MSH 4.1 file: the Bezier elements as bicubic 16-node Lagrange quadrilaterals "
                   "(type 36) with their nodes on the map");
+  cmd->add_option("--vtk-bezier", a->vtk_bezier,
+                  "Output VTK file (.vtu) for ParaView: the map exactly, one rational bicubic Bezier cell "
+                  "(VTK_BEZIER_QUADRILATERAL) per Bezier element, with J_r, det J and the certificate");
   cmd->add_flag("--quiet,-q", a->quiet, "Print errors only");
   cmd->callback([a, &action] {
-    if (a->bezier.empty() && a->msh.empty()) throw CLI::ValidationError("export", "give --bezier and/or --msh");
+    if (a->bezier.empty() && a->msh.empty() && a->vtk_bezier.empty())
+      throw CLI::ValidationError("export", "give --bezier, --msh and/or --vtk-bezier");
     action = [a] {
       const tspline::io::LoadedMaps maps = tspline::io::read_maps_file(a->file);
+      if (!a->vtk_bezier.empty()) export_vtk_bezier(maps, *a);
       if (maps.version == 2) return export_multipatch(maps, *a);
       const tspline::io::LoadedTSpline& t = maps.patches.front();
       if (!a->bezier.empty()) {

@@ -4,43 +4,17 @@
 #include <sstream>
 
 #include "tspline/errors.h"
-#include "tspline/io/multipatch_output.h"
 #include "tspline/io/param_output.h"
 
 namespace tspline_app {
 
-int write_multipatch_param(const tspline::DomainParameterization& P, const tspline::io::DomainInput& input_domain,
-                           const std::string& input, const std::string& out_dir,
-                           const tspline::AdaptiveOptions& adaptive, int samples, double seconds, Progress& progress,
-                           const std::vector<std::string>& cleaning_notes) {
+int write_multipatch_param(const ParamRun& run, const std::string& out_dir, Progress& progress) {
+  const tspline::DomainParameterization& P = run.result;
   const tspline::MultiPatchResult& R = *P.patches;
-  nlohmann::json report = tspline::io::multipatch_report(R, input, seconds);
-  report["input_geometry"] = input_domain.description;
-  report["input_cleaning"] = {{"notes", cleaning_notes}};
-  report["layout"] = {{"chosen", P.layout}, {"reason", P.reason}, {"explanation", R.cuts_explanation}};
-  if (P.quad_stats) {
-    const tspline::QuadLayoutStats& s = *P.quad_stats;
-    report["layout"]["quad"] = {{"patches", s.patches},
-                                {"ring_nodes", s.ring_nodes},
-                                {"inner_nodes", s.inner_nodes},
-                                {"inner_valence", s.valence},
-                                {"straight_min_scaled_jacobian", s.min_corner_scaled_jacobian},
-                                {"straight_mean_scaled_jacobian", s.mean_corner_scaled_jacobian},
-                                {"repair_rounds", s.repair_rounds},
-                                {"pillowed_rings", s.pillowed_rings},
-                                {"optimization_level", s.optimization_level},
-                                {"rotations", s.rotations},
-                                {"optimization_sweeps", s.optimization_sweeps},
-                                {"corner_mean_ratio", s.corner_mean_ratio},
-                                {"corner_scaled_jacobian", s.corner_scaled_jacobian},
-                                {"min_size", s.min_size},
-                                {"max_size", s.max_size},
-                                {"seconds", s.seconds}};
-  }
-  if (P.rejected_single)
-    report["layout"]["single_patch_first_try"] = {{"min_scaled_jacobian_dense", P.rejected_single->min_scaled},
-                                                  {"min_mean_ratio_dense", P.rejected_single->min_mean_ratio}};
-  tspline::io::write_multipatch_outputs(R, out_dir, report, samples);
+  const tspline::AdaptiveOptions& adaptive = run.settings.adaptive;
+  const nlohmann::json& report = run.report;
+  const double seconds = run.seconds;
+  write_param_run(run, out_dir);
   progress.settle();
   const auto& totals = report["totals"];
   progress.event({{"event", "result"},
@@ -62,9 +36,10 @@ int write_multipatch_param(const tspline::DomainParameterization& P, const tspli
       << tspline::io::whole_map_quality_summary(totals["whole_map"]) << "; area " << R.map_area << " vs "
       << R.domain_area << "; largest interface gap " << R.max_gap() << " (" << R.max_gap() / R.diameter
       << " x diameter); " << seconds << " s";
-    std::cout << s.str() << "\nwrote tspline.json (format version 2), surface.vtu, control_net.vtu, "
-                            "parametric_tmesh.vtu, physical_tmesh.vtu, boundary.vtu, report.json to "
-              << out_dir << std::endl;
+    std::string files;
+    for (const std::string& f : param_run_files(run))
+      files += (files.empty() ? "" : ", ") + f + (f == "tspline.json" ? " (format version 2)" : "");
+    std::cout << s.str() << "\nwrote " << files << " to " << out_dir << std::endl;
   }
   if (!R.conforming(tspline::MultiPatchOptions{}.gap_tolerance)) {
     std::cerr << "tspline: error: the map is not watertight: the two images of a cut differ by up to " << R.max_gap()

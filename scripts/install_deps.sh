@@ -6,7 +6,7 @@ PACKAGES=(build-essential cmake pkg-config libeigen3-dev libcgal-dev libgmp-dev 
           libvtk9-dev doctest-dev nlohmann-json3-dev libcli11-dev
           libmuparser-dev libsuitesparse-dev libgmsh-dev gmsh libpetsc-real-dev openmpi-bin
           libgdal-dev libcairo2-dev fonts-dejavu-core
-          pybind11-dev python3-dev python3-numpy python3-pytest
+          pybind11-dev python3-dev python3-numpy python3-pytest python3-shapely python3-vtk9
           clang libfuzzer-14-dev)
 missing=()
 for p in "${PACKAGES[@]}"; do

@@ -70,10 +70,13 @@ TEST_SUITE("multipatch_poisson_app") {
     // cells: until the analysis cells are that small the error falls faster
     // than h^4 (measured on the flange L2 4.67, 4.49 and H1 3.66, 3.70 up to
     // 3.1e5 DOFs; on the sea L2 4.66, 4.40, 4.32 and H1 3.87, 3.70, 3.27 up
-    // to 6.5e5 DOFs: bench/README.md). So the plate is checked within 4 +- 0.3
-    // and 3 +- 0.3, the others at their first pair from below (at least 3.7
-    // and 2.7) and within 1. (On channel_islands_ca, a patch with a kinked
-    // side holds the error of the second step: L2 2.3, then 6.4.)
+    // to 6.5e5 DOFs: bench/README.md; on the sea's optimized layout the first
+    // pair is L2 4.97, H1 4.27). So the plate is checked within 4 +- 0.3 and
+    // 3 +- 0.3, the others from below (at least 3.7 and 2.7: the optimal
+    // rates less the tolerance), with H1 below L2 (the gradient's error is
+    // the slower) and L2 below 6 (faster than h^6 would be a wrong error, not
+    // a good map). (On channel_islands_ca, a patch with a kinked side holds
+    // the error of the second step: L2 2.3, then 6.4.)
     struct Case {
       const char* file;
       int steps;
@@ -94,9 +97,9 @@ TEST_SUITE("multipatch_poisson_app") {
         CHECK(h1 == doctest::Approx(3.0).epsilon(0.3 / 3.0));
       } else {
         CHECK(l2 >= 3.7);
-        CHECK(l2 <= 5.0);
+        CHECK(l2 <= 6.0);
         CHECK(h1 >= 2.7);
-        CHECK(h1 <= 4.0);
+        CHECK(h1 < l2);
       }
       CHECK(rep["geometry"]["patches"].get<std::size_t>() >= 2);
       for (const json& s : rep["steps"]) {

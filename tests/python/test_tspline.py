@@ -1,7 +1,8 @@
-"""Tests of the Python module tspline (pytest): the parameterization from an
-array and from a file, evaluation against the polygon and finite differences,
-T-spline files, the Poisson solver with expressions and callables, and errors
-as Python exceptions with the library's messages."""
+"""Tests of the Python module tspline (pytest): the single-patch
+parameterization from an array and from a file, evaluation against the
+polygon and finite differences, T-spline files, the Poisson solver with
+expressions and callables, errors as Python exceptions of one hierarchy with
+the library's messages, and the example script."""
 import json
 import math
 import pathlib
@@ -11,14 +12,14 @@ import numpy as np
 import pytest
 
 import tspline
+from conftest import APP, DATA, cli_eval
 
-DATA = pathlib.Path(__file__).resolve().parent.parent / "data"
 FLOWER = DATA / "polygons" / "flower.txt"
 
 
 @pytest.fixture(scope="module")
 def flower():
-    return tspline.parameterize(np.loadtxt(FLOWER))
+    return tspline.parameterize(np.loadtxt(FLOWER), layout="single")
 
 
 def distance_to_polygon(points, poly):
@@ -37,6 +38,8 @@ def test_parameterize_array_is_certified(flower):
     assert isinstance(flower.report, dict)
     assert flower.report["certified_valid"] is True
     assert flower.report["input_geometry"]["format"] == "array"
+    assert flower.report["layout"]["chosen"] == "single" and flower.layout == "single"
+    assert flower.patches == 1 and flower.version == 1 and flower.interfaces == []
     assert flower.cells > 64 and flower.functions > flower.cells
 
 
@@ -71,7 +74,7 @@ def test_jacobian_matches_finite_differences(flower):
 
 def test_save_and_load(flower, tmp_path):
     f = tmp_path / "tspline.json"
-    flower.save(str(f))
+    flower.save_tspline(str(f))
     m2 = tspline.load(str(f))
     assert m2.certified_valid is True
     uv = np.random.default_rng(5).uniform(0, 1, size=(50, 2))
@@ -81,7 +84,7 @@ def test_save_and_load(flower, tmp_path):
 
 def test_parameterize_a_file_with_options():
     m = tspline.parameterize(str(DATA / "polygons" / "square.txt"), init_level=2, max_adapt=2)
-    assert m.certified_valid
+    assert m.certified_valid and m.patches == 1  # auto: one patch is good
     assert m.report["input_geometry"]["format"] == "text"
     # The unit square is mapped onto itself by a rigid motion of the square
     # (whichever vertex is the first corner): J^T J = I, the centre is fixed.
@@ -110,7 +113,7 @@ def test_poisson_expressions_and_callables_agree(flower):
 def test_poisson_reproduces_a_cubic_on_the_square():
     # On the square the map is affine, so u = x^3 + x^2 y - 2 y^3 + x y (f = -6x + 10y)
     # lies in the cubic analysis space and is reproduced to round-off.
-    m = tspline.parameterize(np.loadtxt(DATA / "polygons" / "square.txt"), init_level=2, max_adapt=1)
+    m = tspline.parameterize(np.loadtxt(DATA / "polygons" / "square.txt"), init_level=2, max_adapt=1, layout="single")
     u = "x^3 + x^2*y - 2*y^3 + x*y"
     sol = tspline.poisson(m, f=lambda x, y: -6 * x + 10 * y, g=u, exact=u, steps=1)
     uv = np.random.default_rng(11).uniform(0, 1, size=(40, 2))
@@ -126,11 +129,8 @@ SIDES = {"bottom": lambda t: (t, 0.0), "right": lambda t: (1.0, t), "top": lambd
 def test_poisson_on_a_multi_patch_file(tmp_path):
     # The plate with a hole, mapped by the built `tspline param` (a version-2 file of
     # several patches): the same solver through the path of the file.
-    app = pathlib.Path(tspline.__file__).resolve().parent.parent / "apps" / "tspline"
-    if not app.exists():
-        pytest.skip("the tspline program is not built beside the module")
     out = tmp_path / "plate"
-    subprocess.run([str(app), "param", str(DATA / "holes" / "plate_with_hole.txt"), "--out", str(out), "-q"],
+    subprocess.run([str(APP), "param", str(DATA / "holes" / "plate_with_hole.txt"), "--out", str(out), "-q"],
                    check=True)
     doc = json.loads((out / "tspline.json").read_text())
     assert doc["version"] == 2
@@ -148,9 +148,22 @@ def test_poisson_on_a_multi_patch_file(tmp_path):
         sol.evaluate(t[:2, None].repeat(2, axis=1), patch=len(doc["patches"]))
 
 
-def test_errors_are_python_exceptions():
-    with pytest.raises(ValueError, match=r"shape \(n, 2\)"):
+def test_errors_are_python_exceptions_of_one_hierarchy(tmp_path):
+    for name, base in [("InputError", ValueError), ("IoError", OSError), ("NumericalError", ArithmeticError)]:
+        assert issubclass(getattr(tspline, name), tspline.Error) and issubclass(getattr(tspline, name), base)
+    with pytest.raises(tspline.InputError, match=r"shape \(n, 2\)"):
         tspline.parameterize(np.zeros((4, 3)))
+    with pytest.raises(TypeError, match="domain: expected a path"):
+        tspline.parameterize(42)
+    with pytest.raises(tspline.InputError, match="hole 1"):  # a hole outside the outer ring
+        tspline.parameterize([np.loadtxt(FLOWER), np.array([[50.0, 50.0], [51.0, 50.0], [50.0, 51.0]])])
+    with pytest.raises(tspline.InputError, match="not GeoJSON"):
+        tspline.parameterize({"type": "Nothing"})
+    with pytest.raises(tspline.InputError, match="crs 'EPSG:nonesuch'"):
+        tspline.parameterize({"type": "Polygon", "coordinates": [[[0, 0], [1, 0], [1, 1], [0, 1], [0, 0]]]},
+                             crs="EPSG:nonesuch")
+    with pytest.raises(tspline.IoError, match="nonesuch"):
+        tspline.parameterize(tmp_path / "nonesuch.txt")
     bowtie = np.array([[0.0, 0.0], [1.0, 1.0], [1.0, 0.0], [0.0, 1.0]])
     with pytest.raises(tspline.InputError) as e:
         tspline.parameterize(bowtie)
@@ -162,6 +175,10 @@ def test_errors_are_python_exceptions():
     with pytest.raises(TypeError, match="unknown keyword argument 'tolerance'"):
         tspline.parameterize(np.loadtxt(FLOWER), tolerance=1)
     m = tspline.parameterize(np.loadtxt(DATA / "polygons" / "square.txt"), init_level=2, max_adapt=1)
+    blocker = tmp_path / "blocker"
+    blocker.write_text("a file, not a folder")
+    with pytest.raises(tspline.IoError, match="blocker"):
+        m.save(blocker / "out")
     with pytest.raises(ValueError, match="outside"):
         m.evaluate(np.array([[1.5, 0.5]]))
     with pytest.raises(ValueError, match="f: cannot parse"):
@@ -191,22 +208,16 @@ def test_example_script(tmp_path):
 
 
 def test_evaluate_equals_tspline_eval_on_a_coastline(tmp_path):
-    """A bundled coastline (km): the module's evaluate and the `tspline eval`
-    command on the saved file agree to round-off (both print/hold 17 digits)."""
-    import subprocess
-    app = pathlib.Path(__file__).resolve().parent.parent.parent / "build" / "apps" / "tspline"
-    if not app.exists():
-        pytest.fail(f"the tspline program is not built at {app}")
-    m = tspline.parameterize(str(DATA / "coastlines" / "isle_of_man.txt"))
-    assert m.certified_valid
+    """A bundled coastline (km), one patch: the module's evaluate and the
+    `tspline eval` command on the saved file agree to round-off (both
+    print/hold 17 digits; test_domains does the same on every patch of a layout)."""
+    m = tspline.parameterize(str(DATA / "coastlines" / "isle_of_man.txt"), layout="single")
+    assert m.certified_valid and m.patches == 1
     path = tmp_path / "iom.json"
-    m.save(str(path))
+    m.save_tspline(path)
     uv = np.array([[0.1, 0.2], [0.5, 0.5], [0.93, 0.41], [0.0, 0.0], [1.0, 0.7]])
-    args = [str(app), "eval", str(path)]
-    for u, v in uv:
-        args += ["--at", repr(float(u)), repr(float(v))]
-    out = subprocess.run(args, check=True, capture_output=True, text=True).stdout.split("\n")
-    got = np.array([[float(t) for t in line.split()[2:4]] for line in out if line.strip()])
     diam = np.ptp(np.loadtxt(DATA / "coastlines" / "isle_of_man.txt"), axis=0).max()
-    assert got.shape == (len(uv), 2)
-    assert np.abs(got - m.evaluate(uv)).max() <= 1e-13 * diam
+    for p in range(m.patches):
+        got = cli_eval(path, uv, patch=p)
+        assert got.shape == (len(uv), 2)
+        assert np.abs(got - m.evaluate(uv, patch=p)).max() <= 1e-13 * diam

@@ -195,12 +195,42 @@ TEST_SUITE("holes") {
     tspline::DomainCleaningOptions wide;
     wide.needle_width = 0.1;
     CHECK(message_of<tspline::InputError>([&] { (void)tspline::validate_domain(bow, wide); }) == m);
-    // A hole that is nothing but a needle (Maldives islet 140: three nearly
-    // collinear vertices) is named, not reported as "2 vertices".
-    const Domain sliver{square(0, 0, 10, 10), {square(1, 1, 2, 2), make_polygon({{5, 5}, {7, 5.00001}, {6, 5}})}};
-    CHECK(validation_error(sliver) ==
-          "Hole 2: the ring encloses no area: it is nothing but needles narrower than 0.000141 (2 of its 3 vertices "
-          "are left once they are removed)");
+    // Asked to, a hole that crosses itself becomes its convex hull, with a note.
+    std::vector<std::string> notes;
+    tspline::DomainCleaningOptions repair;
+    repair.repair_crossing_holes = true;
+    repair.notes = &notes;
+    const Domain fixed = tspline::validate_domain(bow, repair);
+    REQUIRE(fixed.holes.size() == 2);
+    REQUIRE(notes.size() == 1);
+    CHECK(contains(notes[0], "hole 2: crosses itself; replaced by its convex hull (4 of its 5 vertices"));
+    // The hull of (5,5), (6,5), (7,6), (7,5), (6,6): the square [6,7] x [5,6] with the triangle to (5,5).
+    CHECK(std::abs(tspline::signed_area(fixed.holes[1])) == doctest::Approx(1.5));
+    CHECK(tspline::domain_area(fixed) == doctest::Approx(100.0 - 1.0 - 1.5));
+    // The outer ring is never repaired.
+    const Domain outer_bow{make_polygon({{0, 0}, {10, 0}, {0, 10}, {10, 10}}), {}};
+    CHECK(contains(message_of<tspline::InputError>([&] { (void)tspline::validate_domain(outer_bow, repair); }),
+                   "The outer ring: polygon is not simple"));
+  }
+
+  TEST_CASE("domain validation: a hole that is nothing but needles is dropped with a note; holes keep their numbers") {
+    // Maldives islet 140: three nearly collinear vertices, no area at the needle width.
+    const Domain sliver{square(0, 0, 10, 10),
+                        {square(1, 1, 2, 2), make_polygon({{5, 5}, {7, 5.00001}, {6, 5}}), square(3, 3, 4, 4)}};
+    std::vector<std::string> notes;
+    tspline::DomainCleaningOptions how;
+    how.notes = &notes;
+    const Domain d = tspline::validate_domain(sliver, how);
+    CHECK(d.holes.size() == 2);
+    REQUIRE(notes.size() == 1);
+    CHECK(notes[0] ==
+          "hole 2: dropped: it encloses no area once its needles narrower than 0.000141 are removed (an islet below "
+          "the boundary tolerance)");
+    CHECK(tspline::domain_area(d) == doctest::Approx(98.0));
+    // Hole 3 is still hole 3 in messages after hole 2 is gone.
+    Domain touching = sliver;
+    touching.holes[2] = square(2, 1, 3, 2);  // shares the edge x = 2 with hole 1
+    CHECK(contains(validation_error(touching), "hole 3 touches hole 1"));
   }
 
   TEST_CASE("cuts: crossing, off the rings or out of the domain are named") {

@@ -74,6 +74,16 @@ void validate(const VtuMesh& mesh) {
   check_lengths(mesh.point_vectors, np, "point vector", "point", point_names);
   check_lengths(mesh.cell_scalars, mesh.cells.size(), "cell scalar", "cell", cell_names);
   check_lengths(mesh.cell_ints, mesh.cells.size(), "cell int", "cell", cell_names);
+  check_lengths(mesh.cell_vectors, mesh.cells.size(), "cell vector", "cell", cell_names);
+  if (!mesh.cell_types.empty() && mesh.cell_types.size() != mesh.cells.size())
+    throw std::invalid_argument("write_vtu: " + std::to_string(mesh.cell_types.size()) + " cell types for " +
+                                std::to_string(mesh.cells.size()) + " cells");
+  if (!mesh.higher_order_degrees.empty() && mesh.higher_order_degrees.size() != mesh.cells.size())
+    throw std::invalid_argument("write_vtu: " + std::to_string(mesh.higher_order_degrees.size()) +
+                                " higher-order degrees for " + std::to_string(mesh.cells.size()) + " cells");
+  if (!mesh.rational_weights.empty() && !mesh.point_scalars.count(mesh.rational_weights))
+    throw std::invalid_argument("write_vtu: no point scalar array '" + mesh.rational_weights +
+                                "' for the rational weights");
 }
 
 // ---------------------------------------------------------------- grid building
@@ -93,6 +103,18 @@ vtkNew<vtkDoubleArray> make_double_array(const std::string& name, const std::vec
   a->SetNumberOfComponents(1);
   a->SetNumberOfTuples(static_cast<vtkIdType>(v.size()));
   for (std::size_t i = 0; i < v.size(); ++i) a->SetValue(static_cast<vtkIdType>(i), v[i]);
+  return a;
+}
+
+vtkNew<vtkDoubleArray> make_vector_array(const std::string& name, const std::vector<Eigen::Vector2d>& v) {
+  vtkNew<vtkDoubleArray> a;
+  a->SetName(name.c_str());
+  a->SetNumberOfComponents(3);
+  a->SetNumberOfTuples(static_cast<vtkIdType>(v.size()));
+  for (std::size_t i = 0; i < v.size(); ++i) {
+    const double t[3] = {v[i].x(), v[i].y(), 0.0};
+    a->SetTypedTuple(static_cast<vtkIdType>(i), t);
+  }
   return a;
 }
 
@@ -125,27 +147,30 @@ vtkNew<vtkUnstructuredGrid> build_grid(const VtuMesh& mesh) {
     const auto& cell = mesh.cells[c];
     ids.assign(cell.begin(), cell.end());
     cells->InsertNextCell(static_cast<vtkIdType>(ids.size()), ids.data());
-    types->SetValue(static_cast<vtkIdType>(c), static_cast<unsigned char>(cell_type(cell, mesh.quads_as_polygons)));
+    const int type = mesh.cell_types.empty() ? cell_type(cell, mesh.quads_as_polygons) : mesh.cell_types[c];
+    types->SetValue(static_cast<vtkIdType>(c), static_cast<unsigned char>(type));
   }
   grid->SetCells(types, cells);
 
   vtkPointData* pd = grid->GetPointData();
   for (const auto& [name, v] : mesh.point_scalars) pd->AddArray(make_double_array(name, v));
   for (const auto& [name, v] : mesh.point_ints) pd->AddArray(make_int_array(name, v));
-  for (const auto& [name, v] : mesh.point_vectors) {
-    vtkNew<vtkDoubleArray> a;
-    a->SetName(name.c_str());
-    a->SetNumberOfComponents(3);
-    a->SetNumberOfTuples(static_cast<vtkIdType>(v.size()));
-    for (std::size_t i = 0; i < v.size(); ++i) {
-      const double t[3] = {v[i].x(), v[i].y(), 0.0};
-      a->SetTypedTuple(static_cast<vtkIdType>(i), t);
-    }
-    pd->AddArray(a);
-  }
+  for (const auto& [name, v] : mesh.point_vectors) pd->AddArray(make_vector_array(name, v));
+  if (!mesh.rational_weights.empty())
+    pd->SetActiveAttribute(mesh.rational_weights.c_str(), vtkDataSetAttributes::RATIONALWEIGHTS);
   vtkCellData* cd = grid->GetCellData();
   for (const auto& [name, v] : mesh.cell_scalars) cd->AddArray(make_double_array(name, v));
   for (const auto& [name, v] : mesh.cell_ints) cd->AddArray(make_int_array(name, v));
+  for (const auto& [name, v] : mesh.cell_vectors) cd->AddArray(make_vector_array(name, v));
+  if (!mesh.higher_order_degrees.empty()) {
+    vtkNew<vtkIntArray> a;
+    a->SetName("HigherOrderDegrees");
+    a->SetNumberOfComponents(3);
+    a->SetNumberOfTuples(static_cast<vtkIdType>(mesh.higher_order_degrees.size()));
+    for (std::size_t c = 0; c < mesh.higher_order_degrees.size(); ++c)
+      a->SetTypedTuple(static_cast<vtkIdType>(c), mesh.higher_order_degrees[c].data());
+    cd->SetHigherOrderDegrees(a);
+  }
   return grid;
 }
 

@@ -13,16 +13,11 @@ nlohmann::json bezier_document(const TSplineMap& map, const std::string& source)
   json elements = json::array();
   for (const BezierElement& e : extraction.elements()) {
     json rows = json::array();
-    // Homogeneous Bezier control points: with N_a = sum_k C(a,k) B_k on the
-    // element, X = sum_a P_a N_a and w = sum_a N_a (R = N / sum N, Eq. 6) are
-    // sum_k (sum_a C(a,k) P_a) B_k and sum_k (sum_a C(a,k)) B_k.
-    Eigen::Matrix<double, 16, 3> H = Eigen::Matrix<double, 16, 3>::Zero();
     for (std::size_t r = 0; r < e.functions.size(); ++r) {
       const auto row = e.C.row(static_cast<Eigen::Index>(r));
       rows.push_back(std::vector<double>(row.data(), row.data() + 16));
-      const Eigen::Vector2d& p = P[e.functions[r]];
-      for (int k = 0; k < 16; ++k) H.row(k) += row[k] * Eigen::RowVector3d(p.x(), p.y(), 1.0);
     }
+    const Eigen::Matrix<double, 16, 3> H = homogeneous_bezier_points(e, P);
     json hom = json::array();
     for (int k = 0; k < 16; ++k) hom.push_back({H(k, 0), H(k, 1), H(k, 2)});
     elements.push_back({{"cell", e.cell},

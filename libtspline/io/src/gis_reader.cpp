@@ -2,11 +2,13 @@
 #include "tspline/io/gis_reader.h"
 
 #include <cpl_error.h>
+#include <cpl_vsi.h>
 #include <gdal_priv.h>
 #include <ogr_spatialref.h>
 #include <ogrsf_frmts.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cctype>
 #include <cmath>
 #include <cstring>
@@ -122,6 +124,9 @@ Polygon to_polygon(const Ring& r) {
   return p;
 }
 
+/// The domain of an open dataset; `path` names it in messages.
+DomainInput read_dataset(GDALDataset& dataset, const std::string& path, const DomainReadOptions& options);
+
 std::string lower_extension(const std::string& path) {
   std::string e = fs::path(path).extension().string();
   std::transform(e.begin(), e.end(), e.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
@@ -154,6 +159,7 @@ DomainInput read_domain(const std::string& path, const DomainReadOptions& option
   if (!is_gis_file(path)) {
     if (options.layer || options.feature)
       throw InputError(path + ": --layer and --feature apply to GIS files, not to a text polygon");
+    if (options.crs) throw InputError(path + ": a CRS applies to GIS data, not to a text polygon (planar)");
     // Rings separated by blank lines: the first is the outer boundary, the others are holes.
     std::vector<Polygon> rings = read_text_rings(path);
     out.outer = std::move(rings.front());
@@ -175,6 +181,37 @@ DomainInput read_domain(const std::string& path, const DomainReadOptions& option
       throw IoError("cannot read " + path + ": a directory, and not a vector dataset that GDAL reads");
     throw InputError(path + ": not a vector file that GDAL reads" + QuietGdal::last());
   }
+  return read_dataset(*ds, path, options);
+}
+
+DomainInput read_geojson_domain(const std::string& geojson, const DomainReadOptions& options,
+                                const std::string& name) {
+  const QuietGdal quiet;
+  // A GDAL in-memory file (/vsimem/), unique to this call.
+  static std::atomic<unsigned long> counter{0};
+  const std::string mem = "/vsimem/tspline_domain_" + std::to_string(++counter) + ".geojson";
+  VSILFILE* f = VSIFileFromMemBuffer(mem.c_str(), reinterpret_cast<GByte*>(const_cast<char*>(geojson.data())),
+                                     static_cast<vsi_l_offset>(geojson.size()), FALSE);
+  if (!f) throw IoError(name + ": cannot make an in-memory file for GDAL" + QuietGdal::last());
+  VSIFCloseL(f);
+  struct Unlink {
+    std::string path;
+    ~Unlink() { VSIUnlink(path.c_str()); }
+  } unlink{mem};
+  const char* const drivers[] = {"GeoJSON", nullptr};
+  std::unique_ptr<GDALDataset, DatasetCloser> ds(static_cast<GDALDataset*>(
+      GDALOpenEx(mem.c_str(), GDAL_OF_VECTOR | GDAL_OF_READONLY, drivers, nullptr, nullptr)));
+  if (!ds) throw InputError(name + ": not GeoJSON that GDAL reads" + QuietGdal::last());
+  DomainInput in = read_dataset(*ds, name, options);
+  in.description["layer"] = nullptr;  // GDAL's name of the in-memory file
+  return in;
+}
+
+namespace {
+
+DomainInput read_dataset(GDALDataset& dataset, const std::string& path, const DomainReadOptions& options) {
+  DomainInput out;
+  GDALDataset* ds = &dataset;
   // The layer.
   OGRLayer* layer = nullptr;
   if (options.layer) {
@@ -236,6 +273,13 @@ DomainInput read_domain(const std::string& path, const DomainReadOptions& option
                       {"crs", nullptr},
                       {"projection", nullptr}};
   const OGRSpatialReference* layer_srs = layer->GetSpatialRef();
+  OGRSpatialReference given_srs;
+  if (options.crs) {  // the caller's CRS instead of the layer's
+    if (given_srs.SetFromUserInput(options.crs->c_str()) != OGRERR_NONE)
+      throw InputError(path + ": crs '" + *options.crs + "' is not a CRS that GDAL knows" +
+                       QuietGdal::last());
+    layer_srs = &given_srs;
+  }
   if (layer_srs) d["crs"] = layer_srs->GetName() ? layer_srs->GetName() : "unnamed";
   // GeoPackage's placeholders for "no CRS" (srs_id 0 and -1, "Undefined
   // geographic/Cartesian SRS", what GDAL writes for a layer without one) are
@@ -294,4 +338,5 @@ DomainInput read_domain(const std::string& path, const DomainReadOptions& option
   return out;
 }
 
+}  // namespace
 }  // namespace tspline::io

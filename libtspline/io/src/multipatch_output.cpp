@@ -42,16 +42,22 @@ toolkit::io::VtuMesh merge_patches(const std::vector<toolkit::io::VtuMesh>& part
   out.quads_as_polygons = parts.front().quads_as_polygons;
   out.point_scalars = parts.front().point_scalars, out.cell_scalars = parts.front().cell_scalars;
   out.cell_ints = parts.front().cell_ints, out.point_ints = parts.front().point_ints;
-  out.point_vectors = parts.front().point_vectors;
+  out.point_vectors = parts.front().point_vectors, out.cell_vectors = parts.front().cell_vectors;
+  out.rational_weights = parts.front().rational_weights;
   for (auto& [k, v] : out.point_scalars) v.clear();
   for (auto& [k, v] : out.cell_scalars) v.clear();
   for (auto& [k, v] : out.cell_ints) v.clear();
   for (auto& [k, v] : out.point_ints) v.clear();
   for (auto& [k, v] : out.point_vectors) v.clear();
+  for (auto& [k, v] : out.cell_vectors) v.clear();
+  bool typed = true, degrees = true;
   for (const toolkit::io::VtuMesh& p : parts) {
     keep_common(out.point_scalars, p.point_scalars), keep_common(out.cell_scalars, p.cell_scalars);
     keep_common(out.cell_ints, p.cell_ints), keep_common(out.point_ints, p.point_ints);
-    keep_common(out.point_vectors, p.point_vectors);
+    keep_common(out.point_vectors, p.point_vectors), keep_common(out.cell_vectors, p.cell_vectors);
+    typed = typed && p.cell_types.size() == p.cells.size();
+    degrees = degrees && p.higher_order_degrees.size() == p.cells.size();
+    if (p.rational_weights != out.rational_weights) out.rational_weights.clear();
   }
   std::vector<int> patch;
   for (std::size_t k = 0; k < parts.size(); ++k) {
@@ -65,8 +71,13 @@ toolkit::io::VtuMesh merge_patches(const std::vector<toolkit::io::VtuMesh>& part
     }
     append(out.point_scalars, p.point_scalars), append(out.cell_scalars, p.cell_scalars);
     append(out.cell_ints, p.cell_ints), append(out.point_ints, p.point_ints);
-    append(out.point_vectors, p.point_vectors);
+    append(out.point_vectors, p.point_vectors), append(out.cell_vectors, p.cell_vectors);
+    if (typed) out.cell_types.insert(out.cell_types.end(), p.cell_types.begin(), p.cell_types.end());
+    if (degrees)
+      out.higher_order_degrees.insert(out.higher_order_degrees.end(), p.higher_order_degrees.begin(),
+                                      p.higher_order_degrees.end());
   }
+  if (!out.point_scalars.count(out.rational_weights)) out.rational_weights.clear();
   out.cell_ints["patch"] = std::move(patch);
   return out;
 }
@@ -126,7 +137,7 @@ void write_multipatch_outputs(const MultiPatchResult& R, const std::string& out_
   const std::filesystem::path dir(out_dir);
   std::vector<const TSplineMap*> maps;
   std::vector<TSplineFileMeta> metas;
-  std::vector<toolkit::io::VtuMesh> surface, net, param, phys, boundary;
+  std::vector<toolkit::io::VtuMesh> surface, bezier, net, param, phys, boundary;
   for (std::size_t p = 0; p < R.patches.size(); ++p) {
     const ParameterizationResult& r = R.patches[p];
     maps.push_back(&*r.map);
@@ -136,6 +147,7 @@ void write_multipatch_outputs(const MultiPatchResult& R, const std::string& out_
     meta.corners = r.front.boundary.corners().index;
     metas.push_back(std::move(meta));
     surface.push_back(surface_vtu(*r.map, samples));
+    bezier.push_back(bezier_vtu(r));
     net.push_back(control_net_vtu(*r.map));
     const TMesh& mesh = r.front.mesh;
     std::vector<Eigen::Vector2d> uv(mesh.num_vertices());
@@ -148,6 +160,7 @@ void write_multipatch_outputs(const MultiPatchResult& R, const std::string& out_
   write_multipatch_file((dir / output_files::kTSpline).string(), maps, metas, R.layout.interfaces, R.layout.cuts,
                         report.value("input", ""));
   toolkit::io::write_vtu((dir / output_files::kSurface).string(), merge_patches(surface));
+  toolkit::io::write_vtu((dir / output_files::kBezierSurface).string(), merge_patches(bezier));
   toolkit::io::write_vtu((dir / output_files::kControlNet).string(), merge_patches(net));
   toolkit::io::write_vtu((dir / output_files::kParametricTMesh).string(), merge_patches(param));
   toolkit::io::write_vtu((dir / output_files::kPhysicalTMesh).string(), merge_patches(phys));

@@ -1,5 +1,6 @@
 #include "tspline/io/param_output.h"
 
+#include <Eigen/LU>
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -10,17 +11,16 @@
 #include <stdexcept>
 #include <utility>
 
-#include <Eigen/LU>
-
 #include "toolkit/io/atomic_file.h"
+#include "tspline/io/bezier_vtu.h"
 #include "tspline/io/cell_grid.h"
 #include "tspline/io/front_output.h"
+#include "tspline/io/output_files.h"
 #include "tspline/io/tspline_file.h"
 #include "tspline/spline/bezier_extraction.h"
 #include "tspline/validity/map_certification.h"
 #include "tspline/validity/map_quality.h"
 #include "tspline/validity/map_quality_bounds.h"
-#include "tspline/io/output_files.h"
 
 namespace tspline::io {
 
@@ -150,6 +150,11 @@ toolkit::io::VtuMesh physical_tmesh_vtu(const TSplineMap& map, int k, const MapC
   out.point_ints["hanging"] = std::move(hanging);
   out.point_ints["boundary"] = std::move(boundary);
   return out;
+}
+
+toolkit::io::VtuMesh bezier_vtu(const ParameterizationResult& r) {
+  if (!r.map) throw std::invalid_argument("bezier_vtu: the result has no map");
+  return bezier_vtu(*r.map, r.adaptive.certify ? &r.certification : nullptr, r.adaptive.certification);
 }
 
 toolkit::io::VtuMesh physical_tmesh_vtu(const ParameterizationResult& r, int k) {
@@ -429,6 +434,7 @@ void write_param_outputs(const ParameterizationResult& r, const std::string& out
   meta.corners = r.front.boundary.corners().index;
   write_tspline_file((dir / output_files::kTSpline).string(), *r.map, meta);
   toolkit::io::write_vtu((dir / output_files::kSurface).string(), surface_vtu(*r.map, samples));
+  toolkit::io::write_vtu((dir / output_files::kBezierSurface).string(), bezier_vtu(r));
   toolkit::io::write_vtu((dir / output_files::kControlNet).string(), control_net_vtu(*r.map));
   toolkit::io::write_text_atomic((dir / output_files::kReport).string(), report.dump(2) + "\n");  // last: the run's summary
 }

@@ -214,6 +214,77 @@ RenderView parse_render_view(const std::string& name) {
   throw InputError("--view: '" + name + "' is not one of auto, tmesh, jacobian, control-net, solution, layout");
 }
 
+namespace {
+
+/// The mesh as read_vtu gives it back: integer arrays as doubles.
+toolkit::io::VtuMesh as_read_back(toolkit::io::VtuMesh m) {
+  for (auto& [name, v] : m.cell_ints) m.cell_scalars[name].assign(v.begin(), v.end());
+  for (auto& [name, v] : m.point_ints) m.point_scalars[name].assign(v.begin(), v.end());
+  m.cell_ints.clear(), m.point_ints.clear();
+  return m;
+}
+
+/// A view of the map (not Solution) from its meshes; `source` names the surface (or control net) file.
+void draw_map_view(Canvas& img, RenderView view, const MapMeshes& maps, const std::string& source,
+                   RenderSummary& summary) {
+  const toolkit::io::VtuMesh& m = maps.surface;
+  switch (view) {
+    case RenderView::Jacobian: {
+      const std::vector<double>& jr = point_array(m, "mean_ratio_jacobian", source);
+      // J_r lies in [0, 1] for a valid map; a fold (J_r < 0) is drawn red.
+      auto colour = [](double v) { return v < 0.0 ? kRed : viridis(v); };
+      Box box;
+      box.add(m);
+      set_view(img, box, true);
+      fill_cells(img, m, jr, colour);
+      draw_cell_borders(img, m, kDark, 1.0);
+      draw_colourbar(img, 0.0, 1.0, colour, "mean ratio Jacobian J_r");
+      summary.min = *std::min_element(jr.begin(), jr.end());
+      summary.max = *std::max_element(jr.begin(), jr.end());
+      break;
+    }
+    case RenderView::TMesh: {
+      Box box;
+      box.add(m);
+      set_view(img, box, false);
+      fill_cells(img, m, std::vector<double>(m.points.size(), 0.0), [](double) { return kFill; });
+      draw_cell_borders(img, m, kBlack, 1.0);
+      draw_all_edges(img, maps.boundary, kRed, 1.0);
+      break;
+    }
+    case RenderView::ControlNet: {
+      const toolkit::io::VtuMesh& net = maps.control_net;
+      Box box;
+      box.add(net);
+      box.add(maps.boundary);
+      set_view(img, box, false);
+      draw_all_edges(img, maps.boundary, kBlack, 2.0);
+      draw_all_edges(img, net, kBlue, 1.0);
+      for (const auto& cell : net.cells)
+        if (cell.size() == 1) img.draw_dot(net.points[cell[0]], 2.0, kRed);
+      break;
+    }
+    case RenderView::Layout: {
+      Box box;
+      box.add(m);
+      set_view(img, box, false);
+      summary.max = static_cast<double>(draw_layout(img, m));
+      break;
+    }
+    case RenderView::Solution:
+    case RenderView::Auto:
+      break;
+  }
+  summary.source = source;
+}
+
+void check_size(const RenderOptions& options) {
+  if (options.width < 16 || options.height < 16 || options.width > 16384 || options.height > 16384)
+    throw InputError("image size must be between 16 and 16384 pixels per side");
+}
+
+}  // namespace
+
 RenderSummary render_png(const std::string& dir_name, const std::string& png_path, const RenderOptions& options) {
   const fs::path dir(dir_name);
   std::error_code ec;
@@ -223,91 +294,68 @@ RenderSummary render_png(const std::string& dir_name, const std::string& png_pat
   if (summary.view == RenderView::Auto)
     summary.view = fs::is_directory(dir / "solution", ec) ? RenderView::Solution : RenderView::Jacobian;
   const ImageFormat format = image_format_of(png_path);
-  if (options.width < 16 || options.height < 16 || options.width > 16384 || options.height > 16384)
-    throw InputError("image size must be between 16 and 16384 pixels per side");
+  check_size(options);
   const char* param = "tspline param";
+  if (summary.view != RenderView::Solution) {
+    // The map's files, read before the picture is started.
+    MapMeshes maps;
+    fs::path source = dir / output_files::kSurface;
+    if (summary.view == RenderView::ControlNet) {
+      source = dir / output_files::kControlNet;
+      maps.control_net = read_output(source, param);
+      maps.boundary = read_output(dir / output_files::kBoundary, param);
+    } else {
+      maps.surface = read_output(source, param);
+      const fs::path bfile = dir / output_files::kBoundary;
+      if (summary.view == RenderView::TMesh && fs::is_regular_file(bfile, ec))
+        maps.boundary = toolkit::io::read_vtu(bfile.string());
+    }
+    toolkit::io::write_atomic(png_path, [&](const std::string& tmp) {
+      Canvas img(format, tmp, options.width, options.height);
+      draw_map_view(img, summary.view, maps, source.string(), summary);
+      img.finish();
+    });
+    return summary;
+  }
   toolkit::io::write_atomic(png_path, [&](const std::string& tmp) {
     Canvas img(format, tmp, options.width, options.height);
-    switch (summary.view) {
-      case RenderView::Jacobian: {
-        const fs::path file = dir / output_files::kSurface;
-        const toolkit::io::VtuMesh m = read_output(file, param);
-        const std::vector<double>& jr = point_array(m, "mean_ratio_jacobian", file);
-        // J_r lies in [0, 1] for a valid map; a fold (J_r < 0) is drawn red.
-        auto colour = [](double v) { return v < 0.0 ? kRed : viridis(v); };
-        Box box;
-        box.add(m);
-        set_view(img, box, true);
-        fill_cells(img, m, jr, colour);
-        draw_cell_borders(img, m, kDark, 1.0);
-        draw_colourbar(img, 0.0, 1.0, colour, "mean ratio Jacobian J_r");
-        summary.source = file.string();
-        summary.min = *std::min_element(jr.begin(), jr.end());
-        summary.max = *std::max_element(jr.begin(), jr.end());
-        break;
-      }
-      case RenderView::TMesh: {
-        const fs::path file = dir / output_files::kSurface;
-        const toolkit::io::VtuMesh m = read_output(file, param);
-        Box box;
-        box.add(m);
-        set_view(img, box, false);
-        fill_cells(img, m, std::vector<double>(m.points.size(), 0.0), [](double) { return kFill; });
-        draw_cell_borders(img, m, kBlack, 1.0);
-        const fs::path bfile = dir / output_files::kBoundary;
-        if (fs::is_regular_file(bfile, ec)) draw_all_edges(img, toolkit::io::read_vtu(bfile.string()), kRed, 1.0);
-        summary.source = file.string();
-        break;
-      }
-      case RenderView::ControlNet: {
-        const fs::path file = dir / output_files::kControlNet, bfile = dir / output_files::kBoundary;
-        const toolkit::io::VtuMesh net = read_output(file, param);
-        const toolkit::io::VtuMesh boundary = read_output(bfile, param);
-        Box box;
-        box.add(net);
-        box.add(boundary);
-        set_view(img, box, false);
-        draw_all_edges(img, boundary, kBlack, 2.0);
-        draw_all_edges(img, net, kBlue, 1.0);
-        for (const auto& cell : net.cells)
-          if (cell.size() == 1) img.draw_dot(net.points[cell[0]], 2.0, kRed);
-        summary.source = file.string();
-        break;
-      }
-      case RenderView::Solution: {
-        const fs::path file = solution_step(dir, options.step);
-        const toolkit::io::VtuMesh m = toolkit::io::read_vtu(file.string());
-        const std::vector<double>& u = point_array(m, "u_h", file);
-        const double lo = *std::min_element(u.begin(), u.end()), hi = *std::max_element(u.begin(), u.end());
-        const double span = hi > lo ? hi - lo : 1.0;
-        auto colour = [&](double v) { return viridis((v - lo) / span); };
-        Box box;
-        box.add(m);
-        set_view(img, box, true);
-        fill_cells(img, m, u, colour);
-        // Analysis cell edges (light, to show the refinement) while they stay
-        // readable: at most one cell per 100 pixels on average.
-        const double cells = m.cell_scalars.count("cell") ? m.cell_scalars.at("cell").back() + 1 : 0.0;
-        if (cells > 0 && cells < static_cast<double>(img.width()) * img.height() / 100.0)
-          draw_cell_borders(img, m, kLight, 1.0);
-        draw_colourbar(img, lo, hi, colour, "u_h");
-        summary.source = file.string();
-        summary.min = lo;
-        summary.max = hi;
-        break;
-      }
-      case RenderView::Layout: {
-        const fs::path file = dir / output_files::kSurface;
-        const toolkit::io::VtuMesh m = read_output(file, param);
-        Box box;
-        box.add(m);
-        set_view(img, box, false);
-        summary.max = static_cast<double>(draw_layout(img, m));
-        summary.source = file.string();
-        break;
-      }
-      case RenderView::Auto: break;
-    }
+    const fs::path file = solution_step(dir, options.step);
+    const toolkit::io::VtuMesh m = toolkit::io::read_vtu(file.string());
+    const std::vector<double>& u = point_array(m, "u_h", file);
+    const double lo = *std::min_element(u.begin(), u.end()), hi = *std::max_element(u.begin(), u.end());
+    const double span = hi > lo ? hi - lo : 1.0;
+    auto colour = [&](double v) { return viridis((v - lo) / span); };
+    Box box;
+    box.add(m);
+    set_view(img, box, true);
+    fill_cells(img, m, u, colour);
+    // Analysis cell edges (light, to show the refinement) while they stay
+    // readable: at most one cell per 100 pixels on average.
+    const double cells = m.cell_scalars.count("cell") ? m.cell_scalars.at("cell").back() + 1 : 0.0;
+    if (cells > 0 && cells < static_cast<double>(img.width()) * img.height() / 100.0)
+      draw_cell_borders(img, m, kLight, 1.0);
+    draw_colourbar(img, lo, hi, colour, "u_h");
+    summary.source = file.string();
+    summary.min = lo;
+    summary.max = hi;
+    img.finish();
+  });
+  return summary;
+}
+
+RenderSummary render_map(const MapMeshes& meshes, const std::string& path, const RenderOptions& options) {
+  RenderSummary summary;
+  summary.view = options.view == RenderView::Auto ? RenderView::Jacobian : options.view;
+  if (summary.view == RenderView::Solution)
+    throw InputError("view 'solution' draws the output folder of `tspline poisson`, not a map");
+  const ImageFormat format = image_format_of(path);
+  check_size(options);
+  MapMeshes maps{as_read_back(meshes.surface), as_read_back(meshes.boundary),
+                 as_read_back(meshes.control_net)};
+  toolkit::io::write_atomic(path, [&](const std::string& tmp) {
+    Canvas img(format, tmp, options.width, options.height);
+    draw_map_view(img, summary.view, maps, summary.view == RenderView::ControlNet ? "control net" : "surface",
+                  summary);
     img.finish();
   });
   return summary;

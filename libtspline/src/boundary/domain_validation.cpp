@@ -3,9 +3,12 @@
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/Polygon_2_algorithms.h>
 #include <CGAL/box_intersection_d.h>
+#include <CGAL/convex_hull_2.h>
 
 #include <cctype>
 #include <cmath>
+#include <iterator>
+#include <optional>
 #include <sstream>
 #include <utility>
 #include <vector>
@@ -45,7 +48,8 @@ CGAL::Bounded_side side_of(const Polygon& p, const Eigen::Vector2d& x) {
 
 // The first pair of edges of two different rings that intersect (cross,
 // touch or overlap), found by box intersection in O(n log n + k).
-void check_rings_disjoint(const Domain& d) {
+// number[r]: ring r's number in the file (holes dropped in cleaning leave gaps).
+void check_rings_disjoint(const Domain& d, const std::vector<std::size_t>& number) {
   std::vector<Box> boxes;
   const std::size_t rings = d.holes.size() + 1;
   for (std::size_t r = 0; r < rings; ++r) {
@@ -84,9 +88,10 @@ void check_rings_disjoint(const Domain& d) {
                               CGAL::orientation(t.source(), t.target(), s.target()) < 0;
   std::ostringstream m;
   m.precision(10);
-  m << ring_name(hit.b.first) << (proper ? " crosses " : " touches ") << ring_name(hit.a.first) << ": edge "
-    << edge_name(pb, hit.b.second) << " of " << ring_name(hit.b.first) << " and edge " << edge_name(pa, hit.a.second)
-    << " of " << ring_name(hit.a.first) << (proper ? " intersect" : " meet") << " near (" << at.x() << ", "
+  const std::string na = ring_name(number[hit.a.first]), nb = ring_name(number[hit.b.first]);
+  m << nb << (proper ? " crosses " : " touches ") << na << ": edge " << edge_name(pb, hit.b.second) << " of " << nb
+    << " and edge " << edge_name(pa, hit.a.second) << " of " << na << (proper ? " intersect" : " meet") << " near ("
+    << at.x() << ", "
     << at.y() << "); holes must lie strictly inside the outer ring and apart from each other";
   throw InputError(m.str());
 }
@@ -95,34 +100,95 @@ void check_rings_disjoint(const Domain& d) {
 
 std::string ring_name(std::size_t r) { return r == 0 ? "the outer ring" : "hole " + std::to_string(r); }
 
+namespace {
+
+double ring_area(const std::vector<Eigen::Vector2d>& v) {
+  double a = 0.0;
+  for (std::size_t i = 0; i < v.size(); ++i) {
+    const Eigen::Vector2d &p = v[i], &q = v[(i + 1) % v.size()];
+    a += p.x() * q.y() - p.y() * q.x();
+  }
+  return 0.5 * a;
+}
+
+// The convex hull of a ring's vertices, counter-clockwise, with their file numbers.
+Polygon convex_hull_of(const Polygon& p) {
+  std::vector<Point> pts, hull;
+  for (const auto& v : p.vertices) pts.push_back(point(v));
+  CGAL::convex_hull_2(pts.begin(), pts.end(), std::back_inserter(hull), K());
+  Polygon h;
+  for (const Point& q : hull)
+    for (std::size_t i = 0; i < pts.size(); ++i)
+      if (pts[i] == q) {
+        h.vertices.push_back(p.vertices[i]), h.file_index.push_back(p.file_index[i]);
+        break;
+      }
+  return h;
+}
+
+}  // namespace
+
 Domain validate_domain(Domain d, const DomainCleaningOptions& cleaning) {
   const double width = cleaning.needle_width
                            ? *cleaning.needle_width
                            : needle_width_for_ring(d.outer, std::nullopt, kDefaultNeedleWidthRelative);
-  auto validated = [&](Polygon p, std::size_t r) {
+  auto note = [&](const std::string& s) {
+    if (cleaning.notes) cleaning.notes->push_back(s);
+  };
+  // The ring cleaned and validated; nullopt for a hole that is nothing but needles.
+  auto validated = [&](Polygon p, std::size_t r) -> std::optional<Polygon> {
     std::string name = ring_name(r);
     try {
       PolygonCleaning c = clean_polygon(std::move(p), std::isfinite(width) && width > 0.0 ? width : 0.0);
-      if (cleaning.notes && !c.notes.empty()) cleaning.notes->push_back(cleaning_summary(name, c));
+      if (r > 0 && c.needles > 0 && c.polygon.vertices.size() < 3) {
+        std::ostringstream m;
+        m.precision(3);
+        m << name << ": dropped: it encloses no area once its needles narrower than " << width
+          << " are removed (an islet below the boundary tolerance)";
+        note(m.str());
+        return std::nullopt;
+      }
+      if (!c.notes.empty()) note(cleaning_summary(name, c));
+      if (r > 0 && cleaning.repair_crossing_holes && c.polygon.vertices.size() >= 3) {
+        std::vector<Point> pts;
+        for (const auto& v : c.polygon.vertices) pts.push_back(point(v));
+        if (!CGAL::is_simple_2(pts.begin(), pts.end(), K())) {
+          Polygon h = convex_hull_of(c.polygon);
+          std::ostringstream m;
+          m.precision(4);
+          m << name << ": crosses itself; replaced by its convex hull (" << h.vertices.size() << " of its "
+            << c.polygon.vertices.size() << " vertices; area " << std::abs(ring_area(c.polygon.vertices))
+            << " (signed, lobes cancelling) -> " << ring_area(h.vertices) << ")";
+          note(m.str());
+          c.polygon = std::move(h);
+        }
+      }
       return validate_cleaned_polygon(std::move(c), width, r == 0 ? 4 : 3);
     } catch (const InputError& e) {
       name[0] = static_cast<char>(std::toupper(static_cast<unsigned char>(name[0])));
       throw InputError(name + ": " + e.what());
     }
   };
-  d.outer = validated(std::move(d.outer), 0);
-  for (std::size_t h = 0; h < d.holes.size(); ++h) d.holes[h] = validated(std::move(d.holes[h]), h + 1);
-  check_rings_disjoint(d);
+  d.outer = *validated(std::move(d.outer), 0);
+  std::vector<std::size_t> number = {0};
+  std::vector<Polygon> holes;
+  for (std::size_t h = 0; h < d.holes.size(); ++h)
+    if (std::optional<Polygon> p = validated(std::move(d.holes[h]), h + 1)) {
+      holes.push_back(std::move(*p));
+      number.push_back(h + 1);
+    }
+  d.holes = std::move(holes);
+  check_rings_disjoint(d, number);
   // No ring meets another: each hole lies entirely on one side of every other ring.
   for (std::size_t h = 0; h < d.holes.size(); ++h) {
     const Eigen::Vector2d x = d.holes[h].vertices.front();
     if (side_of(d.outer, x) != CGAL::ON_BOUNDED_SIDE)
-      throw InputError(ring_name(h + 1) + " lies outside the outer ring (its vertex " +
+      throw InputError(ring_name(number[h + 1]) + " lies outside the outer ring (its vertex " +
                        std::to_string(d.holes[h].file_index.front()) + " is not inside it)");
     for (std::size_t g = 0; g < d.holes.size(); ++g) {
       if (g == h) continue;
       if (side_of(d.holes[g], x) == CGAL::ON_BOUNDED_SIDE)
-        throw InputError(ring_name(h + 1) + " lies inside " + ring_name(g + 1) +
+        throw InputError(ring_name(number[h + 1]) + " lies inside " + ring_name(number[g + 1]) +
                          " (a hole in a hole is not part of the domain)");
     }
   }

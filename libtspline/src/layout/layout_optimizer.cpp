@@ -65,6 +65,9 @@ void slide_ring_node(LayoutMesh& m, const LayoutTopology& t, const LayoutQuality
     if (t.on_ring(q, (j + 3) % 4)) back = Q.side_length(m, t, q, (j + 3) % 4);
   }
   if (!(back > 0.0 && ahead > 0.0)) return;
+  // A node whose cuts already cross a ring may move anywhere its energy falls
+  // (the check would otherwise pin it where it is wrong).
+  const bool was_admissible = admissible(m, t, n);
   const double s0 = m.arc[nn];
   const Eigen::Vector2d x0 = m.x[nn];
   // Candidates u in (-0.9 back, 0.9 ahead): the node at arc s0 + d u.
@@ -101,7 +104,7 @@ void slide_ring_node(LayoutMesh& m, const LayoutTopology& t, const LayoutQuality
     if (!(u > lo - 1e-12 && u < hi + 1e-12) || u == 0.0) continue;
     place(u);
     const double f = local(n);
-    if (f < best && admissible(m, t, n)) best = f, best_u = u;
+    if (f < best && (!was_admissible || admissible(m, t, n))) best = f, best_u = u;
   }
   // Local refinement around the best (the energy is smooth between vertices).
   double h = (hi - lo) / o.ring_samples;
@@ -110,7 +113,7 @@ void slide_ring_node(LayoutMesh& m, const LayoutTopology& t, const LayoutQuality
       if (!(u > lo && u < hi)) continue;
       place(u);
       const double f = local(n);
-      if (f < best && admissible(m, t, n)) best = f, best_u = u;
+      if (f < best && (!was_admissible || admissible(m, t, n))) best = f, best_u = u;
     }
   if (best_u == 0.0) m.arc[nn] = s0, m.x[nn] = x0;
   else place(best_u);
@@ -232,6 +235,7 @@ LayoutOptimizationReport optimize_layout_nodes(LayoutMesh& m, const LayoutQualit
       const double f0 = local(n);
       double best = f0;
       if (m.ring[n] < 0) {
+        const bool was_admissible = admissible(m, t, n);
         // Inner node: pattern search, the best of eight directions per step.
         for (int it = 0; it < 4 && step[nn] > 0.0; ++it) {
           const Eigen::Vector2d start = m.x[nn];
@@ -240,7 +244,7 @@ LayoutOptimizationReport optimize_layout_nodes(LayoutMesh& m, const LayoutQualit
             const double a = k * std::numbers::pi / 4.0;
             m.x[nn] = start + step[nn] * Eigen::Vector2d(std::cos(a), std::sin(a));
             const double f = local(n);
-            if (f < best && admissible(m, t, n)) best = f, best_x = m.x[nn];
+            if (f < best && (!was_admissible || admissible(m, t, n))) best = f, best_x = m.x[nn];
           }
           m.x[nn] = best_x;
           if (best_x == start) step[nn] *= 0.5;

@@ -129,13 +129,23 @@ double LayoutQuality::side_shape(const LayoutMesh& m, const LayoutTopology& t, i
   const double chord = (b - a).norm();
   if (!(chord > 0.0)) return 0.0;
   const Eigen::Vector2d u = (b - a) / chord;
-  double in = 0.0, out = 0.0;
+  // The opposite side's line, from corner j + 2 to j + 3: the patch on its left.
+  const Eigen::Vector2d o0 = m.x[m.quads[q][(j + 2) % 4]], o1 = m.x[m.quads[q][(j + 3) % 4]];
+  const double olen = (o1 - o0).norm();
+  const Eigen::Vector2d ou = olen > 0.0 ? Eigen::Vector2d((o1 - o0) / olen) : Eigen::Vector2d(-u);
+  double pinch = 1.0, out = 0.0;
   for (std::size_t i = v.i0; i < v.i1; ++i) {
-    const double d = cross(u, c.vertex(i) - a);  // > 0: inside the patch (left of a -> b)
-    in = std::max(in, d), out = std::max(out, -d);
+    const Eigen::Vector2d p = c.vertex(i);
+    const double d = cross(u, p - a);  // > 0: inside the patch (left of a -> b)
+    if (d <= 0.0) {
+      out = std::max(out, -d);
+      continue;
+    }
+    const Eigen::Vector2d f = a + u.dot(p - a) * u;
+    const double full = cross(ou, f - o0), left = cross(ou, p - o0);
+    pinch = std::min(pinch, full > 0.0 ? left / full : 0.0);
   }
-  const double w = std::min(side_length(m, t, q, (j + 1) % 4), side_length(m, t, q, (j + 3) % 4));
-  return std::min(w > 0.0 ? 1.0 - in / w : 0.0, 1.0 - 0.5 * out / chord);
+  return std::min(pinch, 1.0 - 0.5 * out / chord);
 }
 
 LayoutCornerQuality LayoutQuality::quad(const LayoutMesh& m, const LayoutTopology& t, int q) const {

@@ -1,7 +1,6 @@
 #include "tspline/layout/layout_topology.h"
 
 #include <algorithm>
-#include <cstdio>
 #include <cstdlib>
 #include <array>
 #include <utility>
@@ -89,7 +88,8 @@ std::size_t pillow_rings(LayoutMesh& m, const std::vector<char>& pillow) {
   for (std::size_t q = 0; q < quads.size(); ++q)
     for (int j = 0; j < 4; ++j) {
       const int v = quads[q][j], w = quads[q][(j + 1) % 4];
-      if (t.on_ring(static_cast<int>(q), j) && ring[v] >= 0 && pillow[ring[v]]) along.push_back({v, w});
+      if (t.on_ring(static_cast<int>(q), j) && ring[v] >= 0 && ring[w] == ring[v] && pillow[ring[v]])
+        along.push_back({v, w});
     }
   const std::size_t n0 = x.size();
   std::vector<int> copy(n0, -1);
@@ -129,6 +129,7 @@ LayoutRotationReport rotate_layout_edges(LayoutMesh& m, const LayoutQuality& Q, 
     }
     if (bad.empty()) break;
     std::sort(bad.begin(), bad.end());
+    if (bad.size() > o.max_quads) bad.resize(o.max_quads);
     std::vector<char> touched(m.quads.size(), 0);
     std::size_t kept = 0;
     for (const auto& [f0, q] : bad) {
@@ -142,6 +143,8 @@ LayoutRotationReport rotate_layout_edges(LayoutMesh& m, const LayoutQuality& Q, 
         if (t.on_ring(q, j)) continue;
         const auto [b, k] = t.across(q, j);
         if (b < 0 || touched[b]) continue;
+        // Only between quads that run along their shared edge in opposite directions.
+        if (m.quads[b][k] != m.quads[q][(j + 1) % 4]) continue;
         // The hexagon, counter-clockwise, the shared edge h0-h3.
         const std::array<int, 4>& A = m.quads[q];
         const std::array<int, 4>& B = m.quads[b];
@@ -172,8 +175,6 @@ LayoutRotationReport rotate_layout_edges(LayoutMesh& m, const LayoutQuality& Q, 
           for (const int n : free) valid = valid && admissible(c, ct, n);
           if (!valid) continue;
           const double after = region_figure(c, ct, Q, free);
-          if (std::getenv("TSPLINE_LAYOUT_DEBUG") && f0 < 0.01)
-            std::fprintf(stderr, "   rotation of quad %d edge %d (%d-%d) r %d: %.3g -> %.3g\n", q, j, h[0], h[3], r, before, after);
           if (after > best) best = after, best_mesh = std::move(c), best_other = b, best_free = free;
         }
       }

@@ -8,6 +8,7 @@
 #include <limits>
 #include <numbers>
 #include <set>
+#include <unordered_map>
 #include <sstream>
 
 #include "tspline/errors.h"
@@ -248,26 +249,38 @@ QuadLayout build_quad_layout(const Domain& d, const QuadLayoutOptions& o) {
           }
         }
     }
-    // The straight ring must turn where the true ring turns: at every node, the
-    // chord to a neighbour and the ring's own direction on the scale of a fifth
-    // of that piece within 35 degrees (else the mesher sees a blunt corner where
-    // the coast has a sharp tip, and gives it too few quads).
+    // At a sharp tip of the coast (the domain's angle there below 60 or above
+    // 300 degrees on the scale of a fifth of the pieces next to the node) the
+    // straight ring must be as sharp: the chord to a neighbour and the ring's
+    // own direction within 35 degrees; else the mesher sees a blunt corner where
+    // the coast has a tip, and gives it too few quads (a reflex tip of 340
+    // degrees split in two corners of 170 degrees).
     for (std::size_t r = 0; r < rings.size(); ++r) {
       const std::size_t n = nodes[r].size();
       if (n < 3) continue;
       const double L = rings[r].length();
       for (std::size_t k = 0; k < n; ++k) {
         const double s = nodes[r][k];
-        for (const int side : {1, -1}) {
-          const std::size_t other = side > 0 ? (k + 1) % n : (k + n - 1) % n;
-          double len = side > 0 ? nodes[r][other] - s : s - nodes[r][other];
-          if (len <= 0.0) len += L;
-          const Eigen::Vector2d p = rings[r].point(s);
-          const Eigen::Vector2d chord = straight[r][other] - p;
-          const Eigen::Vector2d near = rings[r].point(s + side * 0.2 * len) - p;
-          const double angle = std::abs(std::atan2(cross(chord, near), chord.dot(near)));
-          if (angle > 35.0 * std::numbers::pi / 180.0 && len > 4.0 * no.min_size * 1e-3)
-            to_split[r].insert(side > 0 ? k : other);
+        const Eigen::Vector2d p = rings[r].point(s);
+        double len[2];
+        Eigen::Vector2d near[2], chord[2];
+        for (const int side : {0, 1}) {
+          const std::size_t other = side == 0 ? (k + 1) % n : (k + n - 1) % n;
+          len[side] = side == 0 ? nodes[r][other] - s : s - nodes[r][other];
+          if (len[side] <= 0.0) len[side] += L;
+          chord[side] = straight[r][other] - p;
+          near[side] = rings[r].point(s + (side == 0 ? 1.0 : -1.0) * 0.2 * len[side]) - p;
+        }
+        // The domain's angle at the node from the forward to the backward direction
+        // (the domain on the left of the outer ring, on the right of holes).
+        double phi = std::atan2(cross(near[0], near[1]), near[0].dot(near[1]));
+        if (R.direction(static_cast<int>(r)) < 0.0) phi = -phi;
+        if (phi < 0.0) phi += 2.0 * std::numbers::pi;
+        if (phi > std::numbers::pi / 3.0 && phi < 5.0 * std::numbers::pi / 3.0) continue;
+        for (const int side : {0, 1}) {
+          const double angle = std::abs(std::atan2(cross(chord[side], near[side]), chord[side].dot(near[side])));
+          if (angle > 35.0 * std::numbers::pi / 180.0 && len[side] > 2.0 * no.min_size)
+            to_split[r].insert(side == 0 ? k : (k + n - 1) % n);
         }
       }
     }
@@ -295,6 +308,34 @@ QuadLayout build_quad_layout(const Domain& d, const QuadLayoutOptions& o) {
       split_marked();
       out.stats.repair_rounds = ++repairs;
       continue;
+    }
+    // The mesh must tile the straight domain: every edge used by two quads in
+    // opposite directions, or by one quad along a ring (between nodes of that
+    // ring). Gmsh can mesh a sliver inside a hole, or lose a ring node's curve
+    // where straight pieces nearly touch: more ring nodes there, and again.
+    {
+      std::unordered_map<unsigned long long, int> directed;
+      auto key = [](int a, int b) {
+        return (static_cast<unsigned long long>(static_cast<unsigned>(a)) << 32) | static_cast<unsigned>(b);
+      };
+      for (const auto& q : qm.quads)
+        for (int j = 0; j < 4; ++j) ++directed[key(q[j], q[(j + 1) % 4])];
+      bool broken = false;
+      for (const auto& q : qm.quads)
+        for (int j = 0; j < 4; ++j) {
+          const int a = q[j], b = q[(j + 1) % 4];
+          const bool twice = directed[key(a, b)] > 1;
+          const bool boundary = directed.find(key(b, a)) == directed.end();
+          if (twice || (boundary && !(qm.ring[a] >= 0 && qm.ring[a] == qm.ring[b]))) {
+            mark_nearest_piece(0.5 * (qm.nodes[a] + qm.nodes[b]));
+            broken = true;
+          }
+        }
+      if (broken && split_marked()) {
+        out.stats.repair_rounds = ++repairs;
+        continue;
+      }
+      if (broken) throw NumericalError("the quad mesher's quadrilaterals do not tile the domain");
     }
     // The mesh with its boundary nodes on the true rings.
     LayoutMesh m{qm.nodes, qm.ring, std::vector<double>(qm.nodes.size(), 0.0), qm.quads};
@@ -343,6 +384,9 @@ QuadLayout build_quad_layout(const Domain& d, const QuadLayoutOptions& o) {
         }
       return involved;
     };
+    if (debugging())
+      std::fprintf(stderr, "layout round %d: %zu nodes in violations at the start, %zu after optimization\n", round,
+                   violations(start, false).size(), violations(m, false).size());
     if (!violations(m, false).empty() && m.quads != start.quads) m = start;  // rotations undone
     for (int pass = 0; pass < 3; ++pass) {
       bool changed = false;
@@ -350,9 +394,11 @@ QuadLayout build_quad_layout(const Domain& d, const QuadLayoutOptions& o) {
         if (m.x[n] != start.x[n]) m.x[n] = start.x[n], m.arc[n] = start.arc[n], changed = true;
       if (!changed) break;
     }
+    if (debugging()) std::fprintf(stderr, "  %zu nodes still in violation\n", violations(m, false).size());
     violations(m, true);
     if (split_marked()) {
       out.stats.repair_rounds = ++repairs;
+      out.stats.optimization_level = level = 2;  // the new mesh is optimized in full
       continue;
     }
 
@@ -381,32 +427,38 @@ QuadLayout build_quad_layout(const Domain& d, const QuadLayoutOptions& o) {
           const double sn = cross(a, b) / (a.norm() * b.norm());
           const bool fine = level == 0 ? sn > 1e-3 : sn > 0.0175 && (a.dot(b) > 0.0 || sn > 0.174);
           if (!fine)
-            throw InputError("a patch corner outside 1-170 degrees at " + std::to_string(v[c].x()) + ", " +
-                             std::to_string(v[c].y()));
+            throw InputError("a patch corner outside 1-170 degrees near (" + std::to_string(v[c].x()) + ", " +
+                             std::to_string(v[c].y()) + ")");
         }
     } catch (const InputError& e) {
       if (debugging()) std::fprintf(stderr, "layout rejected at level %d: %s\n", level, e.what());
-      if (level > 0) {
+      if (level == 2) {
         // The optimization left a corner flat or reflex, or the cuts crossing
         // (a tangled start near rings much closer than the patch size): the
-        // same mesh, optimized less (level 2: rotations and node optimization;
-        // 1: node optimization; 0: the mesher's nodes).
-        out.stats.optimization_level = --level;
+        // same mesh without edge rotations.
+        out.stats.optimization_level = level = 1;
         continue;
       }
-      // Even the mesher's own layout fails (its cuts cross where the true
-      // rings are far from their chords): ring nodes more near the place, and again.
+      // Ring nodes more near the place, and a new mesh optimized in full;
+      // once the repairs are used up, the mesher's own nodes (level 0) are the
+      // last try (its cuts may cross where the true rings are far from their chords).
       const std::string what = e.what();
       const std::size_t at = what.find("near (");
-      if (at == std::string::npos || repairs >= o.max_repair_rounds) throw NumericalError("no valid quad layout: " + what);
-      char* end = nullptr;
-      const double px = std::strtod(what.c_str() + at + 6, &end);
-      const double py = end && *end == ',' ? std::strtod(end + 1, nullptr) : 0.0;
-      mark_nearest_piece(Eigen::Vector2d(px, py));
-      split_marked();
-      out.stats.repair_rounds = ++repairs;
-      out.stats.optimization_level = level = 2;  // the new mesh is optimized again
-      continue;
+      if (at != std::string::npos && repairs < o.max_repair_rounds) {
+        char* end = nullptr;
+        const double px = std::strtod(what.c_str() + at + 6, &end);
+        const double py = end && *end == ',' ? std::strtod(end + 1, nullptr) : 0.0;
+        mark_nearest_piece(Eigen::Vector2d(px, py));
+        split_marked();
+        out.stats.repair_rounds = ++repairs;
+        out.stats.optimization_level = level = 2;
+        continue;
+      }
+      if (level == 1) {
+        out.stats.optimization_level = level = 0;
+        continue;
+      }
+      throw NumericalError("no valid quad layout: " + what);
     }
     QuadLayoutStats& st = out.stats;
     st.patches = out.layout.patches.size();

@@ -1,6 +1,7 @@
 #include "tspline/pipeline/domain_parameterization.h"
 
 #include <algorithm>
+#include <limits>
 #include <sstream>
 
 #include "tspline/errors.h"
@@ -165,10 +166,23 @@ DomainParameterization parameterize_domain(const Domain& input, const Parameteri
   try {
     run_quad(why);
     if (!adaptive.certify || out.patches->certified_valid()) {
-      out.rejected_single = q;
-      return out;
+      // Kept unless one patch was certified and better (the worse of the
+      // scaled Jacobian and J_r over the whole map, dense samples): a layout
+      // can split a sharp tip the single patch keeps whole.
+      DenseMapQuality lq;
+      lq.min_scaled = lq.min_mean_ratio = std::numeric_limits<double>::infinity();
+      for (const auto& r : out.patches->patches) {
+        lq.min_scaled = std::min(lq.min_scaled, r.dense_quality.min_scaled);
+        lq.min_mean_ratio = std::min(lq.min_mean_ratio, r.dense_quality.min_mean_ratio);
+      }
+      if (!certified || std::min(lq.min_scaled, lq.min_mean_ratio) >= std::min(q.min_scaled, q.min_mean_ratio)) {
+        out.rejected_single = q;
+        return out;
+      }
+      why = "the quad layout's map is certified but poorer than one patch (" + figures(lq) + "); one patch instead";
+    } else {
+      why = "the quad layout's map is not certified on every patch; one patch instead";
     }
-    why = "the quad layout's map is not certified on every patch; one patch instead";
   } catch (const NumericalError& e) {
     why = std::string("no quad layout (") + e.what() + "); one patch instead";
   }

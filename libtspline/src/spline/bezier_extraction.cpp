@@ -163,4 +163,14 @@ BezierExtraction::BezierExtraction(const TSplineBasis& basis) {
   cell_begin_.push_back(elements_.size());
 }
 
+Eigen::Matrix<double, 16, 3> homogeneous_bezier_points(const BezierElement& e,
+                                                       const std::vector<Eigen::Vector2d>& P) {
+  Eigen::Matrix<double, 16, 3> H = Eigen::Matrix<double, 16, 3>::Zero();
+  for (std::size_t r = 0; r < e.functions.size(); ++r) {
+    const Eigen::Vector2d& p = P[e.functions[r]];
+    H += e.C.row(static_cast<Eigen::Index>(r)).transpose() * Eigen::RowVector3d(p.x(), p.y(), 1.0);
+  }
+  return H;
+}
+
 }  // namespace tspline

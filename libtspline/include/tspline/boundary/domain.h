@@ -33,12 +33,18 @@ struct DomainCleaningOptions {
   /// If set, receives one note per ring that was cleaned ("hole 9: removed
   /// vertex 0 (tip of a zero-area spike: edges 6-0 and 0-1 overlap)"), in ring order.
   std::vector<std::string>* notes = nullptr;
+  /// A hole whose ring crosses itself (a bow-tie islet of quantized data) is
+  /// replaced by its convex hull, with a note giving both areas; off: it is an
+  /// input error naming the ring and edges. The outer ring is never repaired.
+  bool repair_crossing_holes = false;
 };
 
 /// Cleans (clean_polygon: repeated vertices, needles and spikes narrower than
 /// the needle width, anywhere in the ring, vertex 0 too), validates and orients
-/// the domain; the file numbering of every ring is kept. The outer ring needs 4
-/// vertices, a hole 3.
+/// the domain; the file numbering of every ring is kept in messages. The outer
+/// ring needs 4 vertices, a hole 3; a hole that is nothing but needles (no
+/// area at the needle width: an islet below the boundary tolerance) is dropped
+/// with a note.
 /// \throw InputError with one line naming the rings and edges (file vertex
 /// indices of the ring): a ring that is not a simple polygon (prefixed with the
 /// ring's name), "hole 2 crosses the outer ring: edge 4-5 of hole 2 and edge

@@ -15,7 +15,8 @@
 // ring nodes by sampling their arc (every ring vertex in reach, where the
 // corner angles jump, and a uniform grid, then a local refinement). A move is
 // kept only if `admissible` accepts it (the caller's check of the true
-// geometry: inner nodes inside the domain, no cut crossing a ring).
+// geometry: inner nodes inside the domain, no cut crossing a ring), unless the
+// node was not admissible where it stood (then any move that lowers the energy).
 #include <functional>
 #include <vector>
 

@@ -50,12 +50,13 @@ class LayoutQuality {
   /// sin^2(phi / 2), phi the domain's inner angle, worst over the ring vertices
   /// strictly inside side j of quad q; 1 where the side is a cut or has none.
   double side_kinks(const LayoutMesh& m, const LayoutTopology& t, int q, int j) const;
-  /// How far ring side j of quad q strays from its chord: 1 - d_in / w, d_in the
-  /// farthest of its vertices inside the patch (left of the chord), w the shorter
-  /// of the two adjacent sides (the patch's width there: a coast bulging into a
-  /// thin patch pinches it), and 1 - d_out / (2 c) for vertices outside, c the
-  /// chord; the smaller, 1 for a cut. Not a bound of the map's figures but what
-  /// the corners cannot see.
+  /// How far ring side j of quad q strays from its chord. A vertex p inside the
+  /// patch (left of the chord) leaves the patch the width w(p) to the line of
+  /// the opposite side where the straight patch had w(f), f the foot of p on
+  /// the chord: the figure is w(p) / w(f) (a coast bulging into a thin patch
+  /// pinches it; for a rectangle 1 - d_in / width). Vertices outside give
+  /// 1 - d_out / (2 c), c the chord. The smallest, 1 for a cut. Not a bound of
+  /// the map's figures but what the corners cannot see.
   double side_shape(const LayoutMesh& m, const LayoutTopology& t, int q, int j) const;
   /// The worst of the quad's corners and side kinks.
   LayoutCornerQuality quad(const LayoutMesh& m, const LayoutTopology& t, int q) const;

@@ -24,8 +24,10 @@ struct LayoutRotationOptions {
   /// Quads whose figure (min of J_r and the side shape, layout_quality.h) is
   /// below this are where rotations are tried.
   double target = 0.45;
-  int rounds = 4;
-  int local_sweeps = 10;  ///< optimizer sweeps over the nodes of a tried rotation and their neighbours
+  int rounds = 3;
+  /// Per round, rotations are tried around this many of the worst quads at most.
+  std::size_t max_quads = 300;
+  int local_sweeps = 6;  ///< optimizer sweeps over the nodes of a tried rotation and their neighbours
 };
 
 struct LayoutRotationReport {

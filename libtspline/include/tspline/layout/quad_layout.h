@@ -53,13 +53,17 @@ struct QuadLayoutStats {
   std::size_t pillowed_rings = 0;            ///< rings given a layer of quads (a flat single-quad corner)
   /// How far the layout was optimized: 2 all (node optimization and edge
   /// rotations, layout_optimizer.h and layout_topology.h), 1 nodes only, 0 the
-  /// mesher's own nodes (a level is dropped where it leaves a patch corner
-  /// outside 1-170 degrees or the cuts crossing).
+  /// mesher's own nodes. Where level 2 leaves a patch corner outside 1-170
+  /// degrees or cuts crossing, the same mesh is tried at level 1; where that
+  /// fails too, the ring gets nodes near the place and a new mesh is optimized
+  /// at level 2 again; level 0 is the last try once the repair rounds are used up.
   int optimization_level = 2;
   std::size_t rotations = 0;       ///< edge rotations kept
   int optimization_sweeps = 0;     ///< node optimization sweeps, all passes
   /// The worst patch corner as the patch maps see it (layout_quality.h): J_r
-  /// and the scaled Jacobian there, upper bounds of the map's whole-map figures.
+  /// and the scaled Jacobian there. A prediction, not a bound: the certified
+  /// whole-map figures of the report are the ones to trust (measured within a
+  /// few percent of these at the worst patch when the patch's sides are smooth).
   double corner_mean_ratio = 1.0, corner_scaled_jacobian = 1.0;
   double min_size = 0.0, max_size = 0.0;     ///< of the size field, absolute
   double seconds = 0.0;

@@ -41,6 +41,14 @@ struct BezierElement {
   }
 };
 
+/// The map's homogeneous Bezier points on the element, for control points P
+/// (one per blending function): with N_a = sum_k C(a,k) B_k on the element,
+/// X = sum_a P_a N_a and w = sum_a N_a (R = N / sum N, Eq. 6) are
+/// sum_k X_k B_k and sum_k w_k B_k, X_k = sum_a C(a,k) P_a, w_k = sum_a C(a,k).
+/// Row k = i + 4 j holds (X_k, w_k); the Bezier point itself is X_k / w_k.
+Eigen::Matrix<double, 16, 3> homogeneous_bezier_points(const BezierElement& e,
+                                                       const std::vector<Eigen::Vector2d>& P);
+
 /// The split abscissae of cell c in one direction: the cell's own bounds and
 /// every knot of the functions on c strictly inside it, sorted (>= 2 values).
 void cell_element_breaks(const TSplineBasis& basis, int c, std::vector<double>& xi_breaks,

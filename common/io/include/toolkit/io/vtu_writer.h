@@ -2,6 +2,7 @@
 // ParaView output: VTK XML unstructured grids (.vtu, binary appended, zlib) and
 // .pvd collections. Library-neutral mesh description so callers need no VTK.
 #include <Eigen/Core>
+#include <array>
 #include <map>
 #include <string>
 #include <vector>
@@ -23,6 +24,17 @@ struct VtuMesh {
   std::map<std::string, std::vector<int>> cell_ints;         ///< one value per cell (Int32)
   std::map<std::string, std::vector<int>> point_ints;        ///< one value per point (Int32)
   std::map<std::string, std::vector<Eigen::Vector2d>> point_vectors;  ///< 3-component, z = 0
+  std::map<std::string, std::vector<Eigen::Vector2d>> cell_vectors;   ///< 3-component, z = 0
+
+  // Higher-order cells (VTK 9: Lagrange and Bezier cells, e.g. VTK_BEZIER_QUADRILATERAL = 77).
+  /// VTK cell type of each cell; empty: inferred from the point counts as above.
+  std::vector<int> cell_types;
+  /// Name of a point scalar array that holds the rational weights of Bezier
+  /// cells (marked as the point data's RationalWeights attribute); "" for none.
+  std::string rational_weights;
+  /// Degrees of each higher-order cell (cell data HigherOrderDegrees, marked as
+  /// that attribute); empty for none.
+  std::vector<std::array<int, 3>> higher_order_degrees;
 };
 
 /// Writes `mesh` to `path` atomically. \throw IoError; std::invalid_argument if

@@ -22,6 +22,11 @@ struct DomainReadOptions {
   std::optional<std::size_t> feature;         ///< 0-based feature index in the layer; default: all features
   std::optional<std::size_t> polygon_index;   ///< which polygon of those (0-based, file order); default: the largest
   bool planar = false;                        ///< keep the coordinates as they are (no projection)
+  /// The coordinates' CRS instead of the layer's (anything GDAL's
+  /// OGRSpatialReference::SetFromUserInput reads: "EPSG:4326", "OGC:CRS84",
+  /// WKT, a PROJ string); geographic ones are projected as above. Unset: the
+  /// layer's own.
+  std::optional<std::string> crs;
 };
 
 /// A domain as read: the outer boundary and its holes (each a Polygon in the
@@ -45,5 +50,14 @@ bool is_gis_file(const std::string& path);
 /// layer, a bad layer/feature/polygon choice, an unknown CRS for geographic
 /// data, or coordinates that are not longitude/latitude where they must be.
 DomainInput read_domain(const std::string& path, const DomainReadOptions& options = {});
+
+/// Reads a domain from GeoJSON text in memory (a geometry, Feature or
+/// FeatureCollection) as read_domain reads a .geojson file: through GDAL,
+/// longitude/latitude (RFC 7946) projected to metres unless `planar` or
+/// `crs` says otherwise. `name` stands for the input in messages and in the
+/// description ("format": "GeoJSON").
+/// 	hrow InputError as read_domain, and for text GDAL cannot read as GeoJSON.
+DomainInput read_geojson_domain(const std::string& geojson, const DomainReadOptions& options = {},
+                                const std::string& name = "GeoJSON");
 
 }  // namespace tspline::io

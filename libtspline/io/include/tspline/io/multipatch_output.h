@@ -13,7 +13,8 @@
 namespace tspline::io {
 
 /// The meshes one after the other, with an Int32 cell array `patch` (the index
-/// in `parts`); arrays not present in every part are dropped.
+/// in `parts`); arrays not present in every part are dropped, and so are cell
+/// types, higher-order degrees and rational weights unless every part has them.
 toolkit::io::VtuMesh merge_patches(const std::vector<toolkit::io::VtuMesh>& parts);
 
 /// Report: per patch the single-patch report (param_report), per interface the
@@ -21,7 +22,7 @@ toolkit::io::VtuMesh merge_patches(const std::vector<toolkit::io::VtuMesh>& part
 /// whole-map min J_r, areas, seconds).
 nlohmann::json multipatch_report(const MultiPatchResult& result, const std::string& input_path, double seconds);
 
-/// Writes tspline.json (version 2), surface.vtu, control_net.vtu,
+/// Writes tspline.json (version 2), surface.vtu, surface_bezier.vtu, control_net.vtu,
 /// parametric_tmesh.vtu (patch p shifted by 1.25 p in xi), physical_tmesh.vtu,
 /// boundary.vtu and report.json (last) into out_dir, each atomically.
 void write_multipatch_outputs(const MultiPatchResult& result, const std::string& out_dir,

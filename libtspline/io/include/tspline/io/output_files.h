@@ -10,6 +10,8 @@ namespace tspline::io::output_files {
 // tspline param (single patch and multipatch)
 inline constexpr std::string_view kTSpline = "tspline.json";       ///< the T-spline file (docs/tspline_format.md)
 inline constexpr std::string_view kSurface = "surface.vtu";        ///< the map sampled, with J_r and det J
+/// The map exactly: one rational bicubic Bezier cell per element (bezier_vtu.h)
+inline constexpr std::string_view kBezierSurface = "surface_bezier.vtu";
 inline constexpr std::string_view kControlNet = "control_net.vtu";
 inline constexpr std::string_view kAdaptSeries = "adapt.pvd";      ///< the adaptive rounds (folder adapt/)
 inline constexpr std::string_view kAdaptFolder = "adapt";
@@ -18,8 +20,12 @@ inline constexpr std::string_view kPhysicalTMesh = "physical_tmesh.vtu";
 inline constexpr std::string_view kBoundary = "boundary.vtu";
 inline constexpr std::string_view kReport = "report.json";         ///< written last: the run's summary
 /// What `tspline param` writes (single patch), in the order of its summary line.
-inline constexpr std::array<std::string_view, 8> kParam = {kTSpline, kSurface, kControlNet, kAdaptSeries,
-                                                           kParametricTMesh, kPhysicalTMesh, kBoundary, kReport};
+inline constexpr std::array<std::string_view, 9> kParam = {kTSpline,       kSurface,     kBezierSurface,
+                                                           kControlNet,    kAdaptSeries, kParametricTMesh,
+                                                           kPhysicalTMesh, kBoundary,    kReport};
+/// What `tspline param` writes for a map of several patches (no adapt.pvd).
+inline constexpr std::array<std::string_view, 8> kMultipatchParam = {
+    kTSpline, kSurface, kBezierSurface, kControlNet, kParametricTMesh, kPhysicalTMesh, kBoundary, kReport};
 
 // tspline poisson
 inline constexpr std::string_view kConvergenceCsv = "convergence.csv";

@@ -98,9 +98,13 @@ nlohmann::json combine_whole_map_quality_json(const std::vector<nlohmann::json>&
 /// (the options are those stored in the result).
 nlohmann::json param_report(const ParameterizationResult& result, const std::string& input_path);
 
+/// The map of a result as Bezier cells (bezier_vtu.h), with the result's
+/// certificate if it was certified.
+toolkit::io::VtuMesh bezier_vtu(const ParameterizationResult& result);
+
 /// Writes parametric_tmesh.vtu, physical_tmesh.vtu (physical_tmesh_vtu with
 /// `samples` segments per cell edge), boundary.vtu, tspline.json, surface.vtu,
-/// control_net.vtu and report.json into out_dir (each atomically).
+/// surface_bezier.vtu, control_net.vtu and report.json into out_dir (each atomically).
 void write_param_outputs(const ParameterizationResult& result, const std::string& out_dir,
                          const nlohmann::json& report, int samples);
 

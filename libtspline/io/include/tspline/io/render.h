@@ -5,6 +5,8 @@
 // file, by the file's extension.
 #include <string>
 
+#include "toolkit/io/vtu_writer.h"
+
 namespace tspline::io {
 
 enum class RenderView {
@@ -38,5 +40,17 @@ struct RenderSummary {
 /// it and the command that writes it) or the PNG cannot be written; InputError
 /// for bad options.
 RenderSummary render_png(const std::string& dir, const std::string& png_path, const RenderOptions& options);
+
+/// The meshes of a map's pictures, as `tspline param` writes them into
+/// surface.vtu (surface_vtu; patches merged, multipatch_output.h),
+/// boundary.vtu and control_net.vtu; those a view does not draw may be empty.
+struct MapMeshes {
+  toolkit::io::VtuMesh surface, boundary, control_net;
+};
+
+/// The same pictures of a map from its meshes in memory (the Python module's
+/// Map.render): every view but Solution (Auto: Jacobian).
+/// 	hrow InputError for the Solution view or bad options; IoError as render_png.
+RenderSummary render_map(const MapMeshes& meshes, const std::string& path, const RenderOptions& options);
 
 }  // namespace tspline::io

@@ -1,0 +1,159 @@
+#include "param_session.h"
+
+#include <string_view>
+
+#include "toolkit/io/atomic_file.h"
+#include "tspline/boundary/domain.h"
+#include "tspline/boundary/polygon_validation.h"
+#include "tspline/errors.h"
+#include "tspline/io/multipatch_output.h"
+#include "tspline/io/output_files.h"
+#include "tspline/io/param_output.h"
+#include "tspline/io/polygon_reader.h"
+
+namespace tspline_app {
+namespace {
+
+using nlohmann::json;
+
+/// report.json of a multi-patch run: the multi-patch report with the input,
+/// cleaning and layout sections.
+json multipatch_report(const ParamRun& run) {
+  const tspline::DomainParameterization& P = run.result;
+  const tspline::MultiPatchResult& R = *P.patches;
+  json report = tspline::io::multipatch_report(R, run.source, run.seconds);
+  report["input_geometry"] = run.domain.description;
+  report["input_cleaning"] = {{"notes", run.cleaning_notes}};
+  report["layout"] = {{"chosen", P.layout}, {"reason", P.reason}, {"explanation", R.cuts_explanation}};
+  if (P.quad_stats) {
+    const tspline::QuadLayoutStats& s = *P.quad_stats;
+    report["layout"]["quad"] = {{"patches", s.patches},
+                                {"ring_nodes", s.ring_nodes},
+                                {"inner_nodes", s.inner_nodes},
+                                {"inner_valence", s.valence},
+                                {"straight_min_scaled_jacobian", s.min_corner_scaled_jacobian},
+                                {"straight_mean_scaled_jacobian", s.mean_corner_scaled_jacobian},
+                                {"repair_rounds", s.repair_rounds},
+                                {"pillowed_rings", s.pillowed_rings},
+                                {"optimization_level", s.optimization_level},
+                                {"rotations", s.rotations},
+                                {"optimization_sweeps", s.optimization_sweeps},
+                                {"corner_mean_ratio", s.corner_mean_ratio},
+                                {"corner_scaled_jacobian", s.corner_scaled_jacobian},
+                                {"min_size", s.min_size},
+                                {"max_size", s.max_size},
+                                {"seconds", s.seconds}};
+  }
+  if (P.rejected_single)
+    report["layout"]["single_patch_first_try"] = {
+        {"min_scaled_jacobian_dense", P.rejected_single->min_scaled},
+        {"min_mean_ratio_dense", P.rejected_single->min_mean_ratio}};
+  return report;
+}
+
+json single_report(const ParamRun& run) {
+  json report = tspline::io::param_report(*run.result.single, run.source);
+  report["input_geometry"] = run.domain.description;  // format, layer, CRS, projection (gis_reader.h)
+  report["layout"] = {{"chosen", run.result.layout}, {"reason", run.result.reason}};
+  return report;
+}
+
+}  // namespace
+
+std::vector<const tspline::TSplineMap*> ParamRun::maps() const {
+  std::vector<const tspline::TSplineMap*> out;
+  if (result.patches)
+    for (const tspline::ParameterizationResult& r : result.patches->patches) out.push_back(&*r.map);
+  else if (result.single && result.single->map)
+    out.push_back(&*result.single->map);
+  return out;
+}
+
+bool ParamRun::certified_valid() const {
+  return result.patches ? result.patches->certified_valid()
+                        : result.single && result.single->certified_valid();
+}
+
+ParamRun run_param(tspline::io::DomainInput domain, std::string source, const ParamSettings& settings,
+                   const ParamHooks& hooks, std::chrono::steady_clock::time_point started) {
+  ParamRun run;
+  run.source = std::move(source);
+  run.domain = std::move(domain);
+  run.settings = settings;
+  tspline::ParameterizationOptions opt = settings.opt;
+  opt.progress = hooks.progress;
+  tspline::DomainParameterizationOptions choice = settings.choice;
+  if (!settings.cuts_file.empty()) {
+    choice.cuts.emplace();
+    for (const tspline::Polygon& p : tspline::io::read_text_rings(settings.cuts_file))
+      choice.cuts->push_back(p.vertices);
+  }
+  const tspline::io::DomainInput& in = run.domain;
+  const bool several = !in.holes.empty() || choice.cuts || choice.layout == tspline::LayoutMode::Quad;
+  if (opt.corners && several)
+    throw tspline::InputError(
+        "--corners applies to a single patch; a layout of several patches has its corners "
+        "at the patch corners (use --layout single on a domain without holes)");
+  // A domain with holes: every ring is cleaned here with the run's boundary
+  // tolerance (needles narrower than epsilon / diagonal go, one note per
+  // cleaned ring); the pipeline's own validate_domain then finds nothing more.
+  // (One ring is cleaned by the single-patch pipeline itself.)
+  tspline::Domain rings{in.outer, in.holes};
+  if (!in.holes.empty()) {
+    tspline::DomainCleaningOptions how;
+    how.needle_width =
+        tspline::needle_width_for_ring(in.outer, opt.tolerance_absolute, opt.tolerance_relative);
+    how.notes = &run.cleaning_notes;
+    auto report_notes = [&] {
+      for (const std::string& note : run.cleaning_notes)
+        tspline::report_step(opt.progress, "cleaning", "note: " + note, -1,
+                             tspline::ProgressEvent::Kind::Note);
+    };
+    try {
+      rings = tspline::validate_domain(rings, how);
+    } catch (const tspline::InputError&) {
+      report_notes();  // what was cleaned before the ring that stopped the run
+      throw;
+    }
+    report_notes();
+  }
+  run.result = tspline::parameterize_domain(
+      rings, opt, settings.adaptive, choice,
+      [&](int it, const tspline::TMesh& mesh, const std::vector<Eigen::Vector2d>&,
+          const tspline::TSplineMap& map, const std::vector<tspline::CellMapQuality>& cells) {
+        if (it == 0) run.iterations.clear();  // a new run (auto's first try was run again, or dropped)
+        run.iterations.push_back({it, map, cells});
+        if (hooks.on_iteration) hooks.on_iteration(it, mesh.num_cells(), map.basis().size());
+      },
+      hooks.on_patch);
+  if (run.result.patches) run.iterations.clear();  // adapt.pvd is written for a single patch only
+  run.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  run.report = run.result.patches ? multipatch_report(run) : single_report(run);
+  return run;
+}
+
+void write_param_run(const ParamRun& run, const std::string& out_dir) {
+  toolkit::io::ensure_writable_directory(out_dir);
+  const int samples = run.settings.samples;
+  if (run.result.patches) {
+    tspline::io::write_multipatch_outputs(*run.result.patches, out_dir, run.report, samples);
+    return;
+  }
+  tspline::io::AdaptSeriesWriter series(out_dir, samples);
+  for (const ParamIteration& s : run.iterations) series.add(s.iteration, s.map, &s.cells);
+  series.finish();
+  tspline::io::write_param_outputs(*run.result.single, out_dir, run.report, samples);
+}
+
+std::vector<std::string> param_run_files(const ParamRun& run) {
+  namespace of = tspline::io::output_files;
+  std::vector<std::string> files;
+  if (run.result.patches) {
+    for (const std::string_view f : of::kMultipatchParam) files.emplace_back(f);
+  } else {
+    for (const std::string_view f : of::kParam) files.emplace_back(f);
+  }
+  return files;
+}
+
+}  // namespace tspline_app

@@ -1,0 +1,273 @@
+// The layout's own figures and moves (layout/layout_quality.h,
+// layout_optimizer.h, layout_topology.h): corner J_r and scaled Jacobian
+// against their closed forms, side kinks against sin^2(phi / 2), the node
+// optimizer bringing displaced and inverted nodes back, an edge rotation that
+// replaces a long diagonal, and the pillow layer on a ring with a flat corner.
+#include <doctest/doctest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
+#include "test_support.h"
+#include "tspline/layout/layout_mesh.h"
+#include "tspline/layout/layout_optimizer.h"
+#include "tspline/layout/layout_quality.h"
+#include "tspline/layout/layout_topology.h"
+#include "tspline/layout/ring_geometry.h"
+#include "tspline/layout/ring_nodes.h"
+
+namespace {
+
+using V = Eigen::Vector2d;
+
+// A layout whose nodes are the given ring vertices (ring 0, arc lengths along
+// it) followed by inner nodes.
+tspline::LayoutMesh ring_mesh(const tspline::RingCurve& ring, const std::vector<V>& ring_points,
+                              const std::vector<V>& inner, const std::vector<std::array<int, 4>>& quads) {
+  tspline::LayoutMesh m;
+  for (const V& p : ring_points) {
+    m.x.push_back(p);
+    m.ring.push_back(0);
+    // The arc length of a point on the ring: the nearest vertex's or along an edge.
+    double arc = 0.0, best = 1e300;
+    for (std::size_t i = 0; i < ring.size(); ++i) {
+      const V a = ring.vertex(i), b = ring.vertex(i + 1);
+      const double len = (b - a).norm();
+      const double t = std::clamp((p - a).dot(b - a) / (len * len), 0.0, 1.0);
+      const double d = (a + t * (b - a) - p).norm();
+      if (d < best) best = d, arc = ring.arc(i) + t * len;
+    }
+    m.arc.push_back(arc);
+  }
+  for (const V& p : inner) {
+    m.x.push_back(p);
+    m.ring.push_back(-1);
+    m.arc.push_back(0.0);
+  }
+  m.quads = quads;
+  return m;
+}
+
+tspline::LayoutRings one_ring(const std::vector<V>& vertices) {
+  tspline::LayoutRings r;
+  r.curves.emplace_back(vertices);
+  return r;
+}
+
+std::vector<V> vertices_of(const tspline::RingCurve& ring) {
+  std::vector<V> v;
+  for (std::size_t i = 0; i < ring.size(); ++i) v.push_back(ring.vertex(i));
+  return v;
+}
+
+const tspline::LayoutAdmissible anywhere = [](const tspline::LayoutMesh&, const tspline::LayoutTopology&, int) {
+  return true;
+};
+
+// The unit square as 2 x 2 quads: eight ring nodes, the centre (node 8) inside.
+tspline::LayoutMesh square_2x2(const tspline::RingCurve& ring, const V& centre, double bottom_mid) {
+  return ring_mesh(ring,
+                   {V(0, 0), V(bottom_mid, 0), V(1, 0), V(1, 0.5), V(1, 1), V(0.5, 1), V(0, 1), V(0, 0.5)},
+                   {centre}, {{0, 1, 8, 7}, {1, 2, 3, 8}, {8, 3, 4, 5}, {7, 8, 5, 6}});
+}
+
+}  // namespace
+
+TEST_SUITE("layout_quality") {
+  TEST_CASE("corner figures: J_r = 2 sin(theta) L1 L2 / (L1^2 + L2^2) and SJ = sin(theta), from the sides") {
+    // A 2 x 1 rectangle as one patch: right angles, sides 2 and 1 at every corner.
+    const tspline::LayoutRings rect = one_ring({V(0, 0), V(2, 0), V(2, 1), V(0, 1)});
+    const tspline::LayoutMesh m = ring_mesh(rect.curves[0], vertices_of(rect.curves[0]), {}, {{0, 1, 2, 3}});
+    const tspline::LayoutTopology t(m);
+    const tspline::LayoutQuality Q(rect);
+    for (int j = 0; j < 4; ++j) {
+      const tspline::LayoutCornerQuality c = Q.corner(m, t, 0, j);
+      CHECK(c.scaled_jacobian == doctest::Approx(1.0));
+      CHECK(c.mean_ratio == doctest::Approx(2.0 * 2.0 * 1.0 / (4.0 + 1.0)));
+      CHECK(Q.side_kinks(m, t, 0, j) == 1.0);
+    }
+    CHECK(Q.side_length(m, t, 0, 0) == doctest::Approx(2.0));
+    // A rhombus of side 1 and angle 60 degrees: J_r = SJ = sin 60 at the acute corners.
+    const double c60 = 0.5, s60 = std::sqrt(3.0) / 2.0;
+    const tspline::LayoutRings rh = one_ring({V(0, 0), V(1, 0), V(1 + c60, s60), V(c60, s60)});
+    const tspline::LayoutMesh r = ring_mesh(rh.curves[0], vertices_of(rh.curves[0]), {}, {{0, 1, 2, 3}});
+    const tspline::LayoutTopology rt(r);
+    const tspline::LayoutQuality RQ(rh);
+    CHECK(RQ.corner(r, rt, 0, 0).mean_ratio == doctest::Approx(s60));
+    CHECK(RQ.corner(r, rt, 0, 1).scaled_jacobian == doctest::Approx(s60));  // 120 degrees: sin 120 = sin 60
+    CHECK(RQ.quad(r, rt, 0).mean_ratio == doctest::Approx(s60));
+  }
+
+  TEST_CASE("side kinks: a ring vertex inside a side with domain angle phi gives sin^2(phi / 2)") {
+    // The bottom of a 2 x 1 rectangle bent down at (1, -d): the domain's angle there is
+    // 180 - 2 atan(d), so sin^2(phi / 2) = cos^2(atan d) = 1 / (1 + d^2).
+    for (const double d : {0.25, 1.0, 3.0}) {
+      const tspline::LayoutRings ring = one_ring({V(0, 0), V(1, -d), V(2, 0), V(2, 1), V(0, 1)});
+      const tspline::LayoutMesh m =
+          ring_mesh(ring.curves[0], {V(0, 0), V(2, 0), V(2, 1), V(0, 1)}, {}, {{0, 1, 2, 3}});
+      const tspline::LayoutTopology t(m);
+      const tspline::LayoutQuality Q(ring);
+      CHECK(Q.side_kinks(m, t, 0, 0) == doctest::Approx(1.0 / (1.0 + d * d)));
+      CHECK(Q.side_kinks(m, t, 0, 1) == 1.0);  // the right side is straight
+      // The bottom side runs along the ring: its length is the arc's, 2 sqrt(1 + d^2).
+      CHECK(Q.side_length(m, t, 0, 0) == doctest::Approx(2.0 * std::sqrt(1.0 + d * d)));
+      CHECK(Q.quad(m, t, 0).mean_ratio <= 1.0 / (1.0 + d * d) + 1e-12);
+    }
+  }
+
+  TEST_CASE("side shape: the width a coast bulging into the patch leaves, over the straight patch's") {
+    // A 2 x 1 rectangle whose bottom rises to (1, d) inside: at the vertex the patch
+    // is 1 - d wide where the straight patch is 1.
+    for (const double d : {0.2, 0.6}) {
+      const tspline::LayoutRings ring = one_ring({V(0, 0), V(1, d), V(2, 0), V(2, 1), V(0, 1)});
+      const tspline::LayoutMesh m =
+          ring_mesh(ring.curves[0], {V(0, 0), V(2, 0), V(2, 1), V(0, 1)}, {}, {{0, 1, 2, 3}});
+      const tspline::LayoutTopology t(m);
+      const tspline::LayoutQuality Q(ring);
+      CHECK(Q.side_shape(m, t, 0, 0) == doctest::Approx(1.0 - d));
+      CHECK(Q.side_shape(m, t, 0, 1) == 1.0);  // straight
+    }
+    // A wedge-shaped patch, 4 long, 2 wide at x = 0 and 1 wide at x = 4, whose bottom
+    // rises by 0.5 at x = 3: the width there is 1.25 - 0.5 of 1.25.
+    const tspline::LayoutRings wedge = one_ring({V(0, 0), V(3, 0.5), V(4, 0), V(4, 1), V(0, 2)});
+    const tspline::LayoutMesh w = ring_mesh(wedge.curves[0], {V(0, 0), V(4, 0), V(4, 1), V(0, 2)}, {}, {{0, 1, 2, 3}});
+    const tspline::LayoutQuality WQ(wedge);
+    // (Measured perpendicular to the opposite side: both widths scale alike.)
+    CHECK(WQ.side_shape(w, tspline::LayoutTopology(w), 0, 0) == doctest::Approx(0.75 / 1.25));
+    // A coast bulging out of the patch by d_out over a chord c: 1 - d_out / (2 c).
+    const tspline::LayoutRings outward = one_ring({V(0, 0), V(1, -0.5), V(2, 0), V(2, 1), V(0, 1)});
+    const tspline::LayoutMesh o =
+        ring_mesh(outward.curves[0], {V(0, 0), V(2, 0), V(2, 1), V(0, 1)}, {}, {{0, 1, 2, 3}});
+    CHECK(tspline::LayoutQuality(outward).side_shape(o, tspline::LayoutTopology(o), 0, 0) ==
+          doctest::Approx(1.0 - 0.5 * 0.5 / 2.0));
+  }
+
+  TEST_CASE("node optimization: a displaced centre and a displaced ring node go back to the square grid") {
+    const tspline::LayoutRings ring = one_ring({V(0, 0), V(1, 0), V(1, 1), V(0, 1)});
+    const tspline::LayoutQuality Q(ring);
+    tspline::LayoutMesh m = square_2x2(ring.curves[0], V(0.8, 0.7), 0.3);
+    const tspline::LayoutOptimizationReport r = tspline::optimize_layout_nodes(m, Q, anywhere);
+    CHECK(r.before.mean_ratio < 0.6);
+    CHECK(r.after.mean_ratio > 0.99);
+    CHECK(r.after.scaled_jacobian > 0.99);
+    CHECK((m.x[8] - V(0.5, 0.5)).norm() < 1e-2);
+    CHECK((m.x[1] - V(0.5, 0.0)).norm() < 1e-2);
+    CHECK(m.arc[1] == doctest::Approx(0.5).epsilon(2e-2));  // the ring node slid along its ring
+    CHECK(m.x[1].y() == 0.0);                               // ... and stayed on it
+    // The corners are pinned: a ring node whose quad corner is the ring's corner does not slide.
+    CHECK(m.x[0] == V(0, 0));
+    CHECK(m.x[2] == V(1, 0));
+  }
+
+  TEST_CASE("node optimization: a centre outside its star (inverted corners) is untangled") {
+    const tspline::LayoutRings ring = one_ring({V(0, 0), V(1, 0), V(1, 1), V(0, 1)});
+    const tspline::LayoutQuality Q(ring);
+    tspline::LayoutMesh m = square_2x2(ring.curves[0], V(0.9, 0.1), 0.5);
+    const tspline::LayoutTopology t(m);
+    CHECK(tspline::worst_layout_quality(m, t, Q).scaled_jacobian < 0.0);  // a reflex corner at (0.5, 0)
+    const tspline::LayoutOptimizationReport r = tspline::optimize_layout_nodes(m, Q, anywhere);
+    CHECK(r.before.scaled_jacobian < 0.0);
+    CHECK(r.after.scaled_jacobian > 0.99);
+  }
+
+  TEST_CASE("node optimization keeps nodes where the caller's check refuses the move") {
+    const tspline::LayoutRings ring = one_ring({V(0, 0), V(1, 0), V(1, 1), V(0, 1)});
+    const tspline::LayoutQuality Q(ring);
+    tspline::LayoutMesh m = square_2x2(ring.curves[0], V(0.8, 0.7), 0.5);
+    // The centre may not go left of x = 0.75: it ends on that line, as high as is best.
+    const tspline::LayoutAdmissible right = [](const tspline::LayoutMesh& mm, const tspline::LayoutTopology&, int n) {
+      return mm.ring[n] >= 0 || mm.x[n].x() >= 0.75;
+    };
+    tspline::optimize_layout_nodes(m, Q, right);
+    CHECK(m.x[8].x() >= 0.75);
+    CHECK(m.x[8].x() < 0.76);
+  }
+
+  TEST_CASE("edge rotation: a long hexagon split by its long diagonal is split by a short one instead") {
+    // h0 .. h5 counter-clockwise; two quads share h0-h3 (length 6): corners of 26.6
+    // degrees between sides of ratio 6 / sqrt 5 at h0 and h3.
+    const std::vector<V> h = {V(-3, 0), V(-1, -1), V(1, -1), V(3, 0), V(1, 1), V(-1, 1)};
+    const tspline::LayoutRings ring = one_ring(h);
+    const tspline::LayoutQuality Q(ring);
+    tspline::LayoutMesh m = ring_mesh(ring.curves[0], h, {}, {{0, 1, 2, 3}, {3, 4, 5, 0}});
+    const double before = std::min(tspline::layout_quad_figure(m, tspline::LayoutTopology(m), Q, 0),
+                                   tspline::layout_quad_figure(m, tspline::LayoutTopology(m), Q, 1));
+    CHECK(before == doctest::Approx(2.0 * std::sin(std::atan(0.5)) * std::sqrt(5.0) * 6.0 / 41.0));
+    const tspline::LayoutRotationReport r = tspline::rotate_layout_edges(m, Q, anywhere);
+    CHECK(r.kept >= 1);
+    const tspline::LayoutTopology t(m);
+    double after = 1.0;
+    for (int q = 0; q < 2; ++q) after = std::min(after, tspline::layout_quad_figure(m, t, Q, q));
+    CHECK(after > before + 0.1);
+    // Still two counter-clockwise quads, sharing one edge that is not h0-h3.
+    REQUIRE(m.quads.size() == 2);
+    int shared = 0;
+    for (int j = 0; j < 4; ++j)
+      if (!t.on_ring(0, j)) {
+        ++shared;
+        const int a = m.quads[0][j], b = m.quads[0][(j + 1) % 4];
+        CHECK_FALSE(((a == 0 && b == 3) || (a == 3 && b == 0)));
+      }
+    CHECK(shared == 1);
+    for (const auto& q : m.quads) {
+      double area = 0.0;
+      for (int k = 0; k < 4; ++k) {
+        const V &p = m.x[q[k]], &s = m.x[q[(k + 1) % 4]];
+        area += p.x() * s.y() - p.y() * s.x();
+      }
+      CHECK(area > 0.0);
+    }
+  }
+
+  TEST_CASE("a flat single-quad corner marks its ring, and the pillow layer gives every ring node two quads") {
+    // A right triangle as one quad whose fourth corner is the hypotenuse's midpoint (180 degrees).
+    const tspline::LayoutRings ring = one_ring({V(0, 0), V(2, 0), V(0, 2)});
+    const tspline::LayoutQuality Q(ring);
+    tspline::LayoutMesh m = ring_mesh(ring.curves[0], {V(0, 0), V(2, 0), V(1, 1), V(0, 2)}, {}, {{0, 1, 2, 3}});
+    const std::vector<char> flat = tspline::rings_with_flat_corners(m, Q);
+    REQUIRE(flat.size() == 1);
+    CHECK(flat[0] == 1);
+    CHECK(tspline::pillow_rings(m, flat) == 1);
+    CHECK(m.quads.size() == 5);
+    CHECK(m.size() == 8);
+    const tspline::LayoutTopology t(m);
+    int on_ring = 0;
+    for (std::size_t n = 0; n < m.size(); ++n) {
+      if (m.ring[n] >= 0) {
+        ++on_ring;
+        CHECK(t.valence(static_cast<int>(n)) == 2);
+      } else {
+        CHECK(t.valence(static_cast<int>(n)) == 3);
+      }
+    }
+    CHECK(on_ring == 4);
+    // The quads tile the triangle (area 2).
+    double area = 0.0;
+    for (const auto& q : m.quads)
+      for (int k = 0; k < 4; ++k) {
+        const V &p = m.x[q[k]], &s = m.x[q[(k + 1) % 4]];
+        area += 0.5 * (p.x() * s.y() - p.y() * s.x());
+      }
+    CHECK(area == doctest::Approx(2.0));
+    CHECK(tspline::rings_with_flat_corners(m, Q)[0] == 0);  // the flat corner now has two quads
+  }
+
+  TEST_CASE("ring geometry: inside a square with a hole, segments crossing a ring, the nearest edge") {
+    const std::vector<tspline::RingCurve> rings = {
+        tspline::RingCurve({V(0, 0), V(4, 0), V(4, 4), V(0, 4)}),
+        tspline::RingCurve({V(1, 1), V(2, 1), V(2, 2), V(1, 2)})};
+    const tspline::RingGeometry g = tspline::RingGeometry::of_rings(rings);
+    CHECK(g.size() == 8);
+    CHECK(g.inside(V(3, 3)));
+    CHECK_FALSE(g.inside(V(1.5, 1.5)));  // in the hole
+    CHECK_FALSE(g.inside(V(5, 1)));
+    CHECK(g.crosses(V(0.5, 1.5), V(3, 1.5), false, false, 1e-9));        // through the hole
+    CHECK_FALSE(g.crosses(V(0.5, 3), V(3, 3), false, false, 1e-9));      // above it
+    CHECK_FALSE(g.crosses(V(0, 3), V(1, 1.5), true, true, 1e-9));        // from ring to ring
+    const int e = g.nearest(V(2.2, 1.5));
+    CHECK(g.edge(e).ring == 1);
+    CHECK(g.edge(e).a.x() == 2.0);
+    CHECK(g.edge(e).b.x() == 2.0);
+  }
+}
