@@ -136,6 +136,12 @@ std::vector<ParamOption> make_table() {
       [](const ParamSettings& s) { return json(s.cuts_file); }));
   t.back().show_default = false;
   t.push_back(option(
+      "repair-crossings", OptionKind::Flag,
+      "Replace a hole whose ring crosses itself (a bow-tie islet of quantized data) by its convex hull, with "
+      "a note giving both areas; by default such a ring is an input error naming its edges",
+      [](ParamSettings& s, const std::string&) { s.repair_crossing_holes = true; },
+      [](const ParamSettings& s) { return json(s.repair_crossing_holes); }));
+  t.push_back(option(
       "corners", OptionKind::Text,
       "Four vertex indices i,j,k,l (0-based, the file's own numbering, in cyclic file order) mapped to "
       "(0,0),(1,0),(1,1),(0,1); default: automatic choice explained in report.json",

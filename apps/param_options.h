@@ -30,6 +30,8 @@ struct ParamSettings {
   /// Layout choice; `choice.cuts` is filled from `cuts_file` when the run starts.
   tspline::DomainParameterizationOptions choice;
   std::string cuts_file;  ///< polylines, one cut per blank-line-separated block ("" for none)
+  /// Holes that cross themselves become their convex hulls (DomainCleaningOptions).
+  bool repair_crossing_holes = false;
   int samples = 4;        ///< surface.vtu: k x k sub-quads per cell
 };
 

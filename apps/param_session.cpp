@@ -104,6 +104,7 @@ ParamRun run_param(tspline::io::DomainInput domain, std::string source, const Pa
     how.needle_width =
         tspline::needle_width_for_ring(in.outer, opt.tolerance_absolute, opt.tolerance_relative);
     how.notes = &run.cleaning_notes;
+    how.repair_crossing_holes = settings.repair_crossing_holes;
     auto report_notes = [&] {
       for (const std::string& note : run.cleaning_notes)
         tspline::report_step(opt.progress, "cleaning", "note: " + note, -1,

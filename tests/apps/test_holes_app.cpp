@@ -183,6 +183,26 @@ TEST_SUITE("holes_app") {
                        "not simply connected");
   }
 
+  TEST_CASE("a bow-tie hole: an input error by default, its convex hull with --repair-crossings") {
+    const fs::path d = scratch("bowtie");
+    // Hole 1 crosses itself (edges 1-2 and 3-0 cross at (5, 5)): two triangles of area 1 each.
+    const fs::path in = write_file(d, "bowtie.txt", std::string(kFrame) + "4 4\n6 4\n4 6\n6 6\n");
+    expect_input_error("param " + quoted(in) + " --out " + quoted(d / "out"), d,
+                       "Hole 1: polygon is not simple: edges 1-2 and 3-0 intersect");
+    const fs::path out = d / "fixed";
+    const auto r =
+        test_support::run_app("param " + quoted(in) + " --out " + quoted(out) + " --repair-crossings --init-level 1", d);
+    CAPTURE(r.err);
+    REQUIRE(r.exit_code == 0);
+    CHECK(contains(r.out + r.err, "hole 1: crosses itself; replaced by its convex hull"));
+    const nlohmann::json rep = nlohmann::json::parse(test_support::slurp(out / "report.json"));
+    REQUIRE(rep["input_cleaning"]["notes"].size() == 1);
+    CHECK(contains(rep["input_cleaning"]["notes"][0].get<std::string>(), "area 0 (signed, lobes cancelling) -> 4"));
+    // The map covers the frame less the hull, the square [4, 6]^2.
+    CHECK(rep["totals"]["certified_valid"] == true);
+    CHECK(rep["totals"]["domain_area"].get<double>() == doctest::Approx(100.0 - 4.0));
+  }
+
   TEST_CASE("given cuts: a framed square cut along its diagonals is four certified trapezoids") {
     const fs::path d = scratch("given");
     const fs::path framed = write_file(d, "framed.txt", std::string(kFrame) + "3 3\n7 3\n7 7\n3 7\n");
