@@ -244,8 +244,9 @@ std::vector<ParamOption> make_table() {
       [](const ParamSettings& s) { return json(!s.adaptive.optimize_control_points); }));
   t.push_back(option(
       "optimizer", OptionKind::Text,
-      "Minimizer of the control-point untangling and smoothing: 'lbfgs' or 'newton' (projected Newton with "
-      "CHOLMOD: fewer iterations, each a sparse Cholesky; slower on the benchmarks)",
+      "Minimizer of the control-point untangling and smoothing: 'lbfgs' (L-BFGS, curvature kept across the eps "
+      "stages) or 'newton' (projected Newton, Cholesky or conjugate gradients: fewer iterations and a higher min "
+      "J_r, each iteration a Hessian assembly; slower on the benchmarks)",
       [](ParamSettings& s, const std::string& v) {
         s.adaptive.untangling.optimizer =
             v == "lbfgs" ? tspline::MapOptimizer::LBFGS : tspline::MapOptimizer::Newton;

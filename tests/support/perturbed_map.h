@@ -6,6 +6,7 @@
 #include <random>
 #include <vector>
 
+#include "separable_maps.h"
 #include "test_support.h"
 #include "tspline/spline/tspline_map.h"
 

@@ -1,8 +1,9 @@
 // Certified validity (map_certification.h): Bernstein arithmetic against direct
 // evaluation, the (8,8) numerator against det J of the map, a map folded between
 // the Gauss points found invalid, a distorted square certified, the undecided
-// outcome, and agreement with dense sampling (50 x 50 per element) on the test
-// domains.
+// outcome, agreement with dense sampling (50 x 50 per element) on the test
+// domains, and the parallel whole-map certification (and on a subset of the
+// elements) against element-by-element certification.
 #include <doctest/doctest.h>
 
 #include <Eigen/LU>
@@ -10,6 +11,7 @@
 #include <limits>
 #include <random>
 
+#include "perturbed_map.h"
 #include "separable_maps.h"
 #include "test_support.h"
 #include "tspline/pipeline/adaptive_parameterization.h"
@@ -328,5 +330,45 @@ TEST_SUITE("map_certification") {
     CHECK(negatives > 0);
     CHECK_FALSE(r.certified_valid());
     CHECK(r.certification.invalid >= negatives);
+  }
+
+  TEST_CASE("certify_map (parallel, and on a subset of elements) equals certify_element element by element") {
+    for (unsigned seed : {1u, 4u}) {
+      const TSplineMap map = test_support::perturbed_map(seed, 0.12);
+      const tspline::BezierExtraction ex(map.basis());
+      const std::size_t n = ex.elements().size();
+      std::vector<char> only(n, 0);
+      for (std::size_t k = 0; k < n; k += 3) only[k] = 1;
+      for (bool subset : {false, true}) {
+        const tspline::MapCertification c =
+            tspline::certify_map(ex, map.mesh().num_cells(), map.control_points(), {}, subset ? &only : nullptr);
+        std::size_t elements = 0, certified = 0, invalid = 0, undecided = 0;
+        double min_rel = std::numeric_limits<double>::infinity();
+        std::vector<std::size_t> failing;
+        for (std::size_t k = 0; k < n; ++k) {
+          if (subset && !only[k]) continue;
+          const tspline::ElementCertificate e = tspline::certify_element(ex.elements()[k], map.control_points());
+          ++elements;
+          min_rel = std::min(min_rel, e.relative_lower_bound);
+          if (e.status == ElementStatus::Certified)
+            ++certified;
+          else
+            failing.push_back(k), ++(e.status == ElementStatus::Invalid ? invalid : undecided);
+        }
+        CAPTURE(seed);
+        CAPTURE(subset);
+        CHECK(c.elements == elements);
+        CHECK(c.certified == certified);
+        CHECK(c.invalid == invalid);
+        CHECK(c.undecided == undecided);
+        CHECK(c.min_relative_lower_bound == min_rel);
+        REQUIRE(c.failures.size() == failing.size());
+        for (std::size_t i = 0; i < failing.size(); ++i) {
+          CHECK(c.failures[i].element == failing[i]);
+          CHECK(c.cell_certified[c.failures[i].cell] == 0);
+        }
+        CHECK(invalid > 0);  // the perturbed maps fold
+      }
+    }
   }
 }

@@ -6,7 +6,7 @@
 // differences of the gradient (folded and valid maps, powered terms, finer
 // sample levels), the largest step keeping det J positive, Newton untangling a
 // map built to fold inside an element, and Newton steps never making a
-// certified map uncertified.
+// certified map uncertified (the steps by Cholesky and by conjugate gradients).
 #include <doctest/doctest.h>
 
 #include <Eigen/Dense>
@@ -231,20 +231,29 @@ TEST_SUITE("map_newton") {
     std::vector<Eigen::Vector2d> border;
     for (std::size_t a = 0; a < P.size(); ++a)
       if (tspline::touches_border(map.basis().function(static_cast<int>(a)))) border.push_back(P[a]);
-    tspline::MapUntanglingOptions uo;
-    uo.optimizer = tspline::MapOptimizer::Newton;
-    const tspline::MapUntanglingReport r = tspline::untangle_map(map, uo);
-    CHECK(r.before.nonpositive > 0);
-    CHECK(r.certified);
-    CHECK(tspline::certify_map(map).certified_valid());
-    CHECK(r.factorizations > 0);
-    CHECK(r.iterations == r.factorizations);
-    // The square's identity is the energy's minimum: Newton gets back close to it.
-    CHECK(r.after.min_mean_ratio > 0.9);
-    std::vector<Eigen::Vector2d> border_after;
-    for (std::size_t a = 0; a < P.size(); ++a)
-      if (tspline::touches_border(map.basis().function(static_cast<int>(a)))) border_after.push_back(map.control_points()[a]);
-    CHECK(border_after == border);
+    // The Newton step by CHOLMOD's Cholesky and by CG (inexact Newton).
+    const TSplineMap folded = map;
+    for (tspline::NewtonSolver solver : {tspline::NewtonSolver::Cholesky, tspline::NewtonSolver::ConjugateGradient}) {
+      map = folded;
+      tspline::MapUntanglingOptions uo;
+      uo.optimizer = tspline::MapOptimizer::Newton;
+      uo.newton_solver = solver;
+      const tspline::MapUntanglingReport r = tspline::untangle_map(map, uo);
+      const bool cg = solver == tspline::NewtonSolver::ConjugateGradient;
+      CAPTURE(cg);
+      CHECK(r.before.nonpositive > 0);
+      CHECK(r.certified);
+      CHECK(tspline::certify_map(map).certified_valid());
+      CHECK(r.factorizations > 0);
+      CHECK(r.iterations == r.factorizations);
+      CHECK((r.cg_iterations > 0) == cg);
+      // The square's identity is the energy's minimum: Newton gets back close to it.
+      CHECK(r.after.min_mean_ratio > 0.9);
+      std::vector<Eigen::Vector2d> border_after;
+      for (std::size_t a = 0; a < P.size(); ++a)
+        if (tspline::touches_border(map.basis().function(static_cast<int>(a)))) border_after.push_back(map.control_points()[a]);
+      CHECK(border_after == border);
+    }
   }
 
   TEST_CASE("Newton and L-BFGS both untangle folded maps; Newton in far fewer iterations") {
@@ -272,11 +281,14 @@ TEST_SUITE("map_newton") {
     // One Gauss point per element: the energy sees almost nothing of det J
     // between samples, so free Newton steps would fold the map between them;
     // starting certified, every stage must end certified, and steps are checked.
-    for (unsigned seed : {2u, 9u}) {
+    for (unsigned seed : {2u, 9u})
+    for (tspline::NewtonSolver solver : {tspline::NewtonSolver::Cholesky, tspline::NewtonSolver::ConjugateGradient}) {
       TSplineMap map = perturbed(seed, 0.03);
       REQUIRE(tspline::certify_map(map).certified_valid());
       tspline::MapUntanglingOptions uo;
       uo.optimizer = tspline::MapOptimizer::Newton;
+      uo.newton_solver = solver;
+      CAPTURE(solver == tspline::NewtonSolver::ConjugateGradient);
       uo.energy.lobatto = false;
       uo.energy.gauss = 1;
       uo.local_repair = false;

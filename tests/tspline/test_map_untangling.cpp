@@ -60,8 +60,9 @@ TEST_SUITE("map_untangling") {
           for (std::size_t e = 0; e < energy.num_elements(); e += 3) energy.set_sample_level(e, 1);
           const Eigen::VectorXd x = energy.variables(map);
           REQUIRE(x.size() > 10);
-          for (double eps : {1.0, 0.05}) {
-            const double power = eps == 1.0 ? 1.0 : 3.0;  // the quality phase's powered terms too
+          for (double eps : {1.0, 0.05, 0.02}) {
+            // The quality phase's powered terms too: 3 (std::pow), 8 (the pipeline's polish).
+            const double power = eps == 1.0 ? 1.0 : eps == 0.05 ? 3.0 : 8.0;
             Eigen::VectorXd g(x.size());
             energy.evaluate(x.data(), eps, g.data(), nullptr, power);
             double max_err = 0.0, max_g = 0.0;
@@ -84,6 +85,48 @@ TEST_SUITE("map_untangling") {
             CHECK(max_err <= 1e-6 * max_g);
           }
         }
+  }
+
+  TEST_CASE("the energy (sum factorization) equals the direct sum over 5 x 5 Lobatto points of the map's Jacobian") {
+    // A folded map with T-junctions: some elements are rational (their
+    // functions do not sum to 1), where the chain rule goes through w.
+    const TSplineMap map = perturbed_map(3, 0.12);
+    const MapEnergy energy(map);
+    const tspline::BezierExtraction& ex = energy.extraction();
+    std::size_t rational = 0;
+    for (const tspline::BezierElement& e : ex.elements())
+      rational += (e.C.colwise().sum().array() - 1.0).abs().maxCoeff() > 1e-12 ? 1 : 0;
+    REQUIRE(rational > 0);
+    const double a = 0.5 * std::sqrt(3.0 / 7.0);
+    const double pt[5] = {0.0, 0.5 - a, 0.5, 0.5 + a, 1.0};
+    const double wt[5] = {1.0 / 20, 49.0 / 180, 16.0 / 45, 49.0 / 180, 1.0 / 20};
+    const double theta = tspline::MapEnergyOptions{}.theta, L = energy.length_scale();
+    const Eigen::VectorXd x = energy.variables(map);
+    for (double eps : {0.3, 0.01})
+      for (double power : {1.0, 4.0, 8.0}) {
+        double direct = 0.0;
+        std::size_t folded = 0;
+        for (std::size_t k = 0; k < ex.elements().size(); ++k) {
+          if (!energy.element_active(k)) continue;
+          const tspline::BezierElement& e = ex.elements()[k];
+          for (int r = 0; r < 5; ++r)
+            for (int p = 0; p < 5; ++p) {
+              const Eigen::Vector2d uv(e.lo.x() + pt[p] * (e.hi.x() - e.lo.x()), e.lo.y() + pt[r] * (e.hi.y() - e.lo.y()));
+              const Eigen::Matrix2d J = map.jacobian(uv) / L;
+              const double D = J.determinant();
+              folded += D > 0.0 ? 0 : 1;
+              const double t = ((1.0 - theta) * J.squaredNorm() + theta * (D * D + 1.0)) / tspline::regularized_det(D, eps);
+              direct += wt[p] * wt[r] * std::pow(t, power);
+            }
+        }
+        std::size_t nonpositive = 0;
+        const double E = energy.evaluate(x.data(), eps, nullptr, &nonpositive, power);
+        CAPTURE(eps);
+        CAPTURE(power);
+        CHECK(folded > 0);
+        CHECK(nonpositive == folded);
+        CHECK(E == doctest::Approx(direct).epsilon(1e-10));
+      }
   }
 
   TEST_CASE("the energy of the scaled identity is the ideal 2 per unit weight, and the variables round-trip") {

@@ -70,6 +70,10 @@ void validate_options(const AdaptiveOptions& ad) {
   if (u.max_quality_stages < 1) fail("untangling.max_quality_stages must be >= 1");
   if (u.max_newton_iterations_per_stage < 1 || !(u.newton_stage_tolerance >= 0.0))
     fail("untangling: max_newton_iterations_per_stage must be >= 1 and newton_stage_tolerance >= 0");
+  if (!(u.newton_min_decrease > 0.0 && u.newton_min_decrease < 1.0))
+    fail("untangling.newton_min_decrease must be in (0, 1), got " + str(u.newton_min_decrease));
+  if (u.max_cg_iterations < 1 || u.newton_cholesky_below < 0)
+    fail("untangling: max_cg_iterations must be >= 1 and newton_cholesky_below >= 0");
 }
 
 }  // namespace tspline

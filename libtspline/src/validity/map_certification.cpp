@@ -1,5 +1,6 @@
 // Certified validity of the T-spline map; see map_certification.h for the method.
 #include "tspline/validity/map_certification.h"
+#include "tspline/detail/thread_pool.h"
 
 #include <algorithm>
 #include <chrono>
@@ -157,33 +158,55 @@ MapCertification certify_map(const TSplineMap& map, const CertificationOptions& 
 }
 
 MapCertification certify_map(const BezierExtraction& extraction, std::size_t num_cells,
-                             const std::vector<Eigen::Vector2d>& P, const CertificationOptions& opt) {
+                             const std::vector<Eigen::Vector2d>& P, const CertificationOptions& opt,
+                             const std::vector<char>* only) {
   const auto t0 = std::chrono::steady_clock::now();
+  const std::vector<BezierElement>& es = extraction.elements();
+  // One partial result per range of elements, merged in order (failures by element).
+  std::vector<MapCertification> part(static_cast<std::size_t>(detail::pool_threads()));
+  detail::parallel_ranges(es.size(), detail::pool_threads(), [&](std::size_t b, std::size_t end, int slot) {
+    MapCertification& r = part[slot];
+    r.min_relative_lower_bound = std::numeric_limits<double>::infinity();
+    r.min_det_lower_bound = std::numeric_limits<double>::infinity();
+    for (std::size_t k = b; k < end; ++k) {
+      if (only && !(*only)[k]) continue;
+      const BezierElement& e = es[k];
+      const ElementCertificate cert = certify_element(e, P, opt);
+      ++r.elements;
+      r.max_depth_used = std::max(r.max_depth_used, cert.depth);
+      r.min_relative_lower_bound = std::min(r.min_relative_lower_bound, cert.relative_lower_bound);
+      r.min_det_lower_bound = std::min(r.min_det_lower_bound, cert.det_lower_bound);
+      switch (cert.status) {
+        case ElementStatus::Certified:
+          ++r.certified;
+          continue;
+        case ElementStatus::Invalid:
+          ++r.invalid;
+          break;
+        case ElementStatus::Undecided:
+          ++r.undecided;
+          break;
+      }
+      r.failures.push_back({e.cell, k, e.lo, e.hi, cert});
+    }
+  }, 64);
   MapCertification r;
   r.cell_certified.assign(num_cells, 1);
   r.min_relative_lower_bound = std::numeric_limits<double>::infinity();
   r.min_det_lower_bound = std::numeric_limits<double>::infinity();
-  const std::vector<BezierElement>& es = extraction.elements();
-  for (std::size_t k = 0; k < es.size(); ++k) {
-    const BezierElement& e = es[k];
-    const ElementCertificate cert = certify_element(e, P, opt);
-    ++r.elements;
-    r.max_depth_used = std::max(r.max_depth_used, cert.depth);
-    r.min_relative_lower_bound = std::min(r.min_relative_lower_bound, cert.relative_lower_bound);
-    r.min_det_lower_bound = std::min(r.min_det_lower_bound, cert.det_lower_bound);
-    switch (cert.status) {
-      case ElementStatus::Certified:
-        ++r.certified;
-        continue;
-      case ElementStatus::Invalid:
-        ++r.invalid;
-        break;
-      case ElementStatus::Undecided:
-        ++r.undecided;
-        break;
+  for (MapCertification& p : part) {
+    if (p.elements == 0) continue;
+    r.elements += p.elements;
+    r.certified += p.certified;
+    r.invalid += p.invalid;
+    r.undecided += p.undecided;
+    r.max_depth_used = std::max(r.max_depth_used, p.max_depth_used);
+    r.min_relative_lower_bound = std::min(r.min_relative_lower_bound, p.min_relative_lower_bound);
+    r.min_det_lower_bound = std::min(r.min_det_lower_bound, p.min_det_lower_bound);
+    for (CertificationFailure& f : p.failures) {
+      r.cell_certified[f.cell] = 0;
+      r.failures.push_back(std::move(f));
     }
-    r.cell_certified[e.cell] = 0;
-    r.failures.push_back({e.cell, k, e.lo, e.hi, cert});
   }
   r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return r;

@@ -1,6 +1,7 @@
 // The regularized distortion energy of a T-spline map; see map_energy.h.
 #include "tspline/validity/map_energy.h"
 #include "tspline/detail/quadrature.h"
+#include "tspline/detail/simd_clones.h"
 #include "tspline/detail/thread_pool.h"
 
 #include <algorithm>
@@ -8,10 +9,6 @@
 #include <limits>
 #include <stdexcept>
 #include <thread>
-
-#include <Eigen/Dense>
-
-#include "tspline/validity/map_quality.h"
 
 namespace tspline {
 
@@ -43,46 +40,220 @@ void lobatto_points_01(int n, std::vector<double>& p, std::vector<double>& w) {
   }
 }
 
-// Derivative of B_i^3 at s.
-std::array<double, 4> bernstein3_derivative(double s) {
-  const double r = 1.0 - s;
-  return {-3.0 * r * r, 3.0 * r * r - 6.0 * s * r, 6.0 * s * r - 3.0 * s * s, 3.0 * s * s};
+// The sample terms of evaluate() on one element, point by point over arrays
+// (branch-free, so that the compiler vectorizes the loop). Writes each
+// sample's weighted term omega_q t_q^p into `term`, and with Grad the
+// derivative of that with respect to J into G00..G11 (which may alias nothing
+// read later). Returns the number of samples with det J <= 0.
+enum class Power { One, Four, Eight, Other };
+
+template <Power P, bool Grad>
+std::size_t sample_terms(std::size_t n, const double* __restrict J00, const double* __restrict J01,
+                         const double* __restrict J10, const double* __restrict J11, const double* __restrict weight,
+                         double element_weight, double eps, double theta, double power, double* __restrict term,
+                         double* __restrict G00, double* __restrict G01, double* __restrict G10,
+                         double* __restrict G11) {
+  const double e2 = eps * eps, ie2 = 1.0 / e2;
+  std::size_t nonpos = 0;
+  for (std::size_t q = 0; q < n; ++q) {
+    const double j00 = J00[q], j01 = J01[q], j10 = J10[q], j11 = J11[q];
+    const double omega = weight[q] * element_weight;
+    const double D = j00 * j11 - j01 * j10;
+    const double n2 = j00 * j00 + j01 * j01 + j10 * j10 + j11 * j11;
+    nonpos += static_cast<std::size_t>(!(D > 0.0));
+    const double r = std::sqrt(e2 + D * D);
+    const double ir = 1.0 / r;
+    // 1 / chi = 2 / (D + r) = 2 (r - D) / eps^2 (regularized_det), each form
+    // where it has no cancellation; both computed (a select, no branch).
+    const double ic1_pos = 2.0 / (D + r), ic1_neg = 2.0 * (r - D) * ie2;
+    const double ic1 = D > 0.0 ? ic1_pos : ic1_neg;
+    const double c2 = 0.5 * (1.0 + D * ir);  // d chi / dD = (1 + D / r) / 2 = chi / r
+    const double f = n2 * ic1, gA = (1.0 + D * D) * ic1;
+    const double t = (1.0 - theta) * f + theta * gA;
+    double tp, chain;  // t^p and omega p t^(p - 1)
+    if constexpr (P == Power::One) {
+      tp = t, chain = omega;
+    } else if constexpr (P == Power::Four) {
+      const double t2 = t * t;
+      tp = t2 * t2, chain = 4.0 * omega * t2 * t;
+    } else if constexpr (P == Power::Eight) {
+      const double t2 = t * t, t4 = t2 * t2;
+      tp = t4 * t4, chain = 8.0 * omega * t4 * t2 * t;
+    } else {
+      tp = std::pow(t, power), chain = omega * power * tp / t;
+    }
+    term[q] = omega * tp;
+    if constexpr (Grad) {
+      // dE/dJ = chain [(1-theta) (2 J - f c2 cof J) + theta (2 D - gA c2) cof J] / chi,
+      // cof J = dD/dJ = [[J11, -J10], [-J01, J00]].
+      const double a1 = chain * (1.0 - theta) * 2.0 * ic1;
+      const double a2 = chain * (theta * (2.0 * D - gA * c2) - (1.0 - theta) * f * c2) * ic1;
+      G00[q] = a1 * j00 + a2 * j11;
+      G01[q] = a1 * j01 - a2 * j10;
+      G10[q] = a1 * j10 - a2 * j01;
+      G11[q] = a1 * j11 + a2 * j00;
+    }
+  }
+  return nonpos;
 }
 
-}  // namespace
+template <bool Grad>
+std::size_t sample_terms(std::size_t n, const double* J00, const double* J01, const double* J10, const double* J11,
+                         const double* weight, double element_weight, double eps, double theta, double power,
+                         double* term, double* G00, double* G01, double* G10, double* G11) {
+  if (power == 1.0)
+    return sample_terms<Power::One, Grad>(n, J00, J01, J10, J11, weight, element_weight, eps, theta, power, term,
+                                          G00, G01, G10, G11);
+  if (power == 4.0)
+    return sample_terms<Power::Four, Grad>(n, J00, J01, J10, J11, weight, element_weight, eps, theta, power, term,
+                                           G00, G01, G10, G11);
+  if (power == 8.0)  // the pipeline's polish (AdaptiveOptions::polish_power)
+    return sample_terms<Power::Eight, Grad>(n, J00, J01, J10, J11, weight, element_weight, eps, theta, power, term,
+                                            G00, G01, G10, G11);
+  return sample_terms<Power::Other, Grad>(n, J00, J01, J10, J11, weight, element_weight, eps, theta, power, term,
+                                          G00, G01, G10, G11);
+}
 
-namespace {
+// The energy kernel is compiled for AVX2 and the baseline (simd_clones.h).
 
-// The sample's Jacobian J = dS/d(xi, eta) in normalized coordinates and what
-// the gradient needs, from the element's Bernstein coefficients.
-struct SampleJacobian {
-  double J00, J01, J10, J11;   // [dS/dxi dS/deta], rows x, y
-  double x, y, w, ws, wt;      // X and w and w's derivatives (local coordinates)
+// What element_energy needs of one element, and its buffers (n samples each).
+struct ElementKernel {
+  const double* C;  // rows x 16, row-major: the extraction operator
+  long rows;
+  const int* functions;
+  const int* variable_of;                // per function: its x variable, or -1
+  const Eigen::Vector2d* normalized;     // per function: the fixed control point
+  const double* W;                       // w's Bernstein coefficients, if rational
+  bool rational;
+  double hx, hy, weight;
+  const detail::TensorGrid* grid;
+  const double* point_weight;
+};
+struct KernelBuffers {
+  double *x, *xs, *xt, *y, *ys, *yt, *rw, *rs, *rt, *J00, *J01, *J10, *J11, *term, *scratch;
 };
 
-inline SampleJacobian sample_jacobian(const std::array<double, 16>& X, const std::array<double, 16>& Y,
-                                      const std::array<double, 16>& W, const std::array<double, 16>& B,
-                                      const std::array<double, 16>& Bs, const std::array<double, 16>& Bt, double hx,
-                                      double hy) {
-  double x = 0, y = 0, xs = 0, ys = 0, xt = 0, yt = 0, w = 0, ws = 0, wt = 0;
-  for (int i = 0; i < 16; ++i) {
-    x += X[i] * B[i], y += Y[i] * B[i];
-    xs += X[i] * Bs[i], ys += Y[i] * Bs[i];
-    xt += X[i] * Bt[i], yt += Y[i] * Bt[i];
-    w += W[i] * B[i], ws += W[i] * Bs[i], wt += W[i] * Bt[i];
+// sum of a[0..n) in four interleaved partial sums (independent add chains).
+inline double sum4(const double* a, std::size_t n) {
+  double p[4] = {};
+  std::size_t q = 0;
+  for (; q + 4 <= n; q += 4)
+    for (int l = 0; l < 4; ++l) p[l] += a[q + l];
+  for (; q < n; ++q) p[0] += a[q];
+  return (p[0] + p[1]) + (p[2] + p[3]);
+}
+
+template <int M>
+inline void values(const detail::TensorGrid& g, const double* c, double* f, double* fs, double* ft, double* scratch) {
+  detail::tensor_values_fixed<M>(g, c, f, fs, ft, scratch);
+}
+
+// J = [S_s / hx, S_t / hy] at the n samples from X, Y and their parametric
+// derivatives. On a rational element S = X / w: S_s = (X_s - X w_s / w) / w,
+// S_t alike; rw, rs, rt hold w, w_s, w_t there and become 1/w, w_s/w, w_t/w.
+inline void sample_jacobians(std::size_t n, bool rational, double ihx, double ihy, const double* x, const double* y,
+                             const double* xs, const double* xt, const double* ys, const double* yt, double* rw,
+                             double* rs, double* rt, double* J00, double* J01, double* J10, double* J11) {
+  if (!rational) {
+    for (std::size_t q = 0; q < n; ++q) {
+      J00[q] = xs[q] * ihx, J01[q] = xt[q] * ihy;
+      J10[q] = ys[q] * ihx, J11[q] = yt[q] * ihy;
+    }
+    return;
   }
-  const double iw = 1.0 / w;
-  // S = X / w: S_s = (X_s - S w_s) / w, S_t = (X_t - S w_t) / w.
-  SampleJacobian r;
-  r.J00 = (xs - x * iw * ws) * iw / hx;
-  r.J10 = (ys - y * iw * ws) * iw / hx;
-  r.J01 = (xt - x * iw * wt) * iw / hy;
-  r.J11 = (yt - y * iw * wt) * iw / hy;
-  r.x = x, r.y = y, r.w = w, r.ws = ws, r.wt = wt;
-  return r;
+  for (std::size_t q = 0; q < n; ++q) {
+    const double iw = 1.0 / rw[q];
+    rw[q] = iw, rs[q] *= iw, rt[q] *= iw;
+    J00[q] = (xs[q] - x[q] * rs[q]) * iw * ihx;
+    J01[q] = (xt[q] - x[q] * rt[q]) * iw * ihy;
+    J10[q] = (ys[q] - y[q] * rs[q]) * iw * ihx;
+    J11[q] = (yt[q] - y[q] * rt[q]) * iw * ihy;
+  }
+}
+
+// One element's share of evaluate(): adds its energy to F and, if g, its
+// gradient to g; returns its samples with det J <= 0. The steps (each a loop
+// over the samples or the 16 coefficients): the Bernstein coefficients of X
+// and Y from the control points, X, Y and their derivatives at the samples
+// (sum factorization, tensor_grid.h), J, the terms and dE/dJ, back through J
+// to the coefficients (the transpose), and to the control points.
+template <int M>
+std::size_t element_energy_m(const ElementKernel& in, const double* xv, double eps, double theta, double power,
+                             double* g, double& F, const KernelBuffers& s) {
+  const detail::TensorGrid& grid = *in.grid;
+  const std::size_t n = grid.size();
+  double X[16] = {}, Y[16] = {};
+  for (long r = 0; r < in.rows; ++r) {
+    const int a = in.functions[r];
+    const int v = in.variable_of[a];
+    const double px = v >= 0 ? xv[v] : in.normalized[a].x();
+    const double py = v >= 0 ? xv[v + 1] : in.normalized[a].y();
+    const double* c = in.C + 16 * r;
+    for (int i = 0; i < 16; ++i) X[i] += px * c[i], Y[i] += py * c[i];
+  }
+  values<M>(grid, X, s.x, s.xs, s.xt, s.scratch);
+  values<M>(grid, Y, s.y, s.ys, s.yt, s.scratch);
+  const double ihx = 1.0 / in.hx, ihy = 1.0 / in.hy;
+  if (in.rational) values<M>(grid, in.W, s.rw, s.rs, s.rt, s.scratch);
+  sample_jacobians(n, in.rational, ihx, ihy, s.x, s.y, s.xs, s.xt, s.ys, s.yt, s.rw, s.rs, s.rt, s.J00, s.J01, s.J10,
+                   s.J11);
+  // dE/dJ goes to (xs, xt, ys, yt): X and Y at the samples are not needed any more.
+  const std::size_t nonpos =
+      g ? sample_terms<true>(n, s.J00, s.J01, s.J10, s.J11, in.point_weight, in.weight, eps, theta, power, s.term, s.xs,
+                             s.xt, s.ys, s.yt)
+        : sample_terms<false>(n, s.J00, s.J01, s.J10, s.J11, in.point_weight, in.weight, eps, theta, power, s.term,
+                              nullptr, nullptr, nullptr, nullptr);
+  F += sum4(s.term, n);
+  if (!g) return nonpos;
+  // Back through J = [S_s / hx, S_t / hy] to dE/dX_s, dE/dX_t (and dE/dX for
+  // a rational element), then to the Bernstein coefficients.
+  double GX[16] = {}, GY[16] = {};
+  if (!in.rational) {
+    for (std::size_t q = 0; q < n; ++q) {
+      s.xs[q] *= ihx, s.xt[q] *= ihy;
+      s.ys[q] *= ihx, s.yt[q] *= ihy;
+    }
+    detail::tensor_values_transpose_fixed<M>(grid, nullptr, s.xs, s.xt, GX, s.scratch);
+    detail::tensor_values_transpose_fixed<M>(grid, nullptr, s.ys, s.yt, GY, s.scratch);
+  } else {
+    for (std::size_t q = 0; q < n; ++q) {
+      const double gsx = s.xs[q] * s.rw[q] * ihx, gtx = s.xt[q] * s.rw[q] * ihy;
+      const double gsy = s.ys[q] * s.rw[q] * ihx, gty = s.yt[q] * s.rw[q] * ihy;
+      s.xs[q] = gsx, s.xt[q] = gtx, s.x[q] = -(gsx * s.rs[q] + gtx * s.rt[q]);
+      s.ys[q] = gsy, s.yt[q] = gty, s.y[q] = -(gsy * s.rs[q] + gty * s.rt[q]);
+    }
+    detail::tensor_values_transpose_fixed<M>(grid, s.x, s.xs, s.xt, GX, s.scratch);
+    detail::tensor_values_transpose_fixed<M>(grid, s.y, s.ys, s.yt, GY, s.scratch);
+  }
+  for (long r = 0; r < in.rows; ++r) {
+    const int v = in.variable_of[in.functions[r]];
+    if (v < 0) continue;
+    // Four partial sums each: one vector chain instead of 16 dependent adds.
+    const double* c = in.C + 16 * r;
+    double sx[4] = {}, sy[4] = {};
+    for (int i = 0; i < 16; i += 4)
+      for (int l = 0; l < 4; ++l) sx[l] += c[i + l] * GX[i + l], sy[l] += c[i + l] * GY[i + l];
+    g[v] += (sx[0] + sx[1]) + (sx[2] + sx[3]);
+    g[v + 1] += (sy[0] + sy[1]) + (sy[2] + sy[3]);
+  }
+  return nonpos;
+}
+
+TSPLINE_SIMD_CLONES
+std::size_t element_energy(const ElementKernel& in, const double* xv, double eps, double theta, double power, double* g,
+                           double& F, const KernelBuffers& s) {
+  if (in.grid->m == 5) return element_energy_m<5>(in, xv, eps, theta, power, g, F, s);  // the default samples
+  return element_energy_m<0>(in, xv, eps, theta, power, g, F, s);
 }
 
 }  // namespace
+
+MapEnergy::Samples::Samples(const MapEnergy& energy) {
+  const std::size_t n = energy.levels_.back().grid.size();
+  for (std::vector<double>* v : {&x, &xs, &xt, &y, &ys, &yt, &rw, &rs, &rt, &J00, &J01, &J10, &J11, &term})
+    v->resize(n);
+  scratch.resize(8 * static_cast<std::size_t>(energy.levels_.back().grid.m));
+}
 
 MapEnergy::MapEnergy(const TSplineMap& map, const MapEnergyOptions& opt)
     : options_(opt), extraction_(map.basis()) {
@@ -95,34 +266,30 @@ MapEnergy::MapEnergy(const TSplineMap& map, const MapEnergyOptions& opt)
   if (options_.threads <= 0) options_.threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
   options_.threads = std::min(options_.threads, 16);
 
-  // Sample patterns per level.
+  // Samples per level: the n points of the rule on each of the 2^l equal
+  // sub-intervals, in s and in t (a tensor grid; Lobatto points on the
+  // sub-intervals' common ends appear twice, once per sub-square).
   std::vector<double> gp, gw;
   if (opt.lobatto)
     lobatto_points_01(opt.gauss, gp, gw);
   else
     detail::gauss_points_01(opt.gauss, gp, gw);
   for (int l = 0; l <= opt.max_sample_level; ++l) {
-    Pattern p;
-    const int m = 1 << l;
-    const double h = 1.0 / m;
-    for (int bj = 0; bj < m; ++bj)
-      for (int bi = 0; bi < m; ++bi)
-        for (std::size_t b = 0; b < gp.size(); ++b)
-          for (std::size_t a = 0; a < gp.size(); ++a) {
-            const double s = (bi + gp[a]) * h, t = (bj + gp[b]) * h;
-            const std::array<double, 4> us = bernstein3(s), ut = bernstein3(t);
-            const std::array<double, 4> ds = bernstein3_derivative(s), dt = bernstein3_derivative(t);
-            std::array<double, 16> B, Bs, Bt;
-            for (int j = 0; j < 4; ++j)
-              for (int i = 0; i < 4; ++i) {
-                B[i + 4 * j] = us[i] * ut[j];
-                Bs[i + 4 * j] = ds[i] * ut[j];
-                Bt[i + 4 * j] = us[i] * dt[j];
-              }
-            p.weight.push_back(gw[a] * gw[b] * h * h);
-            p.B.push_back(B), p.Bs.push_back(Bs), p.Bt.push_back(Bt);
-          }
-    patterns_.push_back(std::move(p));
+    const int parts = 1 << l;
+    const double h = 1.0 / parts;
+    std::vector<double> points, weights;
+    for (int part = 0; part < parts; ++part)
+      for (std::size_t a = 0; a < gp.size(); ++a) {
+        points.push_back((part + gp[a]) * h);
+        weights.push_back(gw[a] * h);
+      }
+    Level level;
+    level.grid.set(points, weights);
+    const std::size_t m = weights.size();
+    level.weight.resize(m * m);
+    for (std::size_t r = 0; r < m; ++r)
+      for (std::size_t p = 0; p < m; ++p) level.weight[p + m * r] = weights[p] * weights[r];
+    levels_.push_back(std::move(level));
   }
 
   // Free functions and normalized control points.
@@ -148,11 +315,15 @@ MapEnergy::MapEnergy(const TSplineMap& map, const MapEnergyOptions& opt)
     Element& d = elements_[k];
     for (Eigen::Index r = 0; r < e.C.rows(); ++r)
       for (int i = 0; i < 16; ++i) d.W[i] += e.C(r, i);
+    // w = 1 exactly where the functions sum to 1 (then X_s / w = X_s: no chain rule through w).
+    d.rational = false;
+    for (int i = 0; i < 16; ++i) d.rational = d.rational || std::abs(d.W[i] - 1.0) > 1e-13;
     d.hx = e.hi.x() - e.lo.x();
     d.hy = e.hi.y() - e.lo.y();
     d.weight = opt.weighting == ElementWeighting::Area ? d.hx * d.hy : 1.0;
     d.active = false;
     for (int a : e.functions) d.active = d.active || variable_of_[a] >= 0;
+    if (d.active) active_.push_back(static_cast<int>(k));
   }
 
   // L^2 = area of the domain = integral of det J over the square (exact up to
@@ -165,15 +336,15 @@ MapEnergy::MapEnergy(const TSplineMap& map, const MapEnergyOptions& opt)
   {
     // Integrate det J with area weights regardless of the weighting option.
     const Eigen::VectorXd x0 = variables(map);
-    const Pattern& pat = patterns_[0];
+    const Level& level = levels_[0];
+    Samples s(*this);
     for (std::size_t k = 0; k < es.size(); ++k) {
       const Element& d = elements_[k];
       std::array<double, 16> X, Y;
       element_coefficients(k, x0.data(), X, Y);
-      for (std::size_t q = 0; q < pat.weight.size(); ++q) {
-        const SampleJacobian j = sample_jacobian(X, Y, d.W, pat.B[q], pat.Bs[q], pat.Bt[q], d.hx, d.hy);
-        area += pat.weight[q] * d.hx * d.hy * (j.J00 * j.J11 - j.J01 * j.J10);
-      }
+      element_samples(k, X.data(), Y.data(), s);  // every element is at level 0 here
+      for (std::size_t q = 0; q < level.weight.size(); ++q)
+        area += level.weight[q] * d.hx * d.hy * (s.J00[q] * s.J11[q] - s.J01[q] * s.J10[q]);
     }
   }
   if (!(area > 0.0) || !std::isfinite(area))
@@ -185,14 +356,29 @@ MapEnergy::MapEnergy(const TSplineMap& map, const MapEnergyOptions& opt)
 void MapEnergy::element_coefficients(std::size_t k, const double* x, std::array<double, 16>& X,
                                      std::array<double, 16>& Y) const {
   const BezierElement& e = extraction_.elements()[k];
-  X.fill(0.0), Y.fill(0.0);
+  double sx[16] = {}, sy[16] = {};  // locals: no aliasing with C
   for (Eigen::Index r = 0; r < e.C.rows(); ++r) {
     const int a = e.functions[r];
     const int v = variable_of_[a];
     const double px = v >= 0 ? x[v] : normalized_[a].x();
     const double py = v >= 0 ? x[v + 1] : normalized_[a].y();
-    for (int i = 0; i < 16; ++i) X[i] += px * e.C(r, i), Y[i] += py * e.C(r, i);
+    const double* c = e.C.row(r).data();
+    for (int i = 0; i < 16; ++i) sx[i] += px * c[i], sy[i] += py * c[i];
   }
+  std::copy(sx, sx + 16, X.begin());
+  std::copy(sy, sy + 16, Y.begin());
+}
+
+void MapEnergy::element_samples(std::size_t k, const double* X, const double* Y, Samples& s) const {
+  const Element& d = elements_[k];
+  const detail::TensorGrid& g = levels_[d.level].grid;
+  const std::size_t n = g.size();
+  detail::tensor_values(g, X, s.x.data(), s.xs.data(), s.xt.data(), s.scratch.data());
+  detail::tensor_values(g, Y, s.y.data(), s.ys.data(), s.yt.data(), s.scratch.data());
+  if (d.rational) detail::tensor_values(g, d.W.data(), s.rw.data(), s.rs.data(), s.rt.data(), s.scratch.data());
+  sample_jacobians(n, d.rational, 1.0 / d.hx, 1.0 / d.hy, s.x.data(), s.y.data(), s.xs.data(), s.xt.data(), s.ys.data(),
+                   s.yt.data(), s.rw.data(), s.rs.data(), s.rt.data(), s.J00.data(), s.J01.data(), s.J10.data(),
+                   s.J11.data());
 }
 
 Eigen::VectorXd MapEnergy::variables(const TSplineMap& map) const {
@@ -221,10 +407,9 @@ void MapEnergy::set_sample_level(std::size_t element, int level) {
 
 std::size_t MapEnergy::num_samples() const {
   std::size_t n = 0;
-  for (const Element& e : elements_) n += patterns_[e.level].weight.size();
+  for (const Element& e : elements_) n += levels_[e.level].weight.size();
   return n;
 }
-
 
 double MapEnergy::evaluate(const double* xv, double eps, double* gradient, std::size_t* nonpositive,
                            double power) const {
@@ -235,62 +420,23 @@ double MapEnergy::evaluate(const double* xv, double eps, double* gradient, std::
   std::vector<std::vector<double>> grads(gradient ? threads - 1 : 0, std::vector<double>(num_variables(), 0.0));
   if (gradient) std::fill(gradient, gradient + num_variables(), 0.0);
   const double theta = options_.theta;
-  detail::parallel_ranges(es.size(), threads, [&](std::size_t b, std::size_t e_end, int slot) {
+  detail::parallel_ranges(active_.size(), threads, [&](std::size_t b, std::size_t e_end, int slot) {
     double* g = gradient ? (slot == 0 ? gradient : grads[slot - 1].data()) : nullptr;
+    Samples s(*this);
+    const KernelBuffers buffers{s.x.data(),   s.xs.data(),  s.xt.data(),  s.y.data(),    s.ys.data(),
+                                s.yt.data(),  s.rw.data(),  s.rs.data(),  s.rt.data(),   s.J00.data(),
+                                s.J01.data(), s.J10.data(), s.J11.data(), s.term.data(), s.scratch.data()};
     double F = 0.0;
     std::size_t nonpos = 0;
-    for (std::size_t k = b; k < e_end; ++k) {
-      const BezierElement& e = es[k];
+    for (std::size_t i = b; i < e_end; ++i) {
+      const std::size_t k = static_cast<std::size_t>(active_[i]);
       const Element& d = elements_[k];
-      if (!d.active) continue;
-      const Pattern& pat = patterns_[d.level];
-      const Eigen::Index nf = e.C.rows();
-      std::array<double, 16> X, Y;
-      element_coefficients(k, xv, X, Y);
-      std::array<double, 16> GX{}, GY{};
-      for (std::size_t q = 0; q < pat.weight.size(); ++q) {
-        const SampleJacobian s = sample_jacobian(X, Y, d.W, pat.B[q], pat.Bs[q], pat.Bt[q], d.hx, d.hy);
-        const double omega = pat.weight[q] * d.weight;
-        const double D = s.J00 * s.J11 - s.J01 * s.J10;
-        const double n2 = s.J00 * s.J00 + s.J01 * s.J01 + s.J10 * s.J10 + s.J11 * s.J11;
-        nonpos += !(D > 0.0);
-        const double r = std::sqrt(eps * eps + D * D);
-        const double c1 = regularized_det(D, eps);
-        const double c2 = c1 / r;  // d chi / dD = (1 + D / r) / 2 = chi / r
-        const double f = n2 / c1, gA = (1.0 + D * D) / c1;
-        const double term = (1.0 - theta) * f + theta * gA;
-        // With a power p: omega term^p, so dE = p term^(p-1) omega d(term).
-        const double tp = power == 1.0 ? term : power == 4.0 ? (term * term) * (term * term) : std::pow(term, power);
-        F += omega * tp;
-        if (!g) continue;
-        const double chain = power == 1.0 ? 1.0 : power * tp / term;
-        // dE/dJ = omega [(1-theta) (2 J - f c2 cof J) + theta (2 D - g c2) cof J] / c1,
-        // cof J = dD/dJ = [[J11, -J10], [-J01, J00]].
-        const double a1 = chain * omega * (1.0 - theta) * 2.0 / c1;
-        const double a2 = chain * omega * ((theta * (2.0 * D - gA * c2)) - (1.0 - theta) * f * c2) / c1;
-        const double G00 = a1 * s.J00 + a2 * s.J11, G01 = a1 * s.J01 - a2 * s.J10;
-        const double G10 = a1 * s.J10 - a2 * s.J01, G11 = a1 * s.J11 + a2 * s.J00;
-        // Back to dS/ds (= J col 0 * hx) and dS/dt, then to X, X_s, X_t.
-        const double iw = 1.0 / s.w;
-        const double gsx = G00 / d.hx * iw, gsy = G10 / d.hx * iw;  // dE/dX_s
-        const double gtx = G01 / d.hy * iw, gty = G11 / d.hy * iw;  // dE/dX_t
-        const double gx = -(gsx * s.ws + gtx * s.wt) * iw, gy = -(gsy * s.ws + gty * s.wt) * iw;  // dE/dX
-        const auto& B = pat.B[q];
-        const auto& Bs = pat.Bs[q];
-        const auto& Bt = pat.Bt[q];
-        for (int i = 0; i < 16; ++i) {
-          GX[i] += gx * B[i] + gsx * Bs[i] + gtx * Bt[i];
-          GY[i] += gy * B[i] + gsy * Bs[i] + gty * Bt[i];
-        }
-      }
-      if (!g) continue;
-      for (Eigen::Index r = 0; r < nf; ++r) {
-        const int v = variable_of_[e.functions[r]];
-        if (v < 0) continue;
-        double sx = 0.0, sy = 0.0;
-        for (int i = 0; i < 16; ++i) sx += e.C(r, i) * GX[i], sy += e.C(r, i) * GY[i];
-        g[v] += sx, g[v + 1] += sy;
-      }
+      const BezierElement& e = es[k];
+      const Level& level = levels_[d.level];
+      const ElementKernel in{e.C.data(), static_cast<long>(e.C.rows()), e.functions.data(), variable_of_.data(),
+                             normalized_.data(), d.W.data(), d.rational, d.hx, d.hy, d.weight, &level.grid,
+                             level.weight.data()};
+      nonpos += element_energy(in, xv, eps, theta, power, g, F, buffers);
     }
     energy[slot] = F;
     folded[slot] = nonpos;
@@ -307,27 +453,27 @@ double MapEnergy::evaluate(const double* xv, double eps, double* gradient, std::
 }
 
 SampleStats MapEnergy::stats(const double* xv) const {
-  const auto& es = extraction_.elements();
   SampleStats st;
   st.min_det = std::numeric_limits<double>::infinity();
   st.min_mean_ratio = std::numeric_limits<double>::infinity();
   double wsum = 0.0, jsum = 0.0;
-  for (std::size_t k = 0; k < es.size(); ++k) {
+  Samples s(*this);
+  for (const int ka : active_) {
+    const std::size_t k = static_cast<std::size_t>(ka);
     const Element& d = elements_[k];
-    if (!d.active) continue;
-    const Pattern& pat = patterns_[d.level];
+    const Level& level = levels_[d.level];
     std::array<double, 16> X, Y;
     element_coefficients(k, xv, X, Y);
-    for (std::size_t q = 0; q < pat.weight.size(); ++q) {
-      const SampleJacobian s = sample_jacobian(X, Y, d.W, pat.B[q], pat.Bs[q], pat.Bt[q], d.hx, d.hy);
-      const double D = s.J00 * s.J11 - s.J01 * s.J10;
-      const double n2 = s.J00 * s.J00 + s.J01 * s.J01 + s.J10 * s.J10 + s.J11 * s.J11;
+    element_samples(k, X.data(), Y.data(), s);
+    for (std::size_t q = 0; q < level.weight.size(); ++q) {
+      const double D = s.J00[q] * s.J11[q] - s.J01[q] * s.J10[q];
+      const double n2 = s.J00[q] * s.J00[q] + s.J01[q] * s.J01[q] + s.J10[q] * s.J10[q] + s.J11[q] * s.J11[q];
       const double jr = n2 > 0.0 ? 2.0 * D / n2 : 0.0;
       ++st.points;
       if (!(D > 0.0)) ++st.nonpositive;
       st.min_det = std::min(st.min_det, D);
       st.min_mean_ratio = std::min(st.min_mean_ratio, jr);
-      const double omega = pat.weight[q] * d.weight;
+      const double omega = level.weight[q] * d.weight;
       wsum += omega, jsum += omega * jr;
     }
   }
@@ -335,277 +481,30 @@ SampleStats MapEnergy::stats(const double* xv) const {
   return st;
 }
 
-
-SampleTerm sample_term(const Eigen::Matrix2d& J, double eps, double theta, double power, bool project) {
-  constexpr double s2 = 0.70710678118654752440;  // 1 / sqrt(2)
-  // Conformal (z) and anticonformal (w) coordinates of J in the orthonormal
-  // basis e1..e4 of map_energy.h: vec J = E (z1, z2, w1, w2).
-  const Eigen::Vector2d z(s2 * (J(0, 0) + J(1, 1)), s2 * (J(1, 0) - J(0, 1)));
-  const Eigen::Vector2d w(s2 * (J(0, 0) - J(1, 1)), s2 * (J(0, 1) + J(1, 0)));
-  const double P = z.squaredNorm(), Q = w.squaredNorm();
-  const double D = J.determinant();  // = (P - Q) / 2, without the cancellation
-  const double I = J.squaredNorm();  // = P + Q
-  // t(I, D) = N / chi, N = (1 - theta) I + theta (D^2 + 1) (Garanzha et al. 2021, Eqs. 2-4);
-  // chi' = chi / r, chi'' = eps^2 / (2 r^3), r = sqrt(eps^2 + D^2).
-  const double r = std::sqrt(eps * eps + D * D);
-  const double chi = regularized_det(D, eps);
-  const double c1 = chi / r, c2 = eps * eps / (2.0 * r * r * r);
-  const double N = (1.0 - theta) * I + theta * (D * D + 1.0);
-  const double t = N / chi;
-  const double tI = (1.0 - theta) / chi;
-  const double tD = (2.0 * theta * D - t * c1) / chi;
-  const double tID = -(1.0 - theta) * c1 / (chi * chi);
-  const double tDD = (2.0 * theta - 4.0 * theta * D * c1 / chi - t * c2 + 2.0 * t * c1 * c1 / chi) / chi;
-  // phi = t^p: phi_a = p t^(p-1) t_a, phi_ab = p t^(p-1) t_ab + p (p-1) t^(p-2) t_a t_b.
-  const double tp1 = power == 1.0 ? 1.0 : std::pow(t, power - 1.0);
-  const double d1 = power * tp1, d2 = power == 1.0 ? 0.0 : power * (power - 1.0) * tp1 / t;
-  const double fI = d1 * tI, fD = d1 * tD;
-  const double fII = d2 * tI * tI, fID = d1 * tID + d2 * tI * tD, fDD = d1 * tDD + d2 * tD * tD;
-  // To (P, Q): I = P + Q, D = (P - Q) / 2.
-  const double fP = fI + 0.5 * fD, fQ = fI - 0.5 * fD;
-  const double fPP = fII + fID + 0.25 * fDD, fQQ = fII - fID + 0.25 * fDD, fPQ = fII - 0.25 * fDD;
-
-  SampleTerm out;
-  out.value = power == 1.0 ? t : tp1 * t;
-  // Gradient: d phi / dz = 2 phi_P z, d phi / dw = 2 phi_Q w, then vec J = E (z, w).
-  const Eigen::Vector2d gz = 2.0 * fP * z, gw = 2.0 * fQ * w;
-  out.gradient << s2 * (gz[0] + gw[0]), s2 * (-gz[1] + gw[1]), s2 * (gz[1] + gw[1]), s2 * (gz[0] - gw[0]);
-
-  // Eigensystem of H_zw: unit directions (any, where z or w vanishes).
-  const double nz = std::sqrt(P), nw = std::sqrt(Q);
-  const Eigen::Vector2d zh = nz > 0.0 ? Eigen::Vector2d(z / nz) : Eigen::Vector2d(1.0, 0.0);
-  const Eigen::Vector2d wh = nw > 0.0 ? Eigen::Vector2d(w / nw) : Eigen::Vector2d(1.0, 0.0);
-  const Eigen::Vector2d zp(-zh[1], zh[0]), wp(-wh[1], wh[0]);
-  double lz = 2.0 * fP, lw = 2.0 * fQ;                      // twist (z-perp), flip (w-perp)
-  double a = 2.0 * fP + 4.0 * fPP * P, c = 2.0 * fQ + 4.0 * fQQ * Q;  // scalings: [[a, b], [b, c]]
-  double b = 4.0 * fPQ * nz * nw;                            //   on (zh, 0), (0, wh)
-  if (project) {
-    lz = std::max(lz, 0.0), lw = std::max(lw, 0.0);
-    const double m = 0.5 * (a + c), h = std::hypot(0.5 * (a - c), b);
-    const double lp = m + h, lm = m - h;
-    if (lp <= 0.0) {
-      a = b = c = 0.0;
-    } else if (lm < 0.0) {
-      // Keep the positive eigenpair only: v v^T lp, v the better conditioned
-      // of the two (equivalent) eigenvector formulas.
-      Eigen::Vector2d v1(b, lp - a), v2(lp - c, b);
-      Eigen::Vector2d v = v1.squaredNorm() >= v2.squaredNorm() ? v1 : v2;
-      const double n2 = v.squaredNorm();
-      if (n2 > 0.0) {
-        v /= std::sqrt(n2);
-      } else {
-        v = a >= c ? Eigen::Vector2d(1.0, 0.0) : Eigen::Vector2d(0.0, 1.0);
-      }
-      a = lp * v[0] * v[0], b = lp * v[0] * v[1], c = lp * v[1] * v[1];
-    }
-  }
-  // H_zw in the (z1, z2, w1, w2) coordinates.
-  Eigen::Matrix4d Hzw = Eigen::Matrix4d::Zero();
-  Hzw.topLeftCorner<2, 2>() = lz * zp * zp.transpose() + a * zh * zh.transpose();
-  Hzw.bottomRightCorner<2, 2>() = lw * wp * wp.transpose() + c * wh * wh.transpose();
-  Hzw.topRightCorner<2, 2>() = b * zh * wh.transpose();
-  Hzw.bottomLeftCorner<2, 2>() = Hzw.topRightCorner<2, 2>().transpose();
-  Eigen::Matrix4d E;  // columns e1..e4 in vec J = (J00, J01, J10, J11)
-  E << s2, 0, s2, 0,  //
-      0, -s2, 0, s2,  //
-      0, s2, 0, s2,   //
-      s2, 0, -s2, 0;
-  out.hessian = E * Hzw * E.transpose();
-  return out;
-}
-
-void MapEnergy::build_hessian_pattern() const {
-  HessianPattern& hp = hpattern_;
-  const auto& es = extraction_.elements();
-  const std::size_t nodes = free_functions_.size();
-  // Node adjacency, lower part (rows i >= column j).
-  std::vector<std::vector<int>> col(nodes);
-  std::vector<int> fn;
-  for (std::size_t k = 0; k < es.size(); ++k) {
-    if (!elements_[k].active) continue;
-    fn.clear();
-    for (int a : es[k].functions)
-      if (variable_of_[a] >= 0) fn.push_back(variable_of_[a] / 2);
-    for (int j : fn)
-      for (int i : fn)
-        if (i >= j) col[j].push_back(i);
-  }
-  for (std::vector<int>& c : col) {
-    std::sort(c.begin(), c.end());
-    c.erase(std::unique(c.begin(), c.end()), c.end());
-  }
-  // Scalar structure: columns 2j and 2j+1 both hold rows 2i, 2i+1, i in col[j].
-  const Eigen::Index n = static_cast<Eigen::Index>(2 * nodes);
-  std::size_t nnz = 0;
-  for (const std::vector<int>& c : col) nnz += 4 * c.size();
-  hp.H = Eigen::SparseMatrix<double>(n, n);
-  hp.H.resizeNonZeros(static_cast<Eigen::Index>(nnz));
-  int* outer = hp.H.outerIndexPtr();
-  int* inner = hp.H.innerIndexPtr();
-  double* val = hp.H.valuePtr();
-  std::size_t pos = 0;
-  for (std::size_t j = 0; j < nodes; ++j)
-    for (int d = 0; d < 2; ++d) {
-      outer[2 * j + d] = static_cast<int>(pos);
-      for (int i : col[j]) {
-        inner[pos] = 2 * i, val[pos++] = 0.0;
-        inner[pos] = 2 * i + 1, val[pos++] = 0.0;
-      }
-    }
-  outer[n] = static_cast<int>(pos);
-  // Slots per element.
-  hp.slot_offset.assign(es.size() + 1, 0);
-  for (std::size_t k = 0; k < es.size(); ++k) {
-    const std::size_t m = es[k].functions.size();
-    hp.slot_offset[k + 1] = hp.slot_offset[k] + (elements_[k].active ? m * m : 0);
-  }
-  hp.slots.assign(hp.slot_offset.back(), -1);
-  for (std::size_t k = 0; k < es.size(); ++k) {
-    if (!elements_[k].active) continue;
-    const std::vector<int>& f = es[k].functions;
-    const std::size_t m = f.size();
-    for (std::size_t c = 0; c < m; ++c) {
-      if (variable_of_[f[c]] < 0) continue;
-      const int j = variable_of_[f[c]] / 2;
-      for (std::size_t r = 0; r < m; ++r) {
-        if (variable_of_[f[r]] < 0) continue;
-        const int i = variable_of_[f[r]] / 2;
-        if (i < j) continue;
-        const auto it = std::lower_bound(col[j].begin(), col[j].end(), i);
-        hp.slots[hp.slot_offset[k] + r * m + c] = static_cast<int>(it - col[j].begin());
-      }
-    }
-  }
-  // Greedy colouring: elements of one colour share no free function, so that
-  // they can be assembled in parallel without conflicts.
-  std::vector<std::vector<int>> support(nodes);
-  for (std::size_t k = 0; k < es.size(); ++k)
-    if (elements_[k].active)
-      for (int a : es[k].functions)
-        if (variable_of_[a] >= 0) support[variable_of_[a] / 2].push_back(static_cast<int>(k));
-  std::vector<int> color(es.size(), -1);
-  std::vector<char> used;
-  hp.colors.clear();
-  for (std::size_t k = 0; k < es.size(); ++k) {
-    if (!elements_[k].active) continue;
-    used.assign(hp.colors.size() + 1, 0);
-    for (int a : es[k].functions)
-      if (variable_of_[a] >= 0)
-        for (int o : support[variable_of_[a] / 2])
-          if (color[o] >= 0) used[color[o]] = 1;
-    int cc = 0;
-    while (used[cc]) ++cc;
-    color[k] = cc;
-    if (cc == static_cast<int>(hp.colors.size())) hp.colors.emplace_back();
-    hp.colors[cc].push_back(static_cast<int>(k));
-  }
-  hp.built = true;
-}
-
-void MapEnergy::hessian(const double* xv, double eps, Eigen::SparseMatrix<double>& H, double power,
-                        bool project) const {
-  if (!hpattern_.built) build_hessian_pattern();
-  const HessianPattern& hp = hpattern_;
-  if (H.rows() != hp.H.rows() || H.nonZeros() != hp.H.nonZeros() || !H.isCompressed())
-    H = hp.H;
-  else
-    std::fill(H.valuePtr(), H.valuePtr() + H.nonZeros(), 0.0);
-  const auto& es = extraction_.elements();
-  const double theta = options_.theta;
-  const int* outer = H.outerIndexPtr();
-  double* val = H.valuePtr();
-  using Mat16 = Eigen::Matrix<double, 16, 16>;
-  using MatA = Eigen::Matrix<double, 16, Eigen::Dynamic>;
-  for (const std::vector<int>& group : hp.colors) {
-    detail::parallel_ranges(group.size(), options_.threads, [&](std::size_t b, std::size_t e_end, int) {
-      MatA A, Mxx, Mxy, Myy;
-      Eigen::MatrixXd Cf, Kxx, Kxy, Kyy;
-      std::vector<int> rows;
-      for (std::size_t gi = b; gi < e_end; ++gi) {
-        const std::size_t k = static_cast<std::size_t>(group[gi]);
-        const BezierElement& e = es[k];
-        const Element& d = elements_[k];
-        const Pattern& pat = patterns_[d.level];
-        const Eigen::Index nq = static_cast<Eigen::Index>(pat.weight.size());
-        std::array<double, 16> X, Y;
-        element_coefficients(k, xv, X, Y);
-        A.resize(16, 2 * nq), Mxx.resize(16, 2 * nq), Mxy.resize(16, 2 * nq), Myy.resize(16, 2 * nq);
-        for (Eigen::Index q = 0; q < nq; ++q) {
-          const SampleJacobian s = sample_jacobian(X, Y, d.W, pat.B[q], pat.Bs[q], pat.Bt[q], d.hx, d.hy);
-          Eigen::Matrix2d J;
-          J << s.J00, s.J01, s.J10, s.J11;
-          const SampleTerm st = sample_term(J, eps, theta, power, project);
-          const Eigen::Matrix4d Hq = (pat.weight[q] * d.weight) * st.hessian;
-          // J00 = as . X, J01 = at . X, J10 = as . Y, J11 = at . Y (sample_jacobian).
-          const double iw = 1.0 / s.w;
-          const auto& Bq = pat.B[q];
-          const auto& Bs = pat.Bs[q];
-          const auto& Bt = pat.Bt[q];
-          for (int i = 0; i < 16; ++i) {
-            A(i, 2 * q) = (Bs[i] - Bq[i] * s.ws * iw) * iw / d.hx;
-            A(i, 2 * q + 1) = (Bt[i] - Bq[i] * s.wt * iw) * iw / d.hy;
-          }
-          Mxx.middleCols<2>(2 * q) = A.middleCols<2>(2 * q) * Hq.topLeftCorner<2, 2>();
-          Mxy.middleCols<2>(2 * q) = A.middleCols<2>(2 * q) * Hq.topRightCorner<2, 2>();
-          Myy.middleCols<2>(2 * q) = A.middleCols<2>(2 * q) * Hq.bottomRightCorner<2, 2>();
-        }
-        // Bernstein-coefficient blocks (sum over samples of A_q H_q A_q^T).
-        const Mat16 Bxx = Mxx * A.transpose(), Bxy = Mxy * A.transpose(), Byy = Myy * A.transpose();
-        // To the element's free control points: K = C_f B C_f^T.
-        rows.clear();
-        for (Eigen::Index r = 0; r < e.C.rows(); ++r)
-          if (variable_of_[e.functions[r]] >= 0) rows.push_back(static_cast<int>(r));
-        const Eigen::Index nf = static_cast<Eigen::Index>(rows.size());
-        Cf.resize(nf, 16);
-        for (Eigen::Index r = 0; r < nf; ++r) Cf.row(r) = e.C.row(rows[r]);
-        Kxx.noalias() = Cf * Bxx * Cf.transpose();
-        Kxy.noalias() = Cf * Bxy * Cf.transpose();
-        Kyy.noalias() = Cf * Byy * Cf.transpose();
-        const std::size_t m = e.functions.size();
-        const int* slot = &hp.slots[hp.slot_offset[k]];
-        for (Eigen::Index c = 0; c < nf; ++c) {
-          const int j = variable_of_[e.functions[rows[c]]] / 2;
-          for (Eigen::Index r = 0; r < nf; ++r) {
-            const int sl = slot[rows[r] * m + rows[c]];
-            if (sl < 0) continue;
-            double* c0 = val + outer[2 * j] + 2 * sl;
-            double* c1 = val + outer[2 * j + 1] + 2 * sl;
-            c0[0] += Kxx(r, c);  // (x_i, x_j)
-            c0[1] += Kxy(c, r);  // (y_i, x_j) = (x_j, y_i)
-            c1[0] += Kxy(r, c);  // (x_i, y_j)
-            c1[1] += Kyy(r, c);  // (y_i, y_j)
-          }
-        }
-      }
-    }, 8);
-  }
-}
-
 double MapEnergy::max_positive_step(const double* xv, const double* dv, double a_max, double safety) const {
-  const auto& es = extraction_.elements();
-  // The direction's own coefficients: element_coefficients is linear, so the
+  // The direction's own coefficients: element_coefficients is affine, so the
   // coefficients of x + t d are X + t (X(d) - X(0)) with the fixed points in X(0).
   const std::vector<double> zero(num_variables(), 0.0);
   std::vector<double> result(static_cast<std::size_t>(std::max(1, options_.threads)), a_max);
-  detail::parallel_ranges(es.size(), options_.threads, [&](std::size_t b, std::size_t e_end, int slot) {
+  detail::parallel_ranges(active_.size(), options_.threads, [&](std::size_t b, std::size_t e_end, int slot) {
+    Samples s(*this), sd(*this);
     double best = a_max;
-    for (std::size_t k = b; k < e_end; ++k) {
+    for (std::size_t i = b; i < e_end; ++i) {
+      const std::size_t k = static_cast<std::size_t>(active_[i]);
       const Element& d = elements_[k];
-      if (!d.active) continue;
-      const Pattern& pat = patterns_[d.level];
       std::array<double, 16> X, Y, DX, DY, X0, Y0;
       element_coefficients(k, xv, X, Y);
       element_coefficients(k, dv, DX, DY);
       element_coefficients(k, zero.data(), X0, Y0);
       for (int i = 0; i < 16; ++i) DX[i] -= X0[i], DY[i] -= Y0[i];
-      for (std::size_t q = 0; q < pat.weight.size(); ++q) {
-        const SampleJacobian s = sample_jacobian(X, Y, d.W, pat.B[q], pat.Bs[q], pat.Bt[q], d.hx, d.hy);
-        const double D0 = s.J00 * s.J11 - s.J01 * s.J10;
+      element_samples(k, X.data(), Y.data(), s);
+      element_samples(k, DX.data(), DY.data(), sd);
+      for (std::size_t q = 0; q < levels_[d.level].weight.size(); ++q) {
+        const double D0 = s.J00[q] * s.J11[q] - s.J01[q] * s.J10[q];
         if (!(D0 > 0.0)) continue;
-        const SampleJacobian g = sample_jacobian(DX, DY, d.W, pat.B[q], pat.Bs[q], pat.Bt[q], d.hx, d.hy);
         // det(J + t G) = D0 + t D1 + t^2 D2.
-        const double D1 = s.J00 * g.J11 + g.J00 * s.J11 - s.J01 * g.J10 - g.J01 * s.J10;
-        const double D2 = g.J00 * g.J11 - g.J01 * g.J10;
+        const double D1 = s.J00[q] * sd.J11[q] + sd.J00[q] * s.J11[q] - s.J01[q] * sd.J10[q] - sd.J01[q] * s.J10[q];
+        const double D2 = sd.J00[q] * sd.J11[q] - sd.J01[q] * sd.J10[q];
         // Smallest positive root, if any, by the stable quadratic formula.
         double root = std::numeric_limits<double>::infinity();
         if (D2 == 0.0) {

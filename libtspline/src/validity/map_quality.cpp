@@ -1,6 +1,8 @@
 #include "tspline/validity/map_quality.h"
 
 #include "tspline/detail/quadrature.h"
+#include "tspline/detail/tensor_grid.h"
+#include "tspline/detail/thread_pool.h"
 #include "tspline/spline/bezier_extraction.h"
 
 #include <Eigen/LU>
@@ -21,58 +23,168 @@ double scaled_jacobian(const Eigen::Matrix2d& J) {
   return n > 0.0 ? J.determinant() / n : 0.0;
 }
 
+namespace {
+
+// J = dS/d(xi, eta) at local (s, t) of element e, from the map's Bernstein
+// coefficients on e relative to the point c (X - c w, Y - c w; w = sum C).
+Eigen::Matrix2d element_jacobian_at(const BezierElement& e, const double* X, const double* Y, const double* W, double s,
+                                    double t) {
+  const std::array<double, 4> bs = bernstein3(s), bt = bernstein3(t);
+  const double rs = 1.0 - s, rt = 1.0 - t;
+  const double ds[4] = {-3.0 * rs * rs, 3.0 * rs * rs - 6.0 * s * rs, 6.0 * s * rs - 3.0 * s * s, 3.0 * s * s};
+  const double dt[4] = {-3.0 * rt * rt, 3.0 * rt * rt - 6.0 * t * rt, 6.0 * t * rt - 3.0 * t * t, 3.0 * t * t};
+  double v[3] = {}, vs[3] = {}, vt[3] = {};
+  const double* c[3] = {X, Y, W};
+  for (int j = 0; j < 4; ++j)
+    for (int i = 0; i < 4; ++i) {
+      const double b = bs[i] * bt[j], bS = ds[i] * bt[j], bT = bs[i] * dt[j];
+      for (int f = 0; f < 3; ++f) v[f] += c[f][i + 4 * j] * b, vs[f] += c[f][i + 4 * j] * bS, vt[f] += c[f][i + 4 * j] * bT;
+    }
+  const double iw = 1.0 / v[2], hx = e.hi.x() - e.lo.x(), hy = e.hi.y() - e.lo.y();
+  Eigen::Matrix2d J;
+  J << (vs[0] - v[0] * vs[2] * iw) * iw / hx, (vt[0] - v[0] * vt[2] * iw) * iw / hy,
+      (vs[1] - v[1] * vs[2] * iw) * iw / hx, (vt[1] - v[1] * vt[2] * iw) * iw / hy;
+  return J;
+}
+
+// The Bernstein coefficients of the map on e relative to c = a control point of e.
+void element_coefficients(const BezierElement& e, const std::vector<Eigen::Vector2d>& P, double* X, double* Y,
+                          double* W) {
+  const Eigen::Vector2d c = P[e.functions.front()];
+  std::fill(X, X + 16, 0.0), std::fill(Y, Y + 16, 0.0), std::fill(W, W + 16, 0.0);
+  for (Eigen::Index r = 0; r < e.C.rows(); ++r) {
+    const Eigen::Vector2d d = P[e.functions[r]] - c;
+    for (int i = 0; i < 16; ++i) X[i] += d.x() * e.C(r, i), Y[i] += d.y() * e.C(r, i), W[i] += e.C(r, i);
+  }
+}
+
+}  // namespace
+
 MapQualityStats map_quality(const TSplineMap& map, int gauss, std::vector<CellMapQuality>* per_cell) {
   std::vector<double> gp, gw;
   detail::gauss_points_01(gauss, gp, gw);
   const TMesh& mesh = map.mesh();
+  const int nc = static_cast<int>(mesh.num_cells());
+  // Each Gauss point of a cell on the Bezier element of the cell that holds it
+  // (the elements tile the cell), evaluated from the element's coefficients.
+  const BezierExtraction extraction(map.basis());
+  const std::vector<BezierElement>& es = extraction.elements();
+  const std::vector<Eigen::Vector2d>& P = map.control_points();
+  std::vector<CellMapQuality> cells(static_cast<std::size_t>(nc));
+  std::vector<double> cell_sum(static_cast<std::size_t>(nc), 0.0), cell_max_det(static_cast<std::size_t>(nc));
+  std::vector<std::size_t> cell_nonpositive(static_cast<std::size_t>(nc), 0);
+  detail::parallel_ranges(static_cast<std::size_t>(nc), detail::pool_threads(), [&](std::size_t b, std::size_t end, int) {
+    std::vector<std::array<double, 48>> coeffs;
+    for (std::size_t cu = b; cu < end; ++cu) {
+      const int c = static_cast<int>(cu);
+      const Eigen::Vector2d lo = mesh.cell_min(c), hi = mesh.cell_max(c);
+      const std::size_t e0 = extraction.cell_begin(c), e1 = extraction.cell_begin(c + 1);
+      coeffs.resize(e1 - e0);
+      for (std::size_t k = e0; k < e1; ++k)
+        element_coefficients(es[k], P, coeffs[k - e0].data(), coeffs[k - e0].data() + 16, coeffs[k - e0].data() + 32);
+      CellMapQuality q;
+      q.min_det = std::numeric_limits<double>::infinity();
+      double sum = 0.0, max_det = -std::numeric_limits<double>::infinity();
+      std::size_t nonpositive = 0;
+      for (double a : gp)
+        for (double bb : gp) {
+          const Eigen::Vector2d uv(lo.x() + a * (hi.x() - lo.x()), lo.y() + bb * (hi.y() - lo.y()));
+          std::size_t k = e0;
+          while (k + 1 < e1 && !(uv.x() >= es[k].lo.x() && uv.x() < es[k].hi.x() && uv.y() >= es[k].lo.y() &&
+                                 uv.y() < es[k].hi.y()))
+            ++k;
+          const Eigen::Vector2d st = es[k].local(uv);
+          const double* cf = coeffs[k - e0].data();
+          const Eigen::Matrix2d J = element_jacobian_at(es[k], cf, cf + 16, cf + 32, st.x(), st.y());
+          const double det = J.determinant(), jr = mean_ratio_jacobian(J), js = scaled_jacobian(J);
+          q.min_mean_ratio = std::min(q.min_mean_ratio, jr);
+          q.min_det = std::min(q.min_det, det);
+          q.min_scaled = std::min(q.min_scaled, js);
+          if (!(det > 0.0)) ++nonpositive;
+          sum += jr;
+          max_det = std::max(max_det, det);
+        }
+      cells[cu] = q, cell_sum[cu] = sum, cell_max_det[cu] = max_det, cell_nonpositive[cu] = nonpositive;
+    }
+  }, 64);
   MapQualityStats s;
   s.min_det = std::numeric_limits<double>::infinity();
   s.max_det = -std::numeric_limits<double>::infinity();
   double sum = 0.0;
-  if (per_cell) per_cell->assign(mesh.num_cells(), CellMapQuality{});
-  for (int c = 0; c < static_cast<int>(mesh.num_cells()); ++c) {
-    const Eigen::Vector2d lo = mesh.cell_min(c), hi = mesh.cell_max(c);
-    CellMapQuality q;
-    q.min_det = std::numeric_limits<double>::infinity();
-    for (double a : gp)
-      for (double b : gp) {
-        const Eigen::Vector2d uv(lo.x() + a * (hi.x() - lo.x()), lo.y() + b * (hi.y() - lo.y()));
-        const Eigen::Matrix2d J = map.derivatives(uv, 1, c).J;
-        const double det = J.determinant(), jr = mean_ratio_jacobian(J), js = scaled_jacobian(J);
-        q.min_mean_ratio = std::min(q.min_mean_ratio, jr);
-        q.min_det = std::min(q.min_det, det);
-        q.min_scaled = std::min(q.min_scaled, js);
-        ++s.points;
-        if (!(det > 0.0)) ++s.nonpositive_det;
-        sum += jr;
-        s.max_det = std::max(s.max_det, det);
-      }
+  for (int c = 0; c < nc; ++c) {
+    const CellMapQuality& q = cells[c];
+    s.points += gp.size() * gp.size();
+    s.nonpositive_det += cell_nonpositive[c];
+    sum += cell_sum[c];
+    s.max_det = std::max(s.max_det, cell_max_det[c]);
     s.min_mean_ratio = std::min(s.min_mean_ratio, q.min_mean_ratio);
     s.min_det = std::min(s.min_det, q.min_det);
     s.min_scaled = std::min(s.min_scaled, q.min_scaled);
-    if (per_cell) (*per_cell)[c] = q;
   }
   s.mean_mean_ratio = s.points ? sum / static_cast<double>(s.points) : 0.0;
+  if (per_cell) *per_cell = std::move(cells);
   return s;
 }
 
 DenseMapQuality dense_map_quality(const TSplineMap& map, int k) {
   if (k < 1) throw std::invalid_argument("dense_map_quality: k must be >= 1");
+  const BezierExtraction extraction(map.basis());
+  const std::vector<BezierElement>& es = extraction.elements();
+  const std::vector<Eigen::Vector2d>& P = map.control_points();
+  // The (k + 1) x (k + 1) points of every element as a tensor grid: the map's
+  // Bernstein coefficients per element and sum factorization (tensor_grid.h),
+  // instead of the basis functions point by point.
+  const int m = k + 1;
+  std::vector<double> pts(m), wts(m, 1.0);
+  for (int i = 0; i <= k; ++i) pts[i] = static_cast<double>(i) / k;
+  detail::TensorGrid grid;
+  grid.set(pts, wts);
+  const std::size_t n = grid.size();
+  const int threads = detail::pool_threads();
+  std::vector<DenseMapQuality> part(static_cast<std::size_t>(threads));
+  detail::parallel_ranges(es.size(), threads, [&](std::size_t begin, std::size_t end, int slot) {
+    DenseMapQuality& q = part[slot];
+    std::vector<double> buf(9 * n), scratch(8 * static_cast<std::size_t>(m));
+    double* x = buf.data();
+    double *xs = x + n, *xt = xs + n, *y = xt + n, *ys = y + n, *yt = ys + n, *w = yt + n, *ws = w + n, *wt = ws + n;
+    for (std::size_t ke = begin; ke < end; ++ke) {
+      const BezierElement& e = es[ke];
+      ++q.elements;
+      // S - c = (X - c w) / w: coefficients relative to a control point of the
+      // element, so that far-from-origin coordinates do not cancel in the derivatives.
+      double X[16], Y[16], W[16];
+      element_coefficients(e, P, X, Y, W);
+      detail::tensor_values(grid, X, x, xs, xt, scratch.data());
+      detail::tensor_values(grid, Y, y, ys, yt, scratch.data());
+      detail::tensor_values(grid, W, w, ws, wt, scratch.data());
+      const double hx = e.hi.x() - e.lo.x(), hy = e.hi.y() - e.lo.y();
+      for (int j = 0; j <= k; ++j)
+        for (int i = 0; i <= k; ++i) {
+          const std::size_t p = static_cast<std::size_t>(i + m * j);
+          // S_s = (X_s - X w_s / w) / w, S_t alike; J = [S_s / hx, S_t / hy].
+          const double iw = 1.0 / w[p];
+          Eigen::Matrix2d J;
+          J << (xs[p] - x[p] * ws[p] * iw) * iw / hx, (xt[p] - x[p] * wt[p] * iw) * iw / hy,
+              (ys[p] - y[p] * ws[p] * iw) * iw / hx, (yt[p] - y[p] * wt[p] * iw) * iw / hy;
+          const double jr = mean_ratio_jacobian(J);
+          ++q.points;
+          if (!(J.determinant() > 0.0)) ++q.nonpositive_det;
+          if (jr < q.min_mean_ratio)
+            q.min_mean_ratio = jr,
+            q.worst_at = {e.lo.x() + hx * i / k, e.lo.y() + hy * j / k};
+          q.min_scaled = std::min(q.min_scaled, scaled_jacobian(J));
+        }
+    }
+  }, 16);
+  // Merged in element order: the first worst point wins, as element by element.
   DenseMapQuality q;
   q.samples_per_edge = k;
-  const BezierExtraction extraction(map.basis());
-  for (const BezierElement& e : extraction.elements()) {
-    ++q.elements;
-    for (int j = 0; j <= k; ++j)
-      for (int i = 0; i <= k; ++i) {
-        const Eigen::Vector2d uv(e.lo.x() + (e.hi.x() - e.lo.x()) * i / k, e.lo.y() + (e.hi.y() - e.lo.y()) * j / k);
-        const Eigen::Matrix2d J = map.derivatives(uv, 1, e.cell).J;
-        const double jr = mean_ratio_jacobian(J);
-        ++q.points;
-        if (!(J.determinant() > 0.0)) ++q.nonpositive_det;
-        if (jr < q.min_mean_ratio) q.min_mean_ratio = jr, q.worst_at = uv;
-        q.min_scaled = std::min(q.min_scaled, scaled_jacobian(J));
-      }
+  for (const DenseMapQuality& p : part) {
+    q.elements += p.elements;
+    q.points += p.points;
+    q.nonpositive_det += p.nonpositive_det;
+    if (p.min_mean_ratio < q.min_mean_ratio) q.min_mean_ratio = p.min_mean_ratio, q.worst_at = p.worst_at;
+    q.min_scaled = std::min(q.min_scaled, p.min_scaled);
   }
   return q;
 }

@@ -5,6 +5,9 @@
 #include <ceres/gradient_problem_solver.h>
 
 #include <Eigen/CholmodSupport>
+#include <Eigen/IterativeLinearSolvers>
+
+#include "tspline/detail/lbfgs.h"
 
 #include <algorithm>
 #include <chrono>
@@ -46,7 +49,8 @@ class EnergyFunction final : public ceres::FirstOrderFunction {
 // MapEnergy, same T-mesh): only the numeric factorization is redone.
 class NewtonStage {
  public:
-  explicit NewtonStage(const MapEnergy& energy) : energy_(energy) {
+  NewtonStage(const MapEnergy& energy, bool conjugate_gradient, int max_cg_iterations)
+      : energy_(energy), cg_(conjugate_gradient), max_cg_(max_cg_iterations) {
     llt_.cholmod().print = 0;  // a failed (shifted) attempt is not an error
   }
 
@@ -57,6 +61,7 @@ class NewtonStage {
            bool& certified, const Certify& certify, MapUntanglingReport& rep) {
     const Eigen::Index n = x.size();
     Eigen::VectorXd g(n), d(n), xt(n);
+    g_prev_ = 0.0;  // a new stage: a new energy, the forcing starts over
     for (int it = 0; it < max_iter; ++it) {
       std::size_t nonpos = 0;
       const double E0 = energy_.evaluate(x.data(), eps, g.data(), &nonpos, power);
@@ -104,6 +109,29 @@ class NewtonStage {
     ++rep.factorizations;
     auto t2 = std::chrono::steady_clock::now();
     rep.hessian_seconds += std::chrono::duration<double>(t2 - t).count();
+    if (cg_) {
+      // Inexact Newton: CG preconditioned by the diagonal, to the relative
+      // residual eta of Eisenstat & Walker (SIAM J. Sci. Comput. 17, 1996,
+      // choice 2: eta = 0.9 (|g| / |g_prev|)^2, safeguarded by 0.9 eta_prev^2
+      // when that is above 0.1), in [1e-4, 0.5]. From 0, every CG iterate is a
+      // descent direction of the positive semi-definite model.
+      const double gn = g.norm();
+      double eta = 0.5;
+      if (g_prev_ > 0.0) {
+        eta = 0.9 * (gn / g_prev_) * (gn / g_prev_);
+        const double safeguard = 0.9 * eta_ * eta_;
+        if (safeguard > 0.1) eta = std::max(eta, safeguard);
+      }
+      eta = std::clamp(eta, 1e-4, 0.5);
+      eta_ = eta, g_prev_ = gn;
+      cg_solver_.setTolerance(eta);
+      cg_solver_.setMaxIterations(max_cg_);
+      cg_solver_.compute(H_);
+      d = cg_solver_.solve(-g);
+      rep.cg_iterations += static_cast<int>(cg_solver_.iterations());
+      rep.solve_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t2).count();
+      return d.allFinite() && g.dot(d) < 0.0;
+    }
     if (!analyzed_) {
       llt_.analyzePattern(H_);
       analyzed_ = true;
@@ -136,6 +164,10 @@ class NewtonStage {
   Eigen::SparseMatrix<double> H_;
   Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<double>, Eigen::Lower> llt_;
   bool analyzed_ = false;
+  bool cg_ = false;  // inexact Newton with CG instead of the Cholesky factorization
+  int max_cg_ = 200;
+  Eigen::ConjugateGradient<Eigen::SparseMatrix<double>, Eigen::Lower, Eigen::DiagonalPreconditioner<double>> cg_solver_;
+  double g_prev_ = 0.0, eta_ = 0.5;  // Eisenstat-Walker forcing
   int max_total_ = 1 << 30;
 };
 
@@ -169,6 +201,10 @@ MapUntanglingReport untangle_map(TSplineMap& map, const MapUntanglingOptions& op
     throw std::invalid_argument("untangle_map: eps_floor and energy_tolerance must be > 0");
   if (opt.max_newton_iterations_per_stage < 1 || !(opt.newton_stage_tolerance >= 0.0))
     throw std::invalid_argument("untangle_map: max_newton_iterations_per_stage must be >= 1 and newton_stage_tolerance >= 0");
+  if (!(opt.min_decrease > 0.0 && opt.min_decrease < 1.0) || !(opt.newton_min_decrease > 0.0 && opt.newton_min_decrease < 1.0))
+    throw std::invalid_argument("untangle_map: min_decrease and newton_min_decrease must be in (0, 1)");
+  if (opt.max_cg_iterations < 1 || opt.newton_cholesky_below < 0)
+    throw std::invalid_argument("untangle_map: max_cg_iterations must be >= 1 and newton_cholesky_below >= 0");
   const auto t0 = std::chrono::steady_clock::now();
   MapEnergy energy(map, opt.energy);
   MapUntanglingReport rep;
@@ -181,8 +217,14 @@ MapUntanglingReport untangle_map(TSplineMap& map, const MapUntanglingOptions& op
 
   std::optional<Eigen::VectorXd> best;  // the last certified iterate
   MapCertification best_cert;
+  // A local problem (movable functions) examines only its own elements: the
+  // others do not move, and the caller certified them.
+  std::vector<char> local_elements;
+  if (!opt.energy.movable.empty())
+    for (std::size_t k = 0; k < energy.num_elements(); ++k) local_elements.push_back(energy.element_active(k));
   auto certify = [&](const Eigen::VectorXd& v) {
-    return certify_map(energy.extraction(), num_cells, energy.control_points(v.data()), opt.certification);
+    return certify_map(energy.extraction(), num_cells, energy.control_points(v.data()), opt.certification,
+                       local_elements.empty() ? nullptr : &local_elements);
   };
   // A map without free points is what it is.
   if (rep.free_points == 0) {
@@ -211,10 +253,16 @@ MapUntanglingReport untangle_map(TSplineMap& map, const MapUntanglingOptions& op
   bool resampled = false;
   int quality_stages = 0;  // certified stages at the floor eps
   bool x_certified = false;  // x is the last certified iterate (Newton keeps it certified)
-  NewtonStage newton(energy);
+  const bool newton_cg = opt.newton_solver == NewtonSolver::ConjugateGradient ||
+                         (opt.newton_solver == NewtonSolver::Auto &&
+                          energy.num_variables() > static_cast<std::size_t>(opt.newton_cholesky_below));
+  NewtonStage newton(energy, newton_cg, opt.max_cg_iterations);
   newton.set_max_total(opt.max_iterations);
+  detail::Lbfgs lbfgs;
+  double lbfgs_eps = -1.0, lbfgs_power = 0.0;  // of its last stage
   auto certified_valid = [&](const Eigen::VectorXd& v) { return certify(v).certified_valid(); };
   for (int stage = 0; stage < opt.max_stages; ++stage) {
+    const bool new_samples = resampled;
     if (resampled) {
       // Finer samples can show det J <= 0 where the coarser ones had none:
       // leave the barrier (eps above the floor) but keep the regularization
@@ -229,9 +277,26 @@ MapUntanglingReport untangle_map(TSplineMap& map, const MapUntanglingOptions& op
     // The quality phase (barrier) raises each term to quality_power.
     const double power = barrier ? opt.quality_power : 1.0;
     const double E_prev = energy.evaluate(x.data(), eps, nullptr, nullptr, power);
+    double E_stage = std::numeric_limits<double>::quiet_NaN();  // E at the stage's end, if the minimizer knows it
     if (opt.optimizer == MapOptimizer::Newton) {
       newton.run(x, eps, power, opt.max_newton_iterations_per_stage, opt.newton_stage_tolerance, barrier, x_certified,
                  certified_valid, rep);
+    } else if (opt.optimizer == MapOptimizer::LBFGS) {
+      // The curvature pairs carry over from the last stage unless the energy
+      // changed more than by a lower eps: new samples, another power, eps raised.
+      if (new_samples || power != lbfgs_power || eps > lbfgs_eps) lbfgs.reset();
+      lbfgs_eps = eps, lbfgs_power = power;
+      const auto f = [&](const double* v, double* g) {
+        std::size_t nonpositive = 0;
+        const double e = energy.evaluate(v, eps, g, &nonpositive, power);
+        return barrier && nonpositive > 0 ? std::numeric_limits<double>::infinity() : e;
+      };
+      const detail::Lbfgs::Result r =
+          lbfgs.run(x, f, std::min(opt.max_iterations_per_stage, opt.max_iterations - rep.iterations));
+      rep.iterations += r.iterations;
+      rep.evaluations += r.evaluations;
+      E_stage = r.value;
+      x_certified = false;
     } else {
       so.max_num_iterations = std::min(opt.max_iterations_per_stage, opt.max_iterations - rep.iterations);
       ceres::GradientProblem problem(new EnergyFunction(energy, eps, barrier, power, &rep.evaluations));
@@ -244,7 +309,7 @@ MapUntanglingReport untangle_map(TSplineMap& map, const MapUntanglingOptions& op
       x_certified = false;
     }
     ++rep.stages;
-    const double E = energy.evaluate(x.data(), eps, nullptr, nullptr, power);
+    const double E = std::isfinite(E_stage) ? E_stage : energy.evaluate(x.data(), eps, nullptr, nullptr, power);
     const SampleStats st = energy.stats(x.data());
     bool certified_now = false;
     x_certified = false;
@@ -269,16 +334,23 @@ MapUntanglingReport untangle_map(TSplineMap& map, const MapUntanglingOptions& op
           TSplineMap local = map;
           local.set_control_points(energy.control_points(x.data()));
           const MapUntanglingReport lr = untangle_map(local, local_repair_options(map, energy, cert, opt));
+          rep.local_repair_iterations += lr.iterations;
+          rep.local_repair_seconds += lr.seconds;
           rep.iterations += lr.iterations;
           rep.evaluations += lr.evaluations;
           if (lr.certified) {
-            ++rep.local_repairs_certified;
-            x = energy.variables(local);
-            certified_now = true;
-            x_certified = true;
-            best = x;
-            best_cert = lr.certification;
-            resampled = false;  // the finer samples of the failing elements stay; they are positive now
+            // The local problem certified its own elements; the whole map once more.
+            const Eigen::VectorXd xl = energy.variables(local);
+            MapCertification whole = certify(xl);
+            if (whole.certified_valid()) {
+              ++rep.local_repairs_certified;
+              x = xl;
+              certified_now = true;
+              x_certified = true;
+              best = x;
+              best_cert = std::move(whole);
+              resampled = false;  // the finer samples of the failing elements stay; they are positive now
+            }
           }
         }
       }
@@ -309,7 +381,8 @@ MapUntanglingReport untangle_map(TSplineMap& map, const MapUntanglingOptions& op
     }
     // eps update (Garanzha et al. 2021): a fresh sample set restarts nothing,
     // the rule only looks at this stage's progress and the smallest det J.
-    const double sigma = std::max(1.0 - E / E_prev, opt.min_decrease);
+    const double min_decrease = opt.optimizer == MapOptimizer::Newton ? opt.newton_min_decrease : opt.min_decrease;
+    const double sigma = std::max(1.0 - E / E_prev, min_decrease);
     const double mu = (1.0 - sigma) * regularized_det(st.min_det, eps);
     eps = st.min_det < mu ? std::max(opt.eps_floor, 2.0 * std::sqrt(mu * (mu - st.min_det))) : opt.eps_floor;
   }

@@ -99,8 +99,12 @@ struct MapCertification {
 /// Certifies every Bezier element of every cell.
 MapCertification certify_map(const TSplineMap& map, const CertificationOptions& options = {});
 /// The same on an extraction made once (of a basis with num_cells cells) and
-/// the control points P.
+/// the control points P. With `only` (one flag per element), only the flagged
+/// elements are examined: the counts and bounds are theirs (a local problem,
+/// where the other elements do not change). The elements are examined in
+/// parallel (detail/thread_pool.h); the result does not depend on the threads.
 MapCertification certify_map(const BezierExtraction& extraction, std::size_t num_cells,
-                             const std::vector<Eigen::Vector2d>& P, const CertificationOptions& options = {});
+                             const std::vector<Eigen::Vector2d>& P, const CertificationOptions& options = {},
+                             const std::vector<char>* only = nullptr);
 
 }  // namespace tspline

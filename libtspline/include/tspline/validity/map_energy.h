@@ -61,6 +61,7 @@
 #include <cstddef>
 #include <vector>
 
+#include "tspline/detail/tensor_grid.h"
 #include "tspline/spline/bezier_extraction.h"
 #include "tspline/spline/tspline_map.h"
 
@@ -114,6 +115,8 @@ class MapEnergy {
   /// Indices (into the basis) of the functions whose control points are free.
   const std::vector<int>& free_functions() const { return free_functions_; }
   std::size_t num_elements() const { return elements_.size(); }
+  /// Does element k touch a free control point (else the energy leaves it out)?
+  bool element_active(std::size_t k) const { return elements_[k].active; }
   const BezierExtraction& extraction() const { return extraction_; }
   double length_scale() const { return L_; }
 
@@ -155,14 +158,25 @@ class MapEnergy {
   std::size_t num_samples() const;
 
  private:
-  struct Pattern {  // samples of one level on the unit square
-    std::vector<double> weight;              // sums to 1
-    std::vector<std::array<double, 16>> B;   // tensor Bernstein values
-    std::vector<std::array<double, 16>> Bs;  // d/ds
-    std::vector<std::array<double, 16>> Bt;  // d/dt
+  // Per-thread buffers for one element's samples (element_samples), sized
+  // for the finest sample level.
+  struct Samples {
+    explicit Samples(const MapEnergy& energy);
+    // At the samples: X, Y and their derivatives in the local (s, t), then
+    // (after element_samples) the adjoints of evaluate's gradient in place.
+    std::vector<double> x, xs, xt, y, ys, yt;
+    std::vector<double> rw, rs, rt;          // rational elements: 1 / w, w_s / w, w_t / w
+    std::vector<double> J00, J01, J10, J11;  // the Jacobian in normalized coordinates
+    std::vector<double> term;                // evaluate: each sample's weighted term
+    std::vector<double> scratch;             // tensor_values
+  };
+  struct Level {  // the samples of one sample level on the unit square
+    detail::TensorGrid grid;     // (n 2^l)^2 points: n x n on each of 2^l x 2^l sub-squares
+    std::vector<double> weight;  // per point, sums to 1
   };
   struct Element {
     std::array<double, 16> W{};  // Bernstein coefficients of w = sum_a N_a
+    bool rational = false;       // w is not 1 (the functions are not a partition of unity here)
     double hx = 1.0, hy = 1.0;   // parametric size
     double weight = 1.0;
     int level = 0;
@@ -173,17 +187,23 @@ class MapEnergy {
     std::vector<std::size_t> slot_offset;   // per element: start of its n x n slots
     std::vector<int> slots;                 // (r, c): position of node(r) in node column node(c), -1 if above
     std::vector<std::vector<int>> colors;   // elements in groups sharing no free function
+    std::size_t max_rows = 0;               // functions per element at most
     bool built = false;
   };
   void build_hessian_pattern() const;
   // X and Y Bernstein coefficients of element k at the variables x.
   void element_coefficients(std::size_t k, const double* x, std::array<double, 16>& X,
                             std::array<double, 16>& Y) const;
+  // The Jacobian J at every sample of element k (its level) of the map whose
+  // Bernstein coefficients on k are X, Y: s.J00 ... s.J11, and s.x ... s.yt,
+  // s.rw, s.rs, s.rt for the chain rule. Linear in (X, Y).
+  void element_samples(std::size_t k, const double* X, const double* Y, Samples& s) const;
 
   MapEnergyOptions options_;
   BezierExtraction extraction_;
   std::vector<Element> elements_;
-  std::vector<Pattern> patterns_;
+  std::vector<int> active_;  // the elements that touch a variable, in order
+  std::vector<Level> levels_;
   std::vector<int> variable_of_;             // per function: index of its x coordinate, or -1
   std::vector<int> free_functions_;
   std::vector<Eigen::Vector2d> normalized_;  // all control points, normalized

@@ -49,7 +49,15 @@ namespace tspline {
 /// The minimizer of each eps stage.
 enum class MapOptimizer {
   Newton,  ///< projected Newton, CHOLMOD: fewer iterations, but each costs a sparse Cholesky
-  LBFGS    ///< Ceres' L-BFGS (the default: faster on every benchmark here, bench/README.md)
+  LBFGS,   ///< L-BFGS, curvature pairs kept across the stages (detail/lbfgs.h)
+  CeresLBFGS  ///< Ceres' L-BFGS, restarted every stage (the method before issue 23)
+};
+
+/// The linear solve of each Newton step.
+enum class NewtonSolver {
+  Auto,              ///< Cholesky below newton_cholesky_below unknowns, conjugate gradients above
+  Cholesky,          ///< CHOLMOD supernodal, the symbolic analysis reused
+  ConjugateGradient  ///< inexact Newton: diagonally preconditioned CG, Eisenstat-Walker forcing
 };
 
 struct UntanglingProgress {
@@ -78,6 +86,16 @@ struct MapUntanglingOptions {
   /// iteration lowers the energy by less than newton_stage_tolerance (relative).
   int max_newton_iterations_per_stage = 8;
   double newton_stage_tolerance = 1e-4;
+  NewtonSolver newton_solver = NewtonSolver::Auto;
+  /// Auto: the Cholesky factorization below this many unknowns (measured on the
+  /// 8.5e3 unknowns of Bali at level 6: a factorization 220 ms, CG to 1e-2 17 ms).
+  int newton_cholesky_below = 4000;
+  int max_cg_iterations = 200;  ///< per Newton step
+  /// Newton's sigma floor in the eps rule (min_decrease below is L-BFGS'):
+  /// each Newton stage ends near the stage's minimizer, so eps may fall
+  /// faster (measured on Newfoundland: 8 stages and 118 Newton iterations
+  /// instead of 33 and 279 with 0.25, the same certified quality).
+  double newton_min_decrease = 0.9;
   int max_iterations = 20000;         ///< optimizer iterations in total
   /// Stop once certified and a stage at the floor eps lowered the energy by
   /// less than this fraction.
@@ -114,10 +132,13 @@ struct MapUntanglingReport {
   int shifted_factorizations = 0;  ///< Newton: repeated with a diagonal shift (the first attempt failed)
   int line_search_certifications = 0;  ///< Newton: trial steps checked by the certificate
   double hessian_seconds = 0.0;  ///< Newton: assembly of the Hessians
-  double solve_seconds = 0.0;    ///< Newton: CHOLMOD analysis, factorizations and solves
+  double solve_seconds = 0.0;    ///< Newton: CHOLMOD analysis, factorizations and solves, or CG
+  int cg_iterations = 0;         ///< Newton with conjugate gradients: CG iterations in all
   int sample_refinements = 0;  ///< elements whose sample level was raised
   int local_repairs = 0;        ///< local problems solved for hidden folds (see local_repair)
   int local_repairs_certified = 0;  ///< of which certified the map
+  int local_repair_iterations = 0;  ///< optimizer iterations inside the local repairs (also in iterations)
+  double local_repair_seconds = 0.0;  ///< time in the local repairs (also in seconds)
   SampleStats before, after;   ///< at the initial samples / at the final samples, of the returned map
   bool certified = false;
   MapCertification certification;  ///< of the returned map
