@@ -135,6 +135,13 @@ TEST_SUITE("layout_quality") {
     const tspline::LayoutQuality WQ(wedge);
     // (Measured perpendicular to the opposite side: both widths scale alike.)
     CHECK(WQ.side_shape(w, tspline::LayoutTopology(w), 0, 0) == doctest::Approx(0.75 / 1.25));
+    // A coast reaching towards an adjacent side: from the corner (2, 0) the vertex
+    // (1.95, 0.8) is seen at the angle asin(0.05 / |(-0.05, 0.8)|) from the right side.
+    const tspline::LayoutRings reach = one_ring({V(0, 0), V(1.95, 0.8), V(2, 0), V(2, 1), V(0, 1)});
+    const tspline::LayoutMesh r =
+        ring_mesh(reach.curves[0], {V(0, 0), V(2, 0), V(2, 1), V(0, 1)}, {}, {{0, 1, 2, 3}});
+    CHECK(tspline::LayoutQuality(reach).side_shape(r, tspline::LayoutTopology(r), 0, 0) ==
+          doctest::Approx(0.05 / std::hypot(0.05, 0.8)));
     // A coast bulging out of the patch by d_out over a chord c: 1 - d_out / (2 c).
     const tspline::LayoutRings outward = one_ring({V(0, 0), V(1, -0.5), V(2, 0), V(2, 1), V(0, 1)});
     const tspline::LayoutMesh o =

@@ -144,6 +144,12 @@ double LayoutQuality::side_shape(const LayoutMesh& m, const LayoutTopology& t, i
     const Eigen::Vector2d f = a + u.dot(p - a) * u;
     const double full = cross(ou, f - o0), left = cross(ou, p - o0);
     pinch = std::min(pinch, full > 0.0 ? left / full : 0.0);
+    // Towards an adjacent side: the sine of the angle at its corner between
+    // that side and the direction to p (the corner as the map sees it on p's
+    // scale; a vertex on the chord gives the corner's own sine).
+    const double pa = (p - a).norm(), pb = (p - b).norm();
+    if (pa > 0.0 && (o1 - a).norm() > 0.0) pinch = std::min(pinch, cross(p - a, (o1 - a).normalized()) / pa);
+    if (pb > 0.0 && (o0 - b).norm() > 0.0) pinch = std::min(pinch, cross((o0 - b).normalized(), p - b) / pb);
   }
   return std::min(pinch, 1.0 - 0.5 * out / chord);
 }

@@ -54,7 +54,9 @@ class LayoutQuality {
   /// patch (left of the chord) leaves the patch the width w(p) to the line of
   /// the opposite side where the straight patch had w(f), f the foot of p on
   /// the chord: the figure is w(p) / w(f) (a coast bulging into a thin patch
-  /// pinches it; for a rectangle 1 - d_in / width). Vertices outside give
+  /// pinches it; for a rectangle 1 - d_in / width), and the sine of the angle
+  /// at either end's corner between the adjacent side and the direction to p
+  /// (a coast reaching towards a cut pinches the patch there). Vertices outside give
   /// 1 - d_out / (2 c), c the chord. The smallest, 1 for a cut. Not a bound of
   /// the map's figures but what the corners cannot see.
   double side_shape(const LayoutMesh& m, const LayoutTopology& t, int q, int j) const;
