@@ -102,15 +102,6 @@ std::string ring_name(std::size_t r) { return r == 0 ? "the outer ring" : "hole 
 
 namespace {
 
-double ring_area(const std::vector<Eigen::Vector2d>& v) {
-  double a = 0.0;
-  for (std::size_t i = 0; i < v.size(); ++i) {
-    const Eigen::Vector2d &p = v[i], &q = v[(i + 1) % v.size()];
-    a += p.x() * q.y() - p.y() * q.x();
-  }
-  return 0.5 * a;
-}
-
 // The convex hull of a ring's vertices, counter-clockwise, with their file numbers.
 Polygon convex_hull_of(const Polygon& p) {
   std::vector<Point> pts, hull;
@@ -157,8 +148,8 @@ Domain validate_domain(Domain d, const DomainCleaningOptions& cleaning) {
           std::ostringstream m;
           m.precision(4);
           m << name << ": crosses itself; replaced by its convex hull (" << h.vertices.size() << " of its "
-            << c.polygon.vertices.size() << " vertices; area " << std::abs(ring_area(c.polygon.vertices))
-            << " (signed, lobes cancelling) -> " << ring_area(h.vertices) << ")";
+            << c.polygon.vertices.size() << " vertices; area " << std::abs(signed_area(c.polygon))
+            << " (signed, lobes cancelling) -> " << signed_area(h) << ")";
           note(m.str());
           c.polygon = std::move(h);
         }
