@@ -77,7 +77,13 @@ TEST_SUITE("holes_app") {
       CHECK(t["certified_lower_bound"].get<double>() > 0.0);
       CHECK(t["certified_lower_bound"].get<double>() <= sampled);
       CHECK(t["certified_lower_bound_patch"].get<std::size_t>() < patches);
+      // ... also where a single-patch report has it, so readers need no case for several patches.
+      CHECK(rep["jacobian"]["whole_map"][q] == t);
     }
+    CHECK(rep["certified_valid"] == true);
+    double dense = 2.0;
+    for (const auto& p : rep["patches"]) dense = std::min(dense, p["jacobian"]["whole_map"]["min_mean_ratio"].get<double>());
+    CHECK(rep["jacobian"]["whole_map"]["min_mean_ratio"].get<double>() == dense);
     CHECK(contains(r.out, "whole map: J_r >= "));
     // The surface covers every patch: cell data `patch` in 0..3.
     const std::string vtu = test_support::slurp(out / "surface.vtu");
