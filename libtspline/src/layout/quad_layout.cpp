@@ -44,19 +44,6 @@ void split_piece(const RingCurve& ring, std::vector<double>& nodes, std::size_t 
 
 bool debugging() { return std::getenv("TSPLINE_LAYOUT_DEBUG") != nullptr; }
 
-// Debugging aid (TSPLINE_LAYOUT_DUMP=prefix): the layout mesh as text, a line
-// "n x y ring" per node, then "q a b c d" per quad.
-void dump(const LayoutMesh& m, int round, const char* stage) {
-  const char* prefix = std::getenv("TSPLINE_LAYOUT_DUMP");
-  if (!prefix) return;
-  const std::string path = std::string(prefix) + "_" + std::to_string(round) + "_" + stage;
-  if (FILE* f = std::fopen(path.c_str(), "w")) {
-    for (std::size_t n = 0; n < m.size(); ++n) std::fprintf(f, "n %.17g %.17g %d\n", m.x[n].x(), m.x[n].y(), m.ring[n]);
-    for (const auto& q : m.quads) std::fprintf(f, "q %d %d %d %d\n", q[0], q[1], q[2], q[3]);
-    std::fclose(f);
-  }
-}
-
 // Debugging: the worst quads, corner by corner.
 void print_worst(const LayoutMesh& m, const LayoutQuality& Q, int count) {
   const LayoutTopology t(m);
@@ -349,14 +336,12 @@ QuadLayout build_quad_layout(const Domain& d, const QuadLayoutOptions& o) {
       m.x[n] = rings[m.ring[n]].point(m.arc[n]);
     }
     LayoutMesh start = m;  // the mesher's nodes, on the true rings
-    dump(m, round, "before");
     const auto t_opt = std::chrono::steady_clock::now();
     optimize_layout(m, start, R, quality, admissible, level, out.stats);
     if (debugging())
       std::fprintf(stderr, "layout round %d: mesh %zu quads at %.2f s, optimized in %.2f s\n", round, m.quads.size(),
                    std::chrono::duration<double>(t_opt - t0).count(),
                    std::chrono::duration<double>(std::chrono::steady_clock::now() - t_opt).count());
-    dump(m, round, "after");
 
     // Checks on the true geometry: inner nodes inside, cuts off the rings. The
     // nodes involved in a violation go back where the mesher put them (with the
