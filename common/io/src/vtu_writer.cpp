@@ -223,6 +223,9 @@ void write_vtu(const std::string& path, const VtuMesh& mesh) {
     writer->SetDataModeToAppended();
     writer->EncodeAppendedDataOff();
     writer->SetCompressorTypeToZLib();
+    // zlib level 1: about three times faster than VTK's default 5 on our
+    // meshes (coordinates and quality fields) for files about 10 % larger.
+    writer->SetCompressionLevel(1);
     writer->SetHeaderTypeToUInt64();
     writer->SetIdTypeToInt64();
     // Write() returns 1 even when the file could not be opened or written:
