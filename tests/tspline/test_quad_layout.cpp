@@ -4,6 +4,7 @@
 #include <doctest/doctest.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <numbers>
 
@@ -122,6 +123,17 @@ TEST_SUITE("quad_layout") {
     const double c = std::cos(std::numbers::pi / 3), s = std::sin(std::numbers::pi / 3);
     CHECK(tspline::quad_corner_scaled_jacobian({V(0, 0), V(1, 0), V(1 + c, s), V(c, s)}) == doctest::Approx(s));
     CHECK(tspline::quad_corner_scaled_jacobian({V(0, 0), V(2, 0), V(0.5, 0.5), V(0, 2)}) < 0.0);
+  }
+
+  TEST_CASE("a layout whose cancel flag is set stops with LayoutCancelled and nothing else") {
+    if (!tspline::quad_mesher_available()) return;  // the no-mesher message is tested below
+    const tspline::Domain d = tspline::validate_domain({dumbbell(0.5), {}});
+    std::atomic<bool> cancel{true};
+    tspline::QuadLayoutOptions o;
+    o.cancel = &cancel;
+    CHECK_THROWS_AS((void)tspline::build_quad_layout(d, o), tspline::LayoutCancelled);
+    cancel = false;  // the same options, not cancelled: a layout
+    CHECK(tspline::build_quad_layout(d, o).layout.patches.size() >= 3);
   }
 
   TEST_CASE("layout of a domain with a narrow neck: patches of their own in the neck, near square") {

@@ -82,12 +82,18 @@ void report_optimization(const LayoutOptimizationReport& rep, QuadLayoutStats& s
 //     again while rotations are kept.
 // `start` becomes the mesh the checks fall back to (the mesher's nodes, after
 // any pillowing).
+void stop_if_cancelled(const std::atomic<bool>* cancel) {
+  if (cancel && cancel->load(std::memory_order_relaxed)) throw LayoutCancelled();
+}
+
 void optimize_layout(LayoutMesh& m, LayoutMesh& start, const LayoutRings& R, const LayoutQuality& Q,
-                     const LayoutAdmissible& admissible, int level, QuadLayoutStats& st) {
+                     const LayoutAdmissible& admissible, int level, QuadLayoutStats& st,
+                     const std::atomic<bool>* cancel) {
   st.rotations = 0;
   st.optimization_sweeps = 0;
   st.pillowed_rings = 0;
   auto rotate = [&]() {
+    stop_if_cancelled(cancel);
     LayoutRotationReport rr = rotate_layout_edges(m, Q, admissible);
     st.rotations += rr.kept;
     if (debugging()) std::fprintf(stderr, "layout rotations: %zu tried, %zu kept\n", rr.tried, rr.kept);
@@ -109,11 +115,13 @@ void optimize_layout(LayoutMesh& m, LayoutMesh& start, const LayoutRings& R, con
     if (level >= 1) smooth_layout_kstar(m, R);
   }
   if (level < 1) return;
+  stop_if_cancelled(cancel);
   report_optimization(optimize_layout_nodes(m, Q, admissible), st);
   for (int pass = 0; pass < 2 && level >= 2; ++pass) {
     // Around the rotations kept (the rest of the layout is as optimized as it gets).
     const LayoutRotationReport rr = rotate();
     if (rr.kept == 0) break;
+    stop_if_cancelled(cancel);
     report_optimization(optimize_layout_nodes(m, Q, admissible, rr.moved), st);
   }
   if (debugging()) print_worst(m, Q, 4);
@@ -187,6 +195,7 @@ QuadLayout build_quad_layout(const Domain& d, const QuadLayoutOptions& o) {
   int level = 2;
   int repairs = 0;  // rounds that added nodes (dropping an optimization level is not one)
   for (int round = 0;; ++round) {
+    stop_if_cancelled(o.cancel);
     if (repairs > o.max_repair_rounds)
       throw NumericalError("no quad layout found: the layout still crosses the boundary after " +
                            std::to_string(o.max_repair_rounds) + " rounds of adding nodes");
@@ -337,7 +346,7 @@ QuadLayout build_quad_layout(const Domain& d, const QuadLayoutOptions& o) {
     }
     LayoutMesh start = m;  // the mesher's nodes, on the true rings
     const auto t_opt = std::chrono::steady_clock::now();
-    optimize_layout(m, start, R, quality, admissible, level, out.stats);
+    optimize_layout(m, start, R, quality, admissible, level, out.stats, o.cancel);
     if (debugging())
       std::fprintf(stderr, "layout round %d: mesh %zu quads at %.2f s, optimized in %.2f s\n", round, m.quads.size(),
                    std::chrono::duration<double>(t_opt - t0).count(),

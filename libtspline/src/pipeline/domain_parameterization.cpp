@@ -1,6 +1,8 @@
 #include "tspline/pipeline/domain_parameterization.h"
 
 #include <algorithm>
+#include <atomic>
+#include <future>
 #include <limits>
 #include <sstream>
 
@@ -63,9 +65,24 @@ DomainParameterization parameterize_domain(const Domain& input, const Parameteri
     out.single.emplace(run_parameterization(domain.outer, options, adaptive, on_iteration));
     return out;
   }
+  // The layout of a domain without holes under auto, built while the single
+  // patch is tried (below): the layout is mostly serial work, the single patch's
+  // untangling is parallel; cancelled where one patch is kept.
+  struct LayoutAhead {
+    Domain valid;
+    QuadLayout layout;
+  };
+  std::future<LayoutAhead> ahead;
   auto run_quad = [&](const std::string& reason) {
-    const Domain valid = holes || c.layout == LayoutMode::Quad ? domain : validate_domain(input);
-    QuadLayout L = build_quad_layout(valid, c.quad);
+    LayoutAhead a;
+    if (ahead.valid()) {
+      a = ahead.get();
+    } else {
+      a.valid = holes || c.layout == LayoutMode::Quad ? domain : validate_domain(input);
+      a.layout = build_quad_layout(a.valid, c.quad);
+    }
+    const Domain& valid = a.valid;
+    QuadLayout& L = a.layout;
     report_step(options.progress, "layout", L.explanation());
     out.layout = "quad";
     out.reason = reason;
@@ -139,6 +156,31 @@ DomainParameterization parameterize_domain(const Domain& input, const Parameteri
                                                         on_patch));
     return out;
   }
+  std::atomic<bool> cancel{false};
+  // Declared after `ahead`, so destroyed before it: whatever way this function
+  // leaves, the layout still running is told to stop before it is waited for.
+  struct CancelOnExit {
+    std::atomic<bool>& flag;
+    ~CancelOnExit() { flag = true; }
+  } cancel_on_exit{cancel};
+  if (quad_mesher_available()) {
+    QuadLayoutOptions q = c.quad;
+    q.cancel = &cancel;
+    ahead = std::async(std::launch::async, [&input, q] {
+      LayoutAhead a;
+      a.valid = validate_domain(input);
+      a.layout = build_quad_layout(a.valid, q);
+      return a;
+    });
+  }
+  auto drop_layout = [&] {
+    if (!ahead.valid()) return;
+    cancel = true;
+    try {
+      ahead.get();
+    } catch (...) {  // cancelled, or failed: not wanted either way
+    }
+  };
   AdaptiveOptions first = adaptive;
   first.max_adapt = std::min(adaptive.max_adapt, c.first_try_rounds);
   ParameterizationResult single = run_parameterization(domain.outer, options, first, on_iteration);
@@ -150,6 +192,7 @@ DomainParameterization parameterize_domain(const Domain& input, const Parameteri
   // auto gives what layout single gives wherever it keeps one patch.
   const bool cut_short = first.max_adapt < adaptive.max_adapt &&
                          single.stop_reason.rfind("reached --max-adapt", 0) == 0;
+  if (good) drop_layout();
   if ((good || !quad_mesher_available()) && cut_short)
     single = run_parameterization(domain.outer, options, adaptive, on_iteration);
   if (good || !quad_mesher_available()) {

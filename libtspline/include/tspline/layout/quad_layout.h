@@ -21,7 +21,9 @@
 //     the quad corners the patch corners.
 #include <Eigen/Core>
 #include <array>
+#include <atomic>
 #include <cstddef>
+#include <exception>
 #include <string>
 #include <vector>
 
@@ -40,6 +42,15 @@ struct QuadLayoutOptions {
   double min_size_fraction = 2e-3;
   /// Rounds of "add nodes where the true geometry breaks the layout, mesh again".
   int max_repair_rounds = 40;
+  /// Set by another thread when the layout is no longer wanted (parameterize_domain
+  /// builds it while a single patch is tried): build_quad_layout then throws
+  /// LayoutCancelled at its next check (between optimization phases and rounds).
+  const std::atomic<bool>* cancel = nullptr;
+};
+
+/// Thrown by build_quad_layout when QuadLayoutOptions::cancel was set.
+struct LayoutCancelled : std::exception {
+  const char* what() const noexcept override { return "the quad layout was cancelled"; }
 };
 
 struct QuadLayoutStats {
