@@ -7,9 +7,11 @@
 #include <exception>
 #include <limits>
 #include <mutex>
+#include <numeric>
 #include <set>
 #include <thread>
 
+#include "tspline/detail/thread_pool.h"
 #include "tspline/multipatch/automatic_cuts.h"
 #include "tspline/spline/bezier_extraction.h"
 #include "tspline/boundary/border_knots.h"
@@ -116,6 +118,14 @@ InterfaceReport measure_interface(const MultiPatchResult& R, const Interface& f)
   return rep;
 }
 
+// Every interface of R measured (R.interfaces), on the pool's threads.
+void measure_interfaces(MultiPatchResult& R) {
+  R.interfaces.assign(R.layout.interfaces.size(), {});
+  detail::parallel_ranges(R.layout.interfaces.size(), detail::pool_threads(), [&](std::size_t begin, std::size_t end, int) {
+    for (std::size_t i = begin; i < end; ++i) R.interfaces[i] = measure_interface(R, R.layout.interfaces[i]);
+  }, 16);
+}
+
 // Once the boundary curves agree, the later adaptive rounds may still have
 // refined one side of an interface and not the other. Each patch is refined to
 // the union of the knots of its interfaces and its map carried over
@@ -124,7 +134,6 @@ InterfaceReport measure_interface(const MultiPatchResult& R, const Interface& f)
 // old one only if it is still certified (or the old one was not either).
 // Returns the number of patches refined (0: every interface has one set of knots).
 std::size_t equalize_interface_knots(MultiPatchResult& R, const AdaptiveOptions& ad, int max_level) {
-  std::size_t refined = 0;
   std::vector<BorderParams> want(R.patches.size());
   for (const Interface& f : R.layout.interfaces) {
     const std::set<double> u = interface_knots(R, f);
@@ -133,26 +142,30 @@ std::size_t equalize_interface_knots(MultiPatchResult& R, const AdaptiveOptions&
       want[f.patch_b][f.side_b].push_back(reversed_param(t));
     }
   }
-  for (std::size_t p = 0; p < R.patches.size(); ++p) {
-    ParameterizationResult& r = R.patches[p];
-    TMesh mesh = r.map->mesh();
-    if (refine_to_border_params(mesh, want[p], max_level) == 0) continue;
-    TSplineMap map = transfer_map(*r.map, std::move(mesh));
-    MapCertification cert = ad.certify ? certify_map(map, ad.certification) : MapCertification{};
-    if (ad.certify && r.certified_valid() && !cert.certified_valid()) continue;
-    ++refined;
-    std::vector<CellMapQuality> cells;
-    r.quality = map_quality(map, ad.gauss, &cells);
-    r.cell_quality = std::move(cells);
-    r.dense_quality = dense_map_quality(map, ad.dense_samples);
-    r.certification = std::move(cert);
-    r.front.mesh = map.mesh();
-    r.front.optimized.assign(r.front.mesh.num_vertices(), Eigen::Vector2d::Zero());
-    for (int v = 0; v < static_cast<int>(r.front.mesh.num_vertices()); ++v)
-      r.front.optimized[v] = map.point(r.front.mesh.vertex_param(v));
-    r.map.emplace(std::move(map));
-  }
-  return refined;
+  // Each patch on its own (want is read only): on the pool's threads.
+  std::atomic<std::size_t> count{0};
+  detail::parallel_ranges(R.patches.size(), detail::pool_threads(), [&](std::size_t begin, std::size_t end, int) {
+    for (std::size_t p = begin; p < end; ++p) {
+      ParameterizationResult& r = R.patches[p];
+      TMesh mesh = r.map->mesh();
+      if (refine_to_border_params(mesh, want[p], max_level) == 0) continue;
+      TSplineMap map = transfer_map(*r.map, std::move(mesh));
+      MapCertification cert = ad.certify ? certify_map(map, ad.certification) : MapCertification{};
+      if (ad.certify && r.certified_valid() && !cert.certified_valid()) continue;
+      ++count;
+      std::vector<CellMapQuality> cells;
+      r.quality = map_quality(map, ad.gauss, &cells);
+      r.cell_quality = std::move(cells);
+      r.dense_quality = dense_map_quality(map, ad.dense_samples);
+      r.certification = std::move(cert);
+      r.front.mesh = map.mesh();
+      r.front.optimized.assign(r.front.mesh.num_vertices(), Eigen::Vector2d::Zero());
+      for (int v = 0; v < static_cast<int>(r.front.mesh.num_vertices()); ++v)
+        r.front.optimized[v] = map.point(r.front.mesh.vertex_param(v));
+      r.map.emplace(std::move(map));
+    }
+  }, 2);
+  return count;
 }
 
 }  // namespace
@@ -259,11 +272,11 @@ MultiPatchResult run_multipatch_parameterization(const Domain& domain, PatchLayo
       stale[p] = 0;
     }
     // Interfaces: gaps and knots.
-    R.interfaces.assign(R.layout.interfaces.size(), {});
+    measure_interfaces(R);
     bool all_conform = true;
     for (std::size_t i = 0; i < R.layout.interfaces.size(); ++i) {
       const Interface& f = R.layout.interfaces[i];
-      const InterfaceReport& rep = R.interfaces[i] = measure_interface(R, f);
+      const InterfaceReport& rep = R.interfaces[i];
       if (rep.max_gap <= multi.gap_tolerance * R.diameter) continue;
       all_conform = false;
       if (round >= multi.max_sync_rounds) continue;
@@ -287,10 +300,13 @@ MultiPatchResult run_multipatch_parameterization(const Domain& domain, PatchLayo
   // T-mesh stays balanced): repeat until every interface has one set of knots.
   for (int round = 0; round < 16 && equalize_interface_knots(R, adaptive, options.max_level) > 0; ++round) {
   }
-  for (std::size_t i = 0; i < R.layout.interfaces.size(); ++i)
-    R.interfaces[i] = measure_interface(R, R.layout.interfaces[i]);
-  R.map_area = 0.0;
-  for (const auto& r : R.patches) R.map_area += map_area(*r.map);
+  measure_interfaces(R);
+  // The patches' areas on the pool's threads, summed in patch order.
+  std::vector<double> areas(P);
+  detail::parallel_ranges(P, detail::pool_threads(), [&](std::size_t begin, std::size_t end, int) {
+    for (std::size_t p = begin; p < end; ++p) areas[p] = map_area(*R.patches[p].map);
+  }, 2);
+  R.map_area = std::accumulate(areas.begin(), areas.end(), 0.0);
   return R;
 }
 
