@@ -191,6 +191,51 @@ TEST_SUITE("layout_quality") {
     CHECK(m.x[8].x() < 0.76);
   }
 
+  TEST_CASE("edge rotations tried in batches on threads give the layout that one-by-one tries give") {
+    // A 20 x 20 grid of the square with its inner nodes sheared in rows: many
+    // poor quads all over, so that batches hold many tries.
+    const int n = 20;
+    const tspline::LayoutRings ring = one_ring({V(0, 0), V(1, 0), V(1, 1), V(0, 1)});
+    std::vector<V> on_ring, inner;
+    std::vector<int> id((n + 1) * (n + 1), -1);
+    for (int j = 0; j <= n; ++j)
+      for (int i = 0; i <= n; ++i)
+        if (i == 0 || j == 0 || i == n || j == n) id[i + (n + 1) * j] = 1;
+    // Ring nodes counter-clockwise from (0, 0), then inner nodes row by row.
+    std::vector<std::array<int, 2>> walk;
+    for (int i = 0; i < n; ++i) walk.push_back({i, 0});
+    for (int j = 0; j < n; ++j) walk.push_back({n, j});
+    for (int i = n; i > 0; --i) walk.push_back({i, n});
+    for (int j = n; j > 0; --j) walk.push_back({0, j});
+    for (const auto& [i, j] : walk) id[i + (n + 1) * j] = static_cast<int>(on_ring.size()), on_ring.push_back(V(i, j) / n);
+    for (int j = 1; j < n; ++j)
+      for (int i = 1; i < n; ++i) {
+        id[i + (n + 1) * j] = static_cast<int>(4 * n + inner.size());
+        const double shear = (j % 3 == 1 ? 0.45 : -0.2) * std::sin(0.7 * i * j);
+        inner.push_back(V(i + shear, j + 0.3 * shear) / n);
+      }
+    std::vector<std::array<int, 4>> quads;
+    for (int j = 0; j < n; ++j)
+      for (int i = 0; i < n; ++i)
+        quads.push_back({id[i + (n + 1) * j], id[i + 1 + (n + 1) * j], id[i + 1 + (n + 1) * (j + 1)],
+                         id[i + (n + 1) * (j + 1)]});
+    const tspline::LayoutQuality Q(ring);
+    const tspline::LayoutMesh start = ring_mesh(ring.curves[0], on_ring, inner, quads);
+    tspline::LayoutRotationOptions one_by_one, batched;
+    one_by_one.max_batch = 1;
+    one_by_one.target = batched.target = 0.8;
+    tspline::LayoutMesh a = start, b = start;
+    const tspline::LayoutRotationReport ra = tspline::rotate_layout_edges(a, Q, anywhere, one_by_one);
+    const tspline::LayoutRotationReport rb = tspline::rotate_layout_edges(b, Q, anywhere, batched);
+    CHECK(ra.tried > 20);
+    CHECK(ra.kept > 0);
+    CHECK(rb.tried == ra.tried);
+    CHECK(rb.kept == ra.kept);
+    CHECK(a.quads == b.quads);
+    CHECK(a.x == b.x);
+    CHECK(a.arc == b.arc);
+  }
+
   TEST_CASE("edge rotation: a long hexagon split by its long diagonal is split by a short one instead") {
     // h0 .. h5 counter-clockwise; two quads share h0-h3 (length 6): corners of 26.6
     // degrees between sides of ratio 6 / sqrt 5 at h0 and h3.

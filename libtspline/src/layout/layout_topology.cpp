@@ -6,6 +6,7 @@
 #include <utility>
 #include <vector>
 
+#include "tspline/detail/thread_pool.h"
 #include "tspline/layout/layout_optimizer.h"
 
 namespace tspline {
@@ -169,11 +170,94 @@ std::size_t pillow_rings(LayoutMesh& m, const std::vector<char>& pillow) {
   return count;
 }
 
+namespace {
+
+// The best rotation around quad q (the mesh itself is not changed): the new
+// corners of q and of the quad across the rotated edge, and where the nodes
+// around them end after their optimization.
+struct RotationTry {
+  std::size_t tried = 0;
+  int other = -1;  ///< the quad across the edge rotated, -1 if no rotation is better
+  std::array<int, 4> quad_q{}, quad_other{};
+  std::vector<int> free;  ///< the nodes optimized around the rotation
+  std::vector<Eigen::Vector2d> x;
+  std::vector<double> arc;
+};
+
+RotationTry try_rotations(const LayoutMesh& m, const LayoutTopology& t, const LayoutQuality& Q,
+                          const LayoutAdmissible& admissible, const std::vector<char>& touched, int q,
+                          const LayoutOptimizationOptions& lo) {
+  RotationTry out;
+  double best = -1e300, before = 0.0;
+  for (int j = 0; j < 4; ++j) {
+    if (t.on_ring(q, j)) continue;
+    const auto [b, k] = t.across(q, j);
+    if (b < 0 || touched[b]) continue;
+    // Only between quads that run along their shared edge in opposite directions.
+    if (m.quads[b][k] != m.quads[q][(j + 1) % 4]) continue;
+    // The hexagon, counter-clockwise, the shared edge h0-h3.
+    const std::array<int, 4>& A = m.quads[q];
+    const std::array<int, 4>& B = m.quads[b];
+    const std::array<int, 6> h = {A[j], B[(k + 2) % 4], B[(k + 3) % 4], A[(j + 1) % 4], A[(j + 2) % 4],
+                                  A[(j + 3) % 4]};
+    {
+      std::array<int, 6> sorted = h;
+      std::sort(sorted.begin(), sorted.end());
+      if (std::adjacent_find(sorted.begin(), sorted.end()) != sorted.end()) continue;
+    }
+    const std::vector<int> hex(h.begin(), h.end());
+    const std::vector<int> free = one_ring(m, t, hex);
+    if (best == -1e300) before = region_figure(m, t, Q, free);
+    for (const int r : {1, 2}) {
+      // Diagonal h_r - h_{r+3}; the shared edge's ends lose one quad each.
+      const int d0 = h[r], d1 = h[r + 3];
+      bool ok = !has_edge(m, t, d0, d1);
+      for (const int e : {h[0], h[3]})
+        if (m.ring[e] < 0 && t.valence(e) <= 3) ok = false;
+      if (!ok) continue;
+      LayoutMesh c = m;
+      c.quads[q] = {h[r], h[r + 1], h[r + 2], h[r + 3]};
+      c.quads[b] = {h[(r + 3) % 6], h[(r + 4) % 6], h[(r + 5) % 6], h[r]};
+      optimize_layout_nodes(c, Q, admissible, free, lo);
+      ++out.tried;
+      const LayoutTopology ct(c);
+      bool valid = true;
+      for (const int n : free) valid = valid && admissible(c, ct, n);
+      if (!valid) continue;
+      const double after = region_figure(c, ct, Q, free);
+      if (after > best) {
+        best = after;
+        out.other = b;
+        out.quad_q = c.quads[q], out.quad_other = c.quads[b];
+        out.free = free;
+        out.x.clear(), out.arc.clear();
+        for (const int n : free) out.x.push_back(c.x[n]), out.arc.push_back(c.arc[n]);
+      }
+    }
+  }
+  if (!(out.other >= 0 && best > before + 1e-3)) out.other = -1;
+  return out;
+}
+
+// The nodes a rotation try around quad q reads: the quads around the nodes it
+// may move (the one-ring of q and of its neighbours) and their nodes.
+std::vector<int> try_reach(const LayoutMesh& m, const LayoutTopology& t, int q) {
+  std::vector<int> hex(m.quads[q].begin(), m.quads[q].end());
+  for (int j = 0; j < 4; ++j) {
+    const int b = t.across(q, j).first;
+    if (b >= 0) hex.insert(hex.end(), m.quads[b].begin(), m.quads[b].end());
+  }
+  return one_ring(m, t, one_ring(m, t, hex));
+}
+
+}  // namespace
+
 LayoutRotationReport rotate_layout_edges(LayoutMesh& m, const LayoutQuality& Q, const LayoutAdmissible& admissible,
                                          const LayoutRotationOptions& o) {
   LayoutRotationReport report;
   LayoutOptimizationOptions lo;
   lo.max_sweeps = o.local_sweeps;
+  std::vector<char> reached(m.size(), 0);
   for (int round = 0; round < o.rounds; ++round) {
     LayoutTopology t(m);
     std::vector<std::pair<double, int>> bad;
@@ -186,59 +270,39 @@ LayoutRotationReport rotate_layout_edges(LayoutMesh& m, const LayoutQuality& Q, 
     if (bad.size() > o.max_quads) bad.resize(o.max_quads);
     std::vector<char> touched(m.quads.size(), 0);
     std::size_t kept = 0;
-    for (const auto& [f0, q] : bad) {
-      if (touched[q]) continue;
-      double best = -1e300;
-      LayoutMesh best_mesh;
-      int best_other = -1;
-      std::vector<int> best_free;
-      double before = 0.0;
-      for (int j = 0; j < 4; ++j) {
-        if (t.on_ring(q, j)) continue;
-        const auto [b, k] = t.across(q, j);
-        if (b < 0 || touched[b]) continue;
-        // Only between quads that run along their shared edge in opposite directions.
-        if (m.quads[b][k] != m.quads[q][(j + 1) % 4]) continue;
-        // The hexagon, counter-clockwise, the shared edge h0-h3.
-        const std::array<int, 4>& A = m.quads[q];
-        const std::array<int, 4>& B = m.quads[b];
-        const std::array<int, 6> h = {A[j], B[(k + 2) % 4], B[(k + 3) % 4], A[(j + 1) % 4], A[(j + 2) % 4],
-                                      A[(j + 3) % 4]};
-        {
-          std::array<int, 6> sorted = h;
-          std::sort(sorted.begin(), sorted.end());
-          if (std::adjacent_find(sorted.begin(), sorted.end()) != sorted.end()) continue;
-        }
-        const std::vector<int> hex(h.begin(), h.end());
-        const std::vector<int> free = one_ring(m, t, hex);
-        if (best == -1e300) before = region_figure(m, t, Q, free);
-        for (const int r : {1, 2}) {
-          // Diagonal h_r - h_{r+3}; the shared edge's ends lose one quad each.
-          const int d0 = h[r], d1 = h[r + 3];
-          bool ok = !has_edge(m, t, d0, d1);
-          for (const int e : {h[0], h[3]})
-            if (m.ring[e] < 0 && t.valence(e) <= 3) ok = false;
-          if (!ok) continue;
-          LayoutMesh c = m;
-          c.quads[q] = {h[r], h[r + 1], h[r + 2], h[r + 3]};
-          c.quads[b] = {h[(r + 3) % 6], h[(r + 4) % 6], h[(r + 5) % 6], h[r]};
-          optimize_layout_nodes(c, Q, admissible, free, lo);
-          ++report.tried;
-          const LayoutTopology ct(c);
-          bool valid = true;
-          for (const int n : free) valid = valid && admissible(c, ct, n);
-          if (!valid) continue;
-          const double after = region_figure(c, ct, Q, free);
-          if (after > best) best = after, best_mesh = std::move(c), best_other = b, best_free = free;
-        }
+    // The quads in order, in batches whose tries read disjoint sets of nodes:
+    // each batch's tries run on the pool's threads, on copies of the layout,
+    // and are kept in order; the result is that of trying them one by one.
+    for (std::size_t i = 0; i < bad.size();) {
+      std::vector<int> batch;
+      std::vector<int> marked;
+      for (; i < bad.size() && batch.size() < std::max<std::size_t>(1, o.max_batch); ++i) {
+        const int q = bad[i].second;
+        if (touched[q]) continue;
+        const std::vector<int> reach = try_reach(m, t, q);
+        if (std::any_of(reach.begin(), reach.end(), [&](int n) { return reached[n] != 0; })) break;
+        for (const int n : reach) reached[n] = 1, marked.push_back(n);
+        batch.push_back(q);
       }
-      if (best_other >= 0 && best > before + 1e-3) {
-        m = std::move(best_mesh);
-        touched[q] = touched[best_other] = 1;
-        report.moved.insert(report.moved.end(), best_free.begin(), best_free.end());
-        t = LayoutTopology(m);
+      for (const int n : marked) reached[n] = 0;
+      std::vector<RotationTry> tries(batch.size());
+      detail::parallel_ranges(batch.size(), detail::pool_threads(), [&](std::size_t begin, std::size_t end, int) {
+        for (std::size_t k = begin; k < end; ++k) tries[k] = try_rotations(m, t, Q, admissible, touched, batch[k], lo);
+      }, 2);
+      bool changed = false;
+      for (std::size_t k = 0; k < batch.size(); ++k) {
+        const RotationTry& r = tries[k];
+        report.tried += r.tried;
+        if (r.other < 0) continue;
+        const int q = batch[k];
+        m.quads[q] = r.quad_q, m.quads[r.other] = r.quad_other;
+        for (std::size_t f = 0; f < r.free.size(); ++f) m.x[r.free[f]] = r.x[f], m.arc[r.free[f]] = r.arc[f];
+        touched[q] = touched[r.other] = 1;
+        report.moved.insert(report.moved.end(), r.free.begin(), r.free.end());
         ++kept;
+        changed = true;
       }
+      if (changed) t = LayoutTopology(m);
     }
     report.kept += kept;
     if (kept == 0) break;

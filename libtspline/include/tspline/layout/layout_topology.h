@@ -28,6 +28,11 @@ struct LayoutRotationOptions {
   /// Per round, rotations are tried around this many of the worst quads at most.
   std::size_t max_quads = 300;
   int local_sweeps = 6;  ///< optimizer sweeps over the nodes of a tried rotation and their neighbours
+  /// Rotations around quads whose tries read disjoint nodes are tried together
+  /// on the pool's threads, at most this many at once (1: one by one). The
+  /// result does not depend on it: a batch is cut at the first quad whose try
+  /// would read a node another try of the batch may move.
+  std::size_t max_batch = 64;
 };
 
 struct LayoutRotationReport {
