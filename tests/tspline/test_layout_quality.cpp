@@ -6,6 +6,7 @@
 #include <doctest/doctest.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <numbers>
 
@@ -176,6 +177,24 @@ TEST_SUITE("layout_quality") {
     const tspline::LayoutOptimizationReport r = tspline::optimize_layout_nodes(m, Q, anywhere);
     CHECK(r.before.scaled_jacobian < 0.0);
     CHECK(r.after.scaled_jacobian > 0.99);
+  }
+
+  TEST_CASE("node optimization and edge rotations stop with LayoutCancelled once the cancel flag is set") {
+    const tspline::LayoutRings ring = one_ring({V(0, 0), V(1, 0), V(1, 1), V(0, 1)});
+    const tspline::LayoutQuality Q(ring);
+    tspline::LayoutMesh m = square_2x2(ring.curves[0], V(0.8, 0.7), 0.5);
+    const tspline::LayoutMesh before = m;
+    std::atomic<bool> cancel{true};
+    tspline::LayoutOptimizationOptions o;
+    o.cancel = &cancel;
+    CHECK_THROWS_AS(tspline::optimize_layout_nodes(m, Q, anywhere, {}, o), tspline::LayoutCancelled);
+    CHECK(m.x == before.x);  // stopped before its first sweep
+    tspline::LayoutRotationOptions r;
+    r.cancel = &cancel;
+    r.target = 2.0;  // every quad is "poor": a batch is due
+    CHECK_THROWS_AS(tspline::rotate_layout_edges(m, Q, anywhere, r), tspline::LayoutCancelled);
+    cancel = false;
+    CHECK(tspline::optimize_layout_nodes(m, Q, anywhere, {}, o).after.scaled_jacobian > 0.99);
   }
 
   TEST_CASE("node optimization keeps nodes where the caller's check refuses the move") {

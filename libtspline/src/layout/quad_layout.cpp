@@ -92,16 +92,20 @@ void optimize_layout(LayoutMesh& m, LayoutMesh& start, const LayoutRings& R, con
   st.rotations = 0;
   st.optimization_sweeps = 0;
   st.pillowed_rings = 0;
+  // Every sweep and rotation batch checks the cancel flag.
+  LayoutOptimizationOptions full;
+  full.cancel = cancel;
+  LayoutRotationOptions rotation;
+  rotation.cancel = cancel;
   auto rotate = [&]() {
-    stop_if_cancelled(cancel);
-    LayoutRotationReport rr = rotate_layout_edges(m, Q, admissible);
+    LayoutRotationReport rr = rotate_layout_edges(m, Q, admissible, rotation);
     st.rotations += rr.kept;
     if (debugging()) std::fprintf(stderr, "layout rotations: %zu tried, %zu kept\n", rr.tried, rr.kept);
     return rr;
   };
   if (level >= 1) {
     smooth_layout_kstar(m, R);
-    LayoutOptimizationOptions quick;
+    LayoutOptimizationOptions quick = full;
     quick.max_sweeps = 8;
     report_optimization(optimize_layout_nodes(m, Q, admissible, {}, quick), st);
     if (level >= 2) rotate();
@@ -115,14 +119,12 @@ void optimize_layout(LayoutMesh& m, LayoutMesh& start, const LayoutRings& R, con
     if (level >= 1) smooth_layout_kstar(m, R);
   }
   if (level < 1) return;
-  stop_if_cancelled(cancel);
-  report_optimization(optimize_layout_nodes(m, Q, admissible), st);
+  report_optimization(optimize_layout_nodes(m, Q, admissible, {}, full), st);
   for (int pass = 0; pass < 2 && level >= 2; ++pass) {
     // Around the rotations kept (the rest of the layout is as optimized as it gets).
     const LayoutRotationReport rr = rotate();
     if (rr.kept == 0) break;
-    stop_if_cancelled(cancel);
-    report_optimization(optimize_layout_nodes(m, Q, admissible, rr.moved), st);
+    report_optimization(optimize_layout_nodes(m, Q, admissible, rr.moved, full), st);
   }
   if (debugging()) print_worst(m, Q, 4);
 }

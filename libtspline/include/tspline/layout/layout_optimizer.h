@@ -17,6 +17,8 @@
 // kept only if `admissible` accepts it (the caller's check of the true
 // geometry: inner nodes inside the domain, no cut crossing a ring), unless the
 // node was not admissible where it stood (then any move that lowers the energy).
+#include <atomic>
+#include <exception>
 #include <functional>
 #include <vector>
 
@@ -34,6 +36,13 @@ struct LayoutOptimizationOptions {
   int stall_sweeps = 8;
   int ring_samples = 24;  ///< uniform samples of a ring node's reach (plus its vertices, at most max_ring_vertices)
   int max_ring_vertices = 160;
+  /// Checked before every sweep: once set (by another thread), LayoutCancelled is thrown.
+  const std::atomic<bool>* cancel = nullptr;
+};
+
+/// Thrown where a layout's cancel flag was set (QuadLayoutOptions::cancel).
+struct LayoutCancelled : std::exception {
+  const char* what() const noexcept override { return "the quad layout was cancelled"; }
 };
 
 struct LayoutOptimizationReport {

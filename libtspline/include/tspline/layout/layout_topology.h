@@ -11,6 +11,7 @@
 // kept where, after the nodes around it are optimized again
 // (layout_optimizer.h), the worst quad around it is better than before; inner
 // nodes keep valence >= 3, and no edge is doubled.
+#include <atomic>
 #include <cstddef>
 #include <functional>
 #include <vector>
@@ -33,6 +34,7 @@ struct LayoutRotationOptions {
   /// result does not depend on it: a batch is cut at the first quad whose try
   /// would read a node another try of the batch may move.
   std::size_t max_batch = 64;
+  const std::atomic<bool>* cancel = nullptr;  ///< as LayoutOptimizationOptions::cancel, checked per batch
 };
 
 struct LayoutRotationReport {

@@ -23,11 +23,11 @@
 #include <array>
 #include <atomic>
 #include <cstddef>
-#include <exception>
 #include <string>
 #include <vector>
 
 #include "tspline/boundary/domain.h"
+#include "tspline/layout/layout_optimizer.h"
 #include "tspline/layout/ring_nodes.h"
 #include "tspline/layout/size_field.h"
 #include "tspline/multipatch/patch_layout.h"
@@ -44,14 +44,11 @@ struct QuadLayoutOptions {
   int max_repair_rounds = 40;
   /// Set by another thread when the layout is no longer wanted (parameterize_domain
   /// builds it while a single patch is tried): build_quad_layout then throws
-  /// LayoutCancelled at its next check (between optimization phases and rounds).
+  /// LayoutCancelled (layout_optimizer.h) at its next check (every optimization
+  /// sweep, rotation batch and repair round).
   const std::atomic<bool>* cancel = nullptr;
 };
 
-/// Thrown by build_quad_layout when QuadLayoutOptions::cancel was set.
-struct LayoutCancelled : std::exception {
-  const char* what() const noexcept override { return "the quad layout was cancelled"; }
-};
 
 struct QuadLayoutStats {
   std::size_t patches = 0;
