@@ -306,28 +306,3 @@ TEST_SUITE("map_quality_bounds") {
     CHECK(two.scaled.sampled == q.scaled.sampled);
   }
 }
-
-// Timing, not run by default (./unit_tests -ts=map_quality_bounds_timing --no-skip):
-// a smooth warp of the unit square on a 256 x 256 mesh (65,536 elements).
-TEST_SUITE("map_quality_bounds_timing" * doctest::skip()) {
-  TEST_CASE("seconds per 10^4 elements") {
-    const double pi = 3.14159265358979323846;
-    const TSplineMap map = greville_map(8, [&](const Eigen::Vector2d& p) -> Eigen::Vector2d {
-      const double u = p.x(), v = p.y();
-      return {u + 0.12 * std::sin(2 * pi * v) * u * (1 - u) + 0.3 * u * u, v + 0.1 * std::sin(3 * pi * u) * v * (1 - v)};
-    });
-    const tspline::BezierExtraction ex(map.basis());
-    for (int threads : {1, 2})
-      for (int k : {0, 25}) {
-        QualityBoundOptions opt;
-        opt.threads = threads;
-        opt.samples_per_edge = k;
-        const MapQualityBounds q = tspline::certified_map_quality(ex, map.control_points(), opt);
-        MESSAGE(q.elements << " elements, " << threads << " thread(s), samples " << k << ": " << q.seconds << " s = "
-                           << q.seconds * 1e4 / q.elements << " s per 10^4 elements; " << q.patches << " patches, depth "
-                           << q.max_depth_used << "; J_r bound " << q.mean_ratio.lower_bound << " sampled "
-                           << q.mean_ratio.sampled << ", SJ bound " << q.scaled.lower_bound << " sampled "
-                           << q.scaled.sampled);
-      }
-  }
-}
