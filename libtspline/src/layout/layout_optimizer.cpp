@@ -5,8 +5,6 @@
 #include <limits>
 #include <numbers>
 
-#include "tspline/detail/thread_pool.h"
-
 namespace tspline {
 namespace {
 
@@ -121,24 +119,6 @@ void slide_ring_node(LayoutMesh& m, const LayoutTopology& t, const LayoutQuality
   else place(best_u);
 }
 
-// The nodes in classes of which no two share a quad (greedy, in the given order).
-std::vector<std::vector<int>> colour_classes(const LayoutMesh& m, const LayoutTopology& t, const std::vector<int>& nodes) {
-  std::vector<int> colour(m.size(), -1);
-  std::vector<std::vector<int>> classes;
-  std::vector<char> taken;
-  for (const int n : nodes) {
-    taken.assign(classes.size() + 1, 0);
-    for (const auto& [q, j] : t.corners_of(n))
-      for (const int v : m.quads[q])
-        if (v != n && colour[v] >= 0) taken[colour[v]] = 1;
-    const int c = static_cast<int>(std::find(taken.begin(), taken.end(), 0) - taken.begin());
-    if (c == static_cast<int>(classes.size())) classes.emplace_back();
-    classes[c].push_back(n);
-    colour[n] = c;
-  }
-  return classes;
-}
-
 }  // namespace
 
 LayoutCornerQuality worst_layout_quality(const LayoutMesh& m, const LayoutTopology& t, const LayoutQuality& q) {
@@ -247,12 +227,12 @@ LayoutOptimizationReport optimize_layout_nodes(LayoutMesh& m, const LayoutQualit
     if (!tangled && ++quality_sweeps == 3) refresh_moving();
     if (!tangled && quality_sweeps > 3 && quality_sweeps % 5 == 0) refresh_moving();
     double gain = 0.0;
-    auto move_node = [&](int n, std::size_t& moves, double& node_gain) {
+    for (const int n : (tangled || quality_sweeps < 3 ? active : moving)) {
       const std::size_t nn = static_cast<std::size_t>(n);
-      if (t.valence(n) == 0) return;
+      if (t.valence(n) == 0) continue;
       // While the layout is tangled the rings stay where they are: sliding a
       // ring node across a fold only drags the fold along the coast.
-      if (tangled && m.ring[n] >= 0) return;
+      if (tangled && m.ring[n] >= 0) continue;
       const double f0 = local(n);
       double best = f0;
       if (m.ring[n] < 0) {
@@ -275,25 +255,8 @@ LayoutOptimizationReport optimize_layout_nodes(LayoutMesh& m, const LayoutQualit
         slide_ring_node(m, t, Q, n, local, admissible, o, best);
       }
       if (best < f0) {
-        ++moves;
-        node_gain = std::max(node_gain, (f0 - best) / f0);
-      }
-    };
-    const std::vector<int>& nodes = tangled || quality_sweeps < 3 ? active : moving;
-    if (nodes.size() < o.coloured_sweep_nodes) {
-      for (const int n : nodes) move_node(n, report.moves, gain);
-    } else {
-      // Nodes that share no quad move at once: each node's energy and checks
-      // read only the quads around it. Colour by colour, each colour's nodes on
-      // the pool's threads; the result does not depend on the number of threads.
-      const int slots = detail::pool_threads();
-      for (const std::vector<int>& colour : colour_classes(m, t, nodes)) {
-        std::vector<std::size_t> moves(slots, 0);
-        std::vector<double> gains(slots, 0.0);
-        detail::parallel_ranges(colour.size(), slots, [&](std::size_t begin, std::size_t end, int slot) {
-          for (std::size_t k = begin; k < end; ++k) move_node(colour[k], moves[slot], gains[slot]);
-        }, 64);
-        for (int k = 0; k < slots; ++k) report.moves += moves[k], gain = std::max(gain, gains[k]);
+        ++report.moves;
+        gain = std::max(gain, (f0 - best) / f0);
       }
     }
     report.sweeps = sweep + 1;

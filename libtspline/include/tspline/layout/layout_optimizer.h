@@ -36,12 +36,6 @@ struct LayoutOptimizationOptions {
   int stall_sweeps = 8;
   int ring_samples = 24;  ///< uniform samples of a ring node's reach (plus its vertices, at most max_ring_vertices)
   int max_ring_vertices = 160;
-  /// A sweep over at least this many nodes moves them colour by colour (no two
-  /// nodes of a colour share a quad, so each one's energy and checks are
-  /// independent of the others'), each colour on the pool's threads; smaller
-  /// sweeps go node by node in order. The result does not depend on the number
-  /// of threads, but the order differs from node by node.
-  std::size_t coloured_sweep_nodes = 256;
   /// Checked before every sweep: once set (by another thread), LayoutCancelled is thrown.
   const std::atomic<bool>* cancel = nullptr;
 };
