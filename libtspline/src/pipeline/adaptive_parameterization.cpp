@@ -9,6 +9,7 @@
 #include <utility>
 
 #include "tspline/errors.h"
+#include "tspline/spline/bezier_extraction.h"
 #include "tspline/validity/boundary_curve.h"
 #include "tspline/tmesh/mesh_quality.h"
 
@@ -196,9 +197,14 @@ class AdaptiveRun {
                                       std::vector<CellMapQuality>& cells) {
     std::optional<TSplineMap> interpolant;
     MapCertification interpolant_cert;
+    // One Bezier extraction for every check below: the untangling moves the
+    // control points only, so the map, its interpolant and the map kept share
+    // the T-mesh and the basis.
+    const BezierExtraction extraction(map.basis());
+    const std::size_t num_cells = map.mesh().num_cells();
     if (ad_.optimize_control_points && ad_.certify) {
       const auto t1 = std::chrono::steady_clock::now();
-      interpolant_cert = certify_map(map, ad_.certification);
+      interpolant_cert = certify_map(extraction, num_cells, map.control_points(), ad_.certification);
       if (interpolant_cert.certified_valid()) interpolant = map;
       t_certify_ += seconds_since(t1);
     }
@@ -222,14 +228,14 @@ class AdaptiveRun {
       t_untangle_ += seconds_since(t1);
     } else if (ad_.certify) {
       const auto t1 = std::chrono::steady_clock::now();
-      cert = certify_map(map, ad_.certification);
+      cert = certify_map(extraction, num_cells, map.control_points(), ad_.certification);
       t_certify_ += seconds_since(t1);
     }
     const auto t2 = std::chrono::steady_clock::now();
-    MapQualityStats quality = map_quality(map, ad_.gauss, &cells);
+    MapQualityStats quality = map_quality(map, extraction, ad_.gauss, &cells);
     if (interpolant) {
       std::vector<CellMapQuality> icells;
-      const MapQualityStats iq = map_quality(*interpolant, ad_.gauss, &icells);
+      const MapQualityStats iq = map_quality(*interpolant, extraction, ad_.gauss, &icells);
       if (!cert.certified_valid() || iq.min_mean_ratio > quality.min_mean_ratio) {
         log("map", "kept the interpolating map: certified, and its min J_r at Gauss points " +
                        std::to_string(iq.min_mean_ratio) + " is higher than the untangled map's " +
@@ -241,7 +247,7 @@ class AdaptiveRun {
         rec.control_points_optimized = false;
       }
     }
-    rec.dense_quality = whole_map_quality(map, cells);
+    rec.dense_quality = whole_map_quality(map, cells, &extraction);
     t_check_ += seconds_since(t2);
     {
       std::ostringstream s;
@@ -272,8 +278,10 @@ class AdaptiveRun {
 
   // The whole-map minimum is over every point looked at: the dense sample, and
   // where a Gauss point is worse, that (at its cell's centre).
-  DenseMapQuality whole_map_quality(const TSplineMap& map, const std::vector<CellMapQuality>& cells) const {
-    DenseMapQuality q = dense_map_quality(map, ad_.dense_samples);
+  DenseMapQuality whole_map_quality(const TSplineMap& map, const std::vector<CellMapQuality>& cells,
+                                    const BezierExtraction* extraction = nullptr) const {
+    DenseMapQuality q = extraction ? dense_map_quality(*extraction, map.control_points(), ad_.dense_samples)
+                                   : dense_map_quality(map, ad_.dense_samples);
     for (int c = 0; c < static_cast<int>(cells.size()); ++c) {
       if (cells[c].min_mean_ratio < q.min_mean_ratio) {
         q.min_mean_ratio = cells[c].min_mean_ratio;

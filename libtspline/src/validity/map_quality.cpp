@@ -61,13 +61,17 @@ void element_coefficients(const BezierElement& e, const std::vector<Eigen::Vecto
 }  // namespace
 
 MapQualityStats map_quality(const TSplineMap& map, int gauss, std::vector<CellMapQuality>* per_cell) {
+  return map_quality(map, BezierExtraction(map.basis()), gauss, per_cell);
+}
+
+MapQualityStats map_quality(const TSplineMap& map, const BezierExtraction& extraction, int gauss,
+                            std::vector<CellMapQuality>* per_cell) {
   std::vector<double> gp, gw;
   detail::gauss_points_01(gauss, gp, gw);
   const TMesh& mesh = map.mesh();
   const int nc = static_cast<int>(mesh.num_cells());
   // Each Gauss point of a cell on the Bezier element of the cell that holds it
   // (the elements tile the cell), evaluated from the element's coefficients.
-  const BezierExtraction extraction(map.basis());
   const std::vector<BezierElement>& es = extraction.elements();
   const std::vector<Eigen::Vector2d>& P = map.control_points();
   std::vector<CellMapQuality> cells(static_cast<std::size_t>(nc));
@@ -128,9 +132,12 @@ MapQualityStats map_quality(const TSplineMap& map, int gauss, std::vector<CellMa
 
 DenseMapQuality dense_map_quality(const TSplineMap& map, int k) {
   if (k < 1) throw std::invalid_argument("dense_map_quality: k must be >= 1");
-  const BezierExtraction extraction(map.basis());
+  return dense_map_quality(BezierExtraction(map.basis()), map.control_points(), k);
+}
+
+DenseMapQuality dense_map_quality(const BezierExtraction& extraction, const std::vector<Eigen::Vector2d>& P, int k) {
+  if (k < 1) throw std::invalid_argument("dense_map_quality: k must be >= 1");
   const std::vector<BezierElement>& es = extraction.elements();
-  const std::vector<Eigen::Vector2d>& P = map.control_points();
   // The (k + 1) x (k + 1) points of every element as a tensor grid: the map's
   // Bernstein coefficients per element and sum factorization (tensor_grid.h),
   // instead of the basis functions point by point.

@@ -11,6 +11,8 @@
 
 namespace tspline {
 
+class BezierExtraction;
+
 double mean_ratio_jacobian(const Eigen::Matrix2d& J);
 double scaled_jacobian(const Eigen::Matrix2d& J);
 
@@ -32,6 +34,10 @@ struct MapQualityStats {
 
 /// Over all cells' gauss x gauss points; per cell too if `per_cell` is given.
 MapQualityStats map_quality(const TSplineMap& map, int gauss = 4, std::vector<CellMapQuality>* per_cell = nullptr);
+/// The same with the Bezier extraction of map.basis() given (built once for
+/// several checks of maps on one T-mesh).
+MapQualityStats map_quality(const TSplineMap& map, const BezierExtraction& extraction, int gauss,
+                            std::vector<CellMapQuality>* per_cell = nullptr);
 
 /// Quality over the whole map, not only at quadrature points: a dense sample
 /// of every Bezier element (bezier_extraction.h), (k + 1) x (k + 1) points on a
@@ -51,5 +57,7 @@ struct DenseMapQuality {
 
 /// \pre k >= 1.
 DenseMapQuality dense_map_quality(const TSplineMap& map, int k = 8);
+/// The same from a Bezier extraction and control points (one per blending function).
+DenseMapQuality dense_map_quality(const BezierExtraction& extraction, const std::vector<Eigen::Vector2d>& P, int k = 8);
 
 }  // namespace tspline
