@@ -210,7 +210,7 @@ LayoutOptimizationReport optimize_layout_nodes(LayoutMesh& m, const LayoutQualit
   double worst_tangled = -2.0;  // the worst corner of the tangled sweeps, and when it last rose
   int last_rise = 0;
   for (int sweep = 0; sweep < o.max_sweeps; ++sweep) {
-    if (o.cancel && o.cancel->load(std::memory_order_relaxed)) throw LayoutCancelled();
+    throw_if_cancelled(o.cancel);
     const double w = worst_sin();
     const bool tangled = w <= 0.0;
     if (tangled) {

@@ -275,7 +275,7 @@ LayoutRotationReport rotate_layout_edges(LayoutMesh& m, const LayoutQuality& Q, 
     // each batch's tries run on the pool's threads, on copies of the layout,
     // and are kept in order; the result is that of trying them one by one.
     for (std::size_t i = 0; i < bad.size();) {
-      if (o.cancel && o.cancel->load(std::memory_order_relaxed)) throw LayoutCancelled();
+      throw_if_cancelled(o.cancel);
       std::vector<int> batch;
       std::vector<int> marked;
       for (; i < bad.size() && batch.size() < std::max<std::size_t>(1, o.max_batch); ++i) {

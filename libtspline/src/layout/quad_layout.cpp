@@ -82,10 +82,6 @@ void report_optimization(const LayoutOptimizationReport& rep, QuadLayoutStats& s
 //     again while rotations are kept.
 // `start` becomes the mesh the checks fall back to (the mesher's nodes, after
 // any pillowing).
-void stop_if_cancelled(const std::atomic<bool>* cancel) {
-  if (cancel && cancel->load(std::memory_order_relaxed)) throw LayoutCancelled();
-}
-
 void optimize_layout(LayoutMesh& m, LayoutMesh& start, const LayoutRings& R, const LayoutQuality& Q,
                      const LayoutAdmissible& admissible, int level, QuadLayoutStats& st,
                      const std::atomic<bool>* cancel) {
@@ -197,7 +193,7 @@ QuadLayout build_quad_layout(const Domain& d, const QuadLayoutOptions& o) {
   int level = 2;
   int repairs = 0;  // rounds that added nodes (dropping an optimization level is not one)
   for (int round = 0;; ++round) {
-    stop_if_cancelled(o.cancel);
+    throw_if_cancelled(o.cancel);
     if (repairs > o.max_repair_rounds)
       throw NumericalError("no quad layout found: the layout still crosses the boundary after " +
                            std::to_string(o.max_repair_rounds) + " rounds of adding nodes");

@@ -65,9 +65,9 @@ DomainParameterization parameterize_domain(const Domain& input, const Parameteri
     out.single.emplace(run_parameterization(domain.outer, options, adaptive, on_iteration));
     return out;
   }
-  // The layout of a domain without holes under auto, built while the single
-  // patch is tried (below): the layout is mostly serial work, the single patch's
-  // untangling is parallel; cancelled where one patch is kept.
+  // The layout of a domain without holes under auto, built on a thread of its
+  // own while the single patch is tried (below), so that the two share the
+  // cores; cancelled where one patch is kept.
   struct LayoutAhead {
     Domain valid;
     QuadLayout layout;

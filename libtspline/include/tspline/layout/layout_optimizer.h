@@ -45,6 +45,11 @@ struct LayoutCancelled : std::exception {
   const char* what() const noexcept override { return "the quad layout was cancelled"; }
 };
 
+/// Throws LayoutCancelled if `cancel` is given and set.
+inline void throw_if_cancelled(const std::atomic<bool>* cancel) {
+  if (cancel && cancel->load(std::memory_order_relaxed)) throw LayoutCancelled();
+}
+
 struct LayoutOptimizationReport {
   LayoutCornerQuality before, after;  ///< worst over the quads (layout_quality.h)
   int sweeps = 0;
