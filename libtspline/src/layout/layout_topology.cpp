@@ -184,15 +184,56 @@ struct RotationTry {
   std::vector<double> arc;
 };
 
-RotationTry try_rotations(const LayoutMesh& m, const LayoutTopology& t, const LayoutQuality& Q,
-                          const LayoutAdmissible& admissible, const std::vector<char>& touched, int q,
-                          const LayoutOptimizationOptions& lo) {
+// The quads at the nodes a rotation try reads (try_reach) as a layout of
+// their own, nodes and quads in the order of the whole layout: every quad at a
+// node the try may move is there with all its neighbours, so the try's
+// topology, figures and moves are exactly those on the whole layout, for a
+// cost that does not grow with the layout (a copy of the whole layout and of
+// its topology per try made rotations quadratic in the number of quads).
+struct LocalLayout {
+  LayoutMesh mesh;
+  std::vector<int> node;  ///< local -> global, increasing
+  std::vector<int> quad;  ///< local -> global, increasing
+  static int local(const std::vector<int>& ids, int global) {
+    return static_cast<int>(std::lower_bound(ids.begin(), ids.end(), global) - ids.begin());
+  }
+};
+
+LocalLayout local_layout(const LayoutMesh& m, const LayoutTopology& t, const std::vector<int>& reach) {
+  LocalLayout l;
+  for (const int n : reach)
+    for (const auto& [q, j] : t.corners_of(n)) l.quad.push_back(q);
+  std::sort(l.quad.begin(), l.quad.end());
+  l.quad.erase(std::unique(l.quad.begin(), l.quad.end()), l.quad.end());
+  for (const int q : l.quad) l.node.insert(l.node.end(), m.quads[q].begin(), m.quads[q].end());
+  std::sort(l.node.begin(), l.node.end());
+  l.node.erase(std::unique(l.node.begin(), l.node.end()), l.node.end());
+  for (const int n : l.node) l.mesh.x.push_back(m.x[n]), l.mesh.ring.push_back(m.ring[n]), l.mesh.arc.push_back(m.arc[n]);
+  for (const int q : l.quad) {
+    std::array<int, 4> c;
+    for (int j = 0; j < 4; ++j) c[j] = LocalLayout::local(l.node, m.quads[q][j]);
+    l.mesh.quads.push_back(c);
+  }
+  return l;
+}
+
+// The best rotation around quad q of the layout (which is not changed), tried
+// on the local layout of the nodes it reads: the new corners of q and of the
+// quad across the rotated edge, and where the nodes around them end after
+// their optimization (global indices).
+RotationTry try_rotations(const LayoutMesh& whole, const LayoutTopology& whole_t, const LayoutQuality& Q,
+                          const LayoutAdmissible& admissible, const std::vector<char>& touched, int q_global,
+                          const std::vector<int>& reach, const LayoutOptimizationOptions& lo) {
+  const LocalLayout l = local_layout(whole, whole_t, reach);
+  const LayoutMesh& m = l.mesh;
+  const LayoutTopology t(m);
+  const int q = LocalLayout::local(l.quad, q_global);
   RotationTry out;
   double best = -1e300, before = 0.0;
   for (int j = 0; j < 4; ++j) {
     if (t.on_ring(q, j)) continue;
     const auto [b, k] = t.across(q, j);
-    if (b < 0 || touched[b]) continue;
+    if (b < 0 || touched[l.quad[b]]) continue;
     // Only between quads that run along their shared edge in opposite directions.
     if (m.quads[b][k] != m.quads[q][(j + 1) % 4]) continue;
     // The hexagon, counter-clockwise, the shared edge h0-h3.
@@ -227,11 +268,10 @@ RotationTry try_rotations(const LayoutMesh& m, const LayoutTopology& t, const La
       const double after = region_figure(c, ct, Q, free);
       if (after > best) {
         best = after;
-        out.other = b;
-        out.quad_q = c.quads[q], out.quad_other = c.quads[b];
-        out.free = free;
-        out.x.clear(), out.arc.clear();
-        for (const int n : free) out.x.push_back(c.x[n]), out.arc.push_back(c.arc[n]);
+        out.other = l.quad[b];
+        for (int i = 0; i < 4; ++i) out.quad_q[i] = l.node[c.quads[q][i]], out.quad_other[i] = l.node[c.quads[b][i]];
+        out.free.clear(), out.x.clear(), out.arc.clear();
+        for (const int n : free) out.free.push_back(l.node[n]), out.x.push_back(c.x[n]), out.arc.push_back(c.arc[n]);
       }
     }
   }
@@ -277,6 +317,7 @@ LayoutRotationReport rotate_layout_edges(LayoutMesh& m, const LayoutQuality& Q, 
     for (std::size_t i = 0; i < bad.size();) {
       throw_if_cancelled(o.cancel);
       std::vector<int> batch;
+      std::vector<std::vector<int>> reaches;
       std::vector<int> marked;
       for (; i < bad.size() && batch.size() < std::max<std::size_t>(1, o.max_batch); ++i) {
         const int q = bad[i].second;
@@ -285,11 +326,12 @@ LayoutRotationReport rotate_layout_edges(LayoutMesh& m, const LayoutQuality& Q, 
         if (std::any_of(reach.begin(), reach.end(), [&](int n) { return reached[n] != 0; })) break;
         for (const int n : reach) reached[n] = 1, marked.push_back(n);
         batch.push_back(q);
+        reaches.push_back(reach);
       }
       for (const int n : marked) reached[n] = 0;
       std::vector<RotationTry> tries(batch.size());
       detail::parallel_ranges(batch.size(), detail::pool_threads(), [&](std::size_t begin, std::size_t end, int) {
-        for (std::size_t k = begin; k < end; ++k) tries[k] = try_rotations(m, t, Q, admissible, touched, batch[k], lo);
+        for (std::size_t k = begin; k < end; ++k) tries[k] = try_rotations(m, t, Q, admissible, touched, batch[k], reaches[k], lo);
       }, 2);
       bool changed = false;
       for (std::size_t k = 0; k < batch.size(); ++k) {

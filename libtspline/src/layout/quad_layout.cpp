@@ -65,12 +65,21 @@ void print_worst(const LayoutMesh& m, const LayoutQuality& Q, int count) {
   }
 }
 
+// Seconds since the last call (debugging output).
+double lap() {
+  static thread_local auto last = std::chrono::steady_clock::now();
+  const auto now = std::chrono::steady_clock::now();
+  const double s = std::chrono::duration<double>(now - last).count();
+  last = now;
+  return s;
+}
+
 void report_optimization(const LayoutOptimizationReport& rep, QuadLayoutStats& st) {
   st.optimization_sweeps += rep.sweeps;
   if (debugging())
-    std::fprintf(stderr, "layout optimization: J_r %.4g -> %.4g, SJ %.4g -> %.4g, %d sweeps, %zu moves\n",
+    std::fprintf(stderr, "layout optimization: J_r %.4g -> %.4g, SJ %.4g -> %.4g, %d sweeps, %zu moves, %.2f s\n",
                  rep.before.mean_ratio, rep.after.mean_ratio, rep.before.scaled_jacobian, rep.after.scaled_jacobian,
-                 rep.sweeps, rep.moves);
+                 rep.sweeps, rep.moves, lap());
 }
 
 // The layout mesh optimized for its patch maps (level 0: as the mesher made
@@ -96,11 +105,13 @@ void optimize_layout(LayoutMesh& m, LayoutMesh& start, const LayoutRings& R, con
   auto rotate = [&]() {
     LayoutRotationReport rr = rotate_layout_edges(m, Q, admissible, rotation);
     st.rotations += rr.kept;
-    if (debugging()) std::fprintf(stderr, "layout rotations: %zu tried, %zu kept\n", rr.tried, rr.kept);
+    if (debugging()) std::fprintf(stderr, "layout rotations: %zu tried, %zu kept, %.2f s\n", rr.tried, rr.kept, lap());
     return rr;
   };
+  if (debugging()) lap();
   if (level >= 1) {
     smooth_layout_kstar(m, R);
+    if (debugging()) std::fprintf(stderr, "layout K*: %.2f s\n", lap());
     LayoutOptimizationOptions quick = full;
     quick.max_sweeps = 8;
     report_optimization(optimize_layout_nodes(m, Q, admissible, {}, quick), st);
