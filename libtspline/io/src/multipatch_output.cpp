@@ -2,6 +2,8 @@
 
 #include <filesystem>
 #include <functional>
+#include <type_traits>
+#include <utility>
 
 #include "toolkit/io/atomic_file.h"
 #include "tspline/detail/thread_pool.h"
@@ -36,9 +38,10 @@ json whole_map_of(const json& patch_reports) {
   return combine_whole_map_quality_json(w);
 }
 
-}  // namespace
-
-toolkit::io::VtuMesh merge_patches(const std::vector<toolkit::io::VtuMesh>& parts) {
+// merge_patches; with non-const parts each part is released once appended, so
+// that the parts and the merged mesh are never whole at once.
+template <class Parts>
+toolkit::io::VtuMesh merge(Parts& parts) {
   toolkit::io::VtuMesh out;
   if (parts.empty()) return out;
   out.quads_as_polygons = parts.front().quads_as_polygons;
@@ -61,7 +64,19 @@ toolkit::io::VtuMesh merge_patches(const std::vector<toolkit::io::VtuMesh>& part
     degrees = degrees && p.higher_order_degrees.size() == p.cells.size();
     if (p.rational_weights != out.rational_weights) out.rational_weights.clear();
   }
+  // Every array at its final size at once (growing by doubling held up to
+  // twice the memory).
+  std::size_t np = 0, nc = 0;
+  for (const toolkit::io::VtuMesh& p : parts) np += p.points.size(), nc += p.cells.size();
+  out.points.reserve(np), out.cells.reserve(nc);
+  for (auto& [k, v] : out.point_scalars) v.reserve(np);
+  for (auto& [k, v] : out.point_ints) v.reserve(np);
+  for (auto& [k, v] : out.point_vectors) v.reserve(np);
+  for (auto& [k, v] : out.cell_scalars) v.reserve(nc);
+  for (auto& [k, v] : out.cell_ints) v.reserve(nc);
+  for (auto& [k, v] : out.cell_vectors) v.reserve(nc);
   std::vector<int> patch;
+  patch.reserve(nc);
   for (std::size_t k = 0; k < parts.size(); ++k) {
     const toolkit::io::VtuMesh& p = parts[k];
     const int offset = static_cast<int>(out.points.size());
@@ -78,9 +93,20 @@ toolkit::io::VtuMesh merge_patches(const std::vector<toolkit::io::VtuMesh>& part
     if (degrees)
       out.higher_order_degrees.insert(out.higher_order_degrees.end(), p.higher_order_degrees.begin(),
                                       p.higher_order_degrees.end());
+    if constexpr (!std::is_const_v<Parts>) parts[k] = toolkit::io::VtuMesh();
   }
   if (!out.point_scalars.count(out.rational_weights)) out.rational_weights.clear();
   out.cell_ints["patch"] = std::move(patch);
+  return out;
+}
+
+}  // namespace
+
+toolkit::io::VtuMesh merge_patches(const std::vector<toolkit::io::VtuMesh>& parts) { return merge(parts); }
+
+toolkit::io::VtuMesh merge_patches(std::vector<toolkit::io::VtuMesh>&& parts) {
+  toolkit::io::VtuMesh out = merge(parts);
+  parts.clear();
   return out;
 }
 
@@ -189,9 +215,9 @@ void write_multipatch_outputs(const MultiPatchResult& R, const std::string& out_
       detail::parallel_ranges(n, detail::pool_threads(), [&](std::size_t begin, std::size_t end, int) {
         for (std::size_t p = begin; p < end; ++p) parts[p] = part(p);
       }, 2);
-      merged = merge_patches(parts);
+      merged = merge_patches(std::move(parts));
     }
-    toolkit::io::write_vtu((dir / name).string(), merged);
+    toolkit::io::write_vtu((dir / name).string(), std::move(merged));
   }
   toolkit::io::write_text_atomic((dir / output_files::kReport).string(), report.dump(2) + "\n");
 }

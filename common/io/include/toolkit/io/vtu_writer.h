@@ -40,6 +40,9 @@ struct VtuMesh {
 /// Writes `mesh` to `path` atomically. \throw IoError; std::invalid_argument if
 /// an array has the wrong length or a cell index is out of range.
 void write_vtu(const std::string& path, const VtuMesh& mesh);
+/// The same, releasing each of `mesh`'s arrays as soon as VTK has its copy
+/// (the peak memory of a large mesh about halves); `mesh` is left empty.
+void write_vtu(const std::string& path, VtuMesh&& mesh);
 
 /// One dataset of a .pvd collection.
 struct PvdEntry {

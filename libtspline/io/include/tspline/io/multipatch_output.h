@@ -16,6 +16,8 @@ namespace tspline::io {
 /// in `parts`); arrays not present in every part are dropped, and so are cell
 /// types, higher-order degrees and rational weights unless every part has them.
 toolkit::io::VtuMesh merge_patches(const std::vector<toolkit::io::VtuMesh>& parts);
+/// The same, releasing each part once it is appended (`parts` is left empty).
+toolkit::io::VtuMesh merge_patches(std::vector<toolkit::io::VtuMesh>&& parts);
 
 /// Report: per patch the single-patch report (param_report), per interface the
 /// gap and knots, and the totals (cells, elements, functions, certification,
