@@ -81,9 +81,13 @@ toolkit::io::VtuMesh merge(Parts& parts) {
     const toolkit::io::VtuMesh& p = parts[k];
     const int offset = static_cast<int>(out.points.size());
     out.points.insert(out.points.end(), p.points.begin(), p.points.end());
-    for (std::vector<int> c : p.cells) {
-      for (int& i : c) i += offset;
-      out.cells.push_back(std::move(c));
+    for (std::size_t c = 0; c < p.cells.size(); ++c) {
+      // Released parts give their cells away (no second allocation per cell).
+      std::vector<int> cell;
+      if constexpr (std::is_const_v<Parts>) cell = p.cells[c];
+      else cell = std::move(parts[k].cells[c]);
+      for (int& i : cell) i += offset;
+      out.cells.push_back(std::move(cell));
       patch.push_back(static_cast<int>(k));
     }
     append(out.point_scalars, p.point_scalars), append(out.cell_scalars, p.cell_scalars);
