@@ -115,7 +115,22 @@ int pool_threads() {
 void parallel_ranges(std::size_t n, int threads, const std::function<void(std::size_t, std::size_t, int)>& body,
                      std::size_t min_parallel) {
   const int ranges = std::min(threads, pool_threads());
-  if (ranges > 1 && n >= min_parallel && !inside_pool && pool().run(n, ranges, body)) return;
+  if (ranges > 1 && n >= min_parallel && !inside_pool) {
+    if (pool().run(n, ranges, body)) return;
+    // Busy: the same ranges here, in slot order (as the pool's caller, nested
+    // calls inside them run as one range).
+    const std::size_t chunk = (n + ranges - 1) / ranges;
+    inside_pool = true;
+    try {
+      for (int r = 0; r < ranges; ++r)
+        body(std::min(n, static_cast<std::size_t>(r) * chunk), std::min(n, static_cast<std::size_t>(r + 1) * chunk), r);
+    } catch (...) {
+      inside_pool = false;
+      throw;
+    }
+    inside_pool = false;
+    return;
+  }
   body(0, n, 0);
 }
 

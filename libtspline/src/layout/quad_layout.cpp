@@ -200,7 +200,11 @@ QuadLayout build_quad_layout(const Domain& d, const QuadLayoutOptions& o) {
     return true;
   };
 
+  auto note = [&](const std::string& text) {
+    if (o.progress) o.progress(text);
+  };
   QuadLayout out;
+  int meshes = 0;  // made by the mesher (rounds that only add ring nodes make none)
   int level = 2;
   int repairs = 0;  // rounds that added nodes (dropping an optimization level is not one)
   for (int round = 0;; ++round) {
@@ -209,6 +213,11 @@ QuadLayout build_quad_layout(const Domain& d, const QuadLayoutOptions& o) {
       throw NumericalError("no quad layout found: the layout still crosses the boundary after " +
                            std::to_string(o.max_repair_rounds) + " rounds of adding nodes");
     std::vector<std::set<std::size_t>> to_split(rings.size());
+    auto marked = [&]() {
+      std::size_t k = 0;
+      for (const auto& pieces : to_split) k += pieces.size();
+      return k;
+    };
     auto split_marked = [&]() {
       bool any = false;
       for (std::size_t r = 0; r < rings.size(); ++r)
@@ -310,6 +319,8 @@ QuadLayout build_quad_layout(const Domain& d, const QuadLayoutOptions& o) {
       if (r == straight.size() || curve < 0) throw;
       const std::size_t n = straight[r].size(), k = static_cast<std::size_t>(curve);
       for (const std::size_t j : {(k + n - 1) % n, k, (k + 1) % n}) to_split[r].insert(j);
+      note("mesh " + std::to_string(meshes + 1) + ": the quad mesher lost a piece of ring " + std::to_string(r) +
+           "; 3 ring nodes more there, meshing again");
       split_marked();
       out.stats.repair_rounds = ++repairs;
       continue;
@@ -354,6 +365,9 @@ QuadLayout build_quad_layout(const Domain& d, const QuadLayoutOptions& o) {
       m.x[n] = rings[m.ring[n]].point(m.arc[n]);
     }
     LayoutMesh start = m;  // the mesher's nodes, on the true rings
+    ++meshes;
+    note("mesh " + std::to_string(meshes) + ": " + std::to_string(m.quads.size()) + " quads; optimizing them" +
+         (level == 2 ? "" : " without edge rotations"));
     const auto t_opt = std::chrono::steady_clock::now();
     optimize_layout(m, start, R, quality, admissible, level, out.stats, o.cancel);
     if (debugging())
@@ -398,7 +412,13 @@ QuadLayout build_quad_layout(const Domain& d, const QuadLayoutOptions& o) {
       if (!changed) break;
     }
     if (debugging()) std::fprintf(stderr, "  %zu nodes still in violation\n", violations(m, false).size());
-    violations(m, true);
+    {
+      const std::size_t bad = violations(m, true).size();
+      if (bad > 0)
+        note("mesh " + std::to_string(meshes) + ": " + std::to_string(bad) +
+             " node(s) outside the domain or with cuts across its boundary; " + std::to_string(marked()) +
+             " ring node(s) more there, meshing again");
+    }
     if (split_marked()) {
       out.stats.repair_rounds = ++repairs;
       out.stats.optimization_level = level = 2;  // the new mesh is optimized in full
@@ -439,6 +459,7 @@ QuadLayout build_quad_layout(const Domain& d, const QuadLayoutOptions& o) {
         // The optimization left a corner flat or reflex, or the cuts crossing
         // (a tangled start near rings much closer than the patch size): the
         // same mesh without edge rotations.
+        note("mesh " + std::to_string(meshes) + ": " + e.what() + "; the same mesh without edge rotations");
         out.stats.optimization_level = level = 1;
         continue;
       }
@@ -452,6 +473,7 @@ QuadLayout build_quad_layout(const Domain& d, const QuadLayoutOptions& o) {
         const double px = std::strtod(what.c_str() + at + 6, &end);
         const double py = end && *end == ',' ? std::strtod(end + 1, nullptr) : 0.0;
         mark_nearest_piece(Eigen::Vector2d(px, py));
+        note("mesh " + std::to_string(meshes) + ": " + what + "; a ring node more there, meshing again");
         split_marked();
         out.stats.repair_rounds = ++repairs;
         out.stats.optimization_level = level = 2;

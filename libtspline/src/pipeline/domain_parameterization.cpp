@@ -4,6 +4,7 @@
 #include <atomic>
 #include <future>
 #include <limits>
+#include <mutex>
 #include <sstream>
 
 #include "tspline/errors.h"
@@ -72,6 +73,19 @@ DomainParameterization parameterize_domain(const Domain& input, const Parameteri
     Domain valid;
     QuadLayout layout;
   };
+  // The layout's progress and the single patch's, from two threads, one at a time.
+  std::mutex progress_mutex;
+  ParameterizationOptions serial = options;
+  if (options.progress)
+    serial.progress = [&progress_mutex, cb = options.progress](const ProgressEvent& e) {
+      std::lock_guard<std::mutex> lock(progress_mutex);
+      cb(e);
+    };
+  auto layout_progress = [cb = serial.progress](const std::string& prefix) {
+    return cb ? std::function<void(const std::string&)>(
+                    [cb, prefix](const std::string& text) { report_step(cb, "layout", prefix + text); })
+              : std::function<void(const std::string&)>();
+  };
   std::future<LayoutAhead> ahead;
   auto run_quad = [&](const std::string& reason) {
     LayoutAhead a;
@@ -79,11 +93,13 @@ DomainParameterization parameterize_domain(const Domain& input, const Parameteri
       a = ahead.get();
     } else {
       a.valid = holes || c.layout == LayoutMode::Quad ? domain : validate_domain(input);
-      a.layout = build_quad_layout(a.valid, c.quad);
+      QuadLayoutOptions q = c.quad;
+      q.progress = layout_progress("quad layout: ");
+      a.layout = build_quad_layout(a.valid, q);
     }
     const Domain& valid = a.valid;
     QuadLayout& L = a.layout;
-    report_step(options.progress, "layout", L.explanation());
+    report_step(serial.progress, "layout", L.explanation());
     out.layout = "quad";
     out.reason = reason;
     out.quad_stats = L.stats;
@@ -125,7 +141,7 @@ DomainParameterization parameterize_domain(const Domain& input, const Parameteri
       } catch (const InputError& e) {
         why = std::string("the domain has holes, and no automatic cuts were found (") + e.what() + ")";
       }
-      report_step(options.progress, "layout", why + ": building a quad layout");
+      report_step(serial.progress, "layout", why + ": building a quad layout");
     }
     if (quad_mesher_available()) {
       if (!by_cuts) {
@@ -141,7 +157,7 @@ DomainParameterization parameterize_domain(const Domain& input, const Parameteri
       } catch (const NumericalError& e) {
         fallback = std::string("no quad layout (") + e.what() + ")";
       }
-      report_step(options.progress, "layout", fallback + ": keeping the automatic cuts");
+      report_step(serial.progress, "layout", fallback + ": keeping the automatic cuts");
       out.quad_stats.reset();
       out.layout = "automatic cuts";
       out.reason = why + "; " + fallback + ", so the certified automatic cuts are kept";
@@ -166,6 +182,7 @@ DomainParameterization parameterize_domain(const Domain& input, const Parameteri
   if (quad_mesher_available()) {
     QuadLayoutOptions q = c.quad;
     q.cancel = &cancel;
+    q.progress = layout_progress("quad layout (built while one patch is tried): ");
     ahead = std::async(std::launch::async, [&input, q] {
       LayoutAhead a;
       a.valid = validate_domain(input);
@@ -183,7 +200,7 @@ DomainParameterization parameterize_domain(const Domain& input, const Parameteri
   };
   AdaptiveOptions first = adaptive;
   first.max_adapt = std::min(adaptive.max_adapt, c.first_try_rounds);
-  ParameterizationResult single = run_parameterization(domain.outer, options, first, on_iteration);
+  ParameterizationResult single = run_parameterization(domain.outer, serial, first, on_iteration);
   const DenseMapQuality& q = single.dense_quality;
   const bool certified = !adaptive.certify || single.certified_valid();
   const bool good = certified && single.map && q.min_scaled >= c.good_scaled_jacobian &&
@@ -205,7 +222,7 @@ DomainParameterization parameterize_domain(const Domain& input, const Parameteri
   std::string why = !certified ? std::string("one patch is not certified after ") +
                                      std::to_string(first.max_adapt) + " adaptive rounds"
                                : "one patch is certified but poor over the whole map (" + figures(q) + ")";
-  report_step(options.progress, "layout", why + ": building a quad layout");
+  report_step(serial.progress, "layout", why + ": building a quad layout");
   try {
     run_quad(why);
     if (!adaptive.certify || out.patches->certified_valid()) {
@@ -231,7 +248,7 @@ DomainParameterization parameterize_domain(const Domain& input, const Parameteri
   }
   // The quad layout failed or did worse: the single patch, with every adaptive
   // round it may take (what layout single gives).
-  report_step(options.progress, "layout", why);
+  report_step(serial.progress, "layout", why);
   out.patches.reset();
   out.quad_stats.reset();
   out.layout = "single";

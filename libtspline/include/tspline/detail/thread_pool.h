@@ -17,8 +17,12 @@ namespace tspline::detail {
 int pool_threads();
 
 /// Runs body(begin, end, slot) on min(threads, pool_threads()) contiguous
-/// ranges of [0, n), slot in [0, ranges); returns when all are done. Serial
-/// (one range, slot 0) if threads <= 1, n < min_parallel, or the pool is busy.
+/// ranges of [0, n), slot in [0, ranges); returns when all are done. One range
+/// (slot 0) if threads <= 1, n < min_parallel or inside a pool's range. If the
+/// pool is busy with another caller's work, the same ranges run one after the
+/// other in the caller: the ranges never depend on timing, so neither does a
+/// result combined from per-slot parts (auto's single patch, tried while the
+/// layout's rotations use the pool, gave other last digits from run to run).
 /// Exceptions from a body are rethrown in the caller (the first one).
 void parallel_ranges(std::size_t n, int threads, const std::function<void(std::size_t, std::size_t, int)>& body,
                      std::size_t min_parallel = 256);

@@ -23,6 +23,7 @@
 #include <array>
 #include <atomic>
 #include <cstddef>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -47,6 +48,9 @@ struct QuadLayoutOptions {
   /// LayoutCancelled (layout_optimizer.h) at its next check (every optimization
   /// sweep, rotation batch and repair round).
   const std::atomic<bool>* cancel = nullptr;
+  /// Told what each mesh round does (a large coast takes several rounds of
+  /// tens of seconds each); never called from two threads at once.
+  std::function<void(const std::string&)> progress;
 };
 
 
