@@ -281,13 +281,24 @@ RotationTry try_rotations(const LayoutMesh& whole, const LayoutTopology& whole_t
 
 // The nodes a rotation try around quad q reads: the quads around the nodes it
 // may move (the one-ring of q and of its neighbours) and their nodes.
+// (A set, sorted: its cost does not grow with the layout.)
 std::vector<int> try_reach(const LayoutMesh& m, const LayoutTopology& t, int q) {
-  std::vector<int> hex(m.quads[q].begin(), m.quads[q].end());
+  std::vector<int> nodes(m.quads[q].begin(), m.quads[q].end());
   for (int j = 0; j < 4; ++j) {
     const int b = t.across(q, j).first;
-    if (b >= 0) hex.insert(hex.end(), m.quads[b].begin(), m.quads[b].end());
+    if (b >= 0) nodes.insert(nodes.end(), m.quads[b].begin(), m.quads[b].end());
   }
-  return one_ring(m, t, one_ring(m, t, hex));
+  for (int ring = 0; ring < 2; ++ring) {
+    std::sort(nodes.begin(), nodes.end());
+    nodes.erase(std::unique(nodes.begin(), nodes.end()), nodes.end());
+    std::vector<int> next;
+    for (const int n : nodes)
+      for (const auto& [a, j] : t.corners_of(n)) next.insert(next.end(), m.quads[a].begin(), m.quads[a].end());
+    nodes = std::move(next);
+  }
+  std::sort(nodes.begin(), nodes.end());
+  nodes.erase(std::unique(nodes.begin(), nodes.end()), nodes.end());
+  return nodes;
 }
 
 }  // namespace
@@ -314,21 +325,36 @@ LayoutRotationReport rotate_layout_edges(LayoutMesh& m, const LayoutQuality& Q, 
     // The quads in order, in batches whose tries read disjoint sets of nodes:
     // each batch's tries run on the pool's threads, on copies of the layout,
     // and are kept in order; the result is that of trying them one by one.
+    // A quad whose try reads a node that an earlier quad's try (in the batch,
+    // or left for a later batch) may read waits for a later batch; quads past
+    // it that read none of those nodes join this one: tries that read
+    // disjoint nodes give the same result in either order.
+    const std::size_t max_batch = std::max<std::size_t>(1, o.max_batch);
+    std::vector<char> done(bad.size(), 0);
     for (std::size_t i = 0; i < bad.size();) {
       throw_if_cancelled(o.cancel);
       std::vector<int> batch;
       std::vector<std::vector<int>> reaches;
       std::vector<int> marked;
-      for (; i < bad.size() && batch.size() < std::max<std::size_t>(1, o.max_batch); ++i) {
-        const int q = bad[i].second;
-        if (touched[q]) continue;
-        const std::vector<int> reach = try_reach(m, t, q);
-        if (std::any_of(reach.begin(), reach.end(), [&](int n) { return reached[n] != 0; })) break;
-        for (const int n : reach) reached[n] = 1, marked.push_back(n);
+      const std::size_t window = std::min(bad.size(), i + 4 * max_batch);
+      for (std::size_t k = i; k < window && batch.size() < max_batch; ++k) {
+        if (done[k]) continue;
+        const int q = bad[k].second;
+        if (touched[q]) {
+          done[k] = 1;
+          continue;
+        }
+        std::vector<int> reach = try_reach(m, t, q);
+        const bool clear = std::none_of(reach.begin(), reach.end(), [&](int n) { return reached[n] != 0; });
+        for (const int n : reach)
+          if (!reached[n]) reached[n] = 1, marked.push_back(n);
+        if (!clear) continue;
+        done[k] = 1;
         batch.push_back(q);
-        reaches.push_back(reach);
+        reaches.push_back(std::move(reach));
       }
       for (const int n : marked) reached[n] = 0;
+      while (i < bad.size() && done[i]) ++i;
       std::vector<RotationTry> tries(batch.size());
       detail::parallel_ranges(batch.size(), detail::pool_threads(), [&](std::size_t begin, std::size_t end, int) {
         for (std::size_t k = begin; k < end; ++k) tries[k] = try_rotations(m, t, Q, admissible, touched, batch[k], reaches[k], lo);

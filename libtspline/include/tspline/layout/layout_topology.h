@@ -31,8 +31,9 @@ struct LayoutRotationOptions {
   int local_sweeps = 6;  ///< optimizer sweeps over the nodes of a tried rotation and their neighbours
   /// Rotations around quads whose tries read disjoint nodes are tried together
   /// on the pool's threads, at most this many at once (1: one by one). The
-  /// result does not depend on it: a batch is cut at the first quad whose try
-  /// would read a node another try of the batch may move.
+  /// result does not depend on it: a quad joins a batch only if its try reads
+  /// no node that the try of an earlier quad, in the batch or still waiting,
+  /// may read.
   std::size_t max_batch = 64;
   const std::atomic<bool>* cancel = nullptr;  ///< as LayoutOptimizationOptions::cancel, checked per batch
 };
