@@ -366,7 +366,7 @@ QuadLayout build_quad_layout(const Domain& d, const QuadLayoutOptions& o) {
     }
     LayoutMesh start = m;  // the mesher's nodes, on the true rings
     ++meshes;
-    note("mesh " + std::to_string(meshes) + ": " + std::to_string(m.quads.size()) + " quads; optimizing them" +
+    note("mesh " + std::to_string(meshes) + ": " + std::to_string(m.quads.size()) + " quads from the mesher; optimizing them" +
          (level == 2 ? "" : " without edge rotations"));
     const auto t_opt = std::chrono::steady_clock::now();
     optimize_layout(m, start, R, quality, admissible, level, out.stats, o.cancel);
