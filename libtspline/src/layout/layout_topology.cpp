@@ -182,6 +182,7 @@ struct RotationTry {
   std::vector<int> free;  ///< the nodes optimized around the rotation
   std::vector<Eigen::Vector2d> x;
   std::vector<double> arc;
+  bool blocked = false;  ///< an edge was not tried: the quad across it already rotated this round
 };
 
 // The quads at the nodes a rotation try reads (try_reach) as a layout of
@@ -233,7 +234,11 @@ RotationTry try_rotations(const LayoutMesh& whole, const LayoutTopology& whole_t
   for (int j = 0; j < 4; ++j) {
     if (t.on_ring(q, j)) continue;
     const auto [b, k] = t.across(q, j);
-    if (b < 0 || touched[l.quad[b]]) continue;
+    if (b < 0) continue;
+    if (touched[l.quad[b]]) {
+      out.blocked = true;
+      continue;
+    }
     // Only between quads that run along their shared edge in opposite directions.
     if (m.quads[b][k] != m.quads[q][(j + 1) % 4]) continue;
     // The hexagon, counter-clockwise, the shared edge h0-h3.
@@ -310,6 +315,11 @@ LayoutRotationReport rotate_layout_edges(LayoutMesh& m, const LayoutQuality& Q, 
   lo.max_sweeps = o.local_sweeps;
   lo.cancel = o.cancel;
   std::vector<char> reached(m.size(), 0);
+  // A try that found no better rotation (and was not blocked) is not made
+  // again while no node it reads has moved or changed quads since: it would
+  // find the same. Stamps count batches.
+  std::vector<std::size_t> node_stamp(m.size(), 0), failed_at(m.quads.size(), 0);
+  std::size_t clock = 0;
   for (int round = 0; round < o.rounds; ++round) {
     LayoutTopology t(m);
     std::vector<std::pair<double, int>> bad;
@@ -333,6 +343,7 @@ LayoutRotationReport rotate_layout_edges(LayoutMesh& m, const LayoutQuality& Q, 
     std::vector<char> done(bad.size(), 0);
     for (std::size_t i = 0; i < bad.size();) {
       throw_if_cancelled(o.cancel);
+      ++clock;
       std::vector<int> batch;
       std::vector<std::vector<int>> reaches;
       std::vector<int> marked;
@@ -346,6 +357,12 @@ LayoutRotationReport rotate_layout_edges(LayoutMesh& m, const LayoutQuality& Q, 
         }
         std::vector<int> reach = try_reach(m, t, q);
         const bool clear = std::none_of(reach.begin(), reach.end(), [&](int n) { return reached[n] != 0; });
+        // (Only once no earlier quad waiting or batched may move what it reads.)
+        if (clear && o.skip_known_failures && failed_at[q] != 0 &&
+            std::all_of(reach.begin(), reach.end(), [&](int n) { return node_stamp[n] <= failed_at[q]; })) {
+          done[k] = 1;
+          continue;
+        }
         for (const int n : reach)
           if (!reached[n]) reached[n] = 1, marked.push_back(n);
         if (!clear) continue;
@@ -363,8 +380,12 @@ LayoutRotationReport rotate_layout_edges(LayoutMesh& m, const LayoutQuality& Q, 
       for (std::size_t k = 0; k < batch.size(); ++k) {
         const RotationTry& r = tries[k];
         report.tried += r.tried;
-        if (r.other < 0) continue;
         const int q = batch[k];
+        if (r.other < 0) {
+          if (!r.blocked) failed_at[q] = clock;
+          continue;
+        }
+        for (const int n : r.free) node_stamp[n] = clock;
         m.quads[q] = r.quad_q, m.quads[r.other] = r.quad_other;
         for (std::size_t f = 0; f < r.free.size(); ++f) m.x[r.free[f]] = r.x[f], m.arc[r.free[f]] = r.arc[f];
         touched[q] = touched[r.other] = 1;

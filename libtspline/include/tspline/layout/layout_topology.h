@@ -35,6 +35,10 @@ struct LayoutRotationOptions {
   /// no node that the try of an earlier quad, in the batch or still waiting,
   /// may read.
   std::size_t max_batch = 64;
+  /// A quad whose try found no better rotation is not tried again while no
+  /// node its try reads has moved or changed quads (the try would find the
+  /// same); false tries it again in every round (same result, more time).
+  bool skip_known_failures = true;
   const std::atomic<bool>* cancel = nullptr;  ///< as LayoutOptimizationOptions::cancel, checked per batch
 };
 
