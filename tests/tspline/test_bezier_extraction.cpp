@@ -9,6 +9,7 @@
 #include "test_support.h"
 #include "tspline/detail/quadrature.h"
 #include "tspline/spline/bezier_extraction.h"
+#include "tspline/spline/element_map.h"
 #include "tspline/validity/map_quality.h"
 #include "tspline/tmesh/tmesh.h"
 #include "tspline/spline/tspline_map.h"
@@ -185,6 +186,54 @@ TEST_SUITE("bezier_extraction") {
     }
     // With T-junctions some functions' knot lines cross cell interiors.
     CHECK(split_total > 0);
+  }
+
+  TEST_CASE("the map per cell from its Bezier elements (element_map.h): S and J as TSplineMap::derivatives, "
+            "cell boundaries and knot lines inside cells included, far from the origin") {
+    // A map in km far from (0, 0) (as real coastlines in a projected CRS):
+    // the evaluator works relative to a control point of each element.
+    for (unsigned seed : {3u, 7u}) {
+      CAPTURE(seed);
+      TSplineMap map = smooth_map(test_support::random_leaf_splits(2, 12, seed));
+      std::vector<Eigen::Vector2d> P = map.control_points();
+      const Eigen::Vector2d far(4.0e5, -2.5e6);
+      for (Eigen::Vector2d& p : P) p = far + 37.0 * p;
+      map.set_control_points(P);
+      const tspline::BezierExtraction ex(map.basis());
+      tspline::CellMapEvaluator at_cell(ex, map.control_points());
+      int split_cells = 0, boundary_points = 0;
+      double err_x = 0.0, err_j = 0.0, scale_j = 0.0;
+      for (int c = 0; c < static_cast<int>(map.mesh().num_cells()); ++c) {
+        if (ex.cell_begin(c + 1) - ex.cell_begin(c) > 1) ++split_cells;
+        at_cell.set_cell(c);
+        CHECK(at_cell.cell() == c);
+        const Eigen::Vector2d lo = map.mesh().cell_min(c), hi = map.mesh().cell_max(c);
+        // A 9 x 9 grid: the cell's sides, its corners and its midlines (where
+        // knot lines split cells into elements) are all sampled.
+        for (int j = 0; j <= 8; ++j)
+          for (int i = 0; i <= 8; ++i) {
+            const Eigen::Vector2d uv(lo.x() + (hi.x() - lo.x()) * i / 8, lo.y() + (hi.y() - lo.y()) * j / 8);
+            if (i == 0 || i == 8 || j == 0 || j == 8) ++boundary_points;
+            const tspline::MapDerivatives a = at_cell.at(uv), b = map.derivatives(uv, 1, c);
+            err_x = std::max(err_x, (a.x - b.x).norm());
+            err_j = std::max(err_j, (a.J - b.J).norm());
+            scale_j = std::max(scale_j, b.J.norm());
+          }
+      }
+      CHECK(split_cells > 0);
+      CHECK(boundary_points > 0);
+      // |P| ~ 2.5e6: S agrees to a few ulps of the coordinates; J (~37 x 2)
+      // to the basis path's cancellation, about eps |P| / cell size.
+      CHECK(err_x < 1e-8);
+      CHECK(err_j < 1e-6 * scale_j);
+      // ElementMap alone: at local (s, t) of an element, the same as at its
+      // parametric point.
+      const tspline::BezierElement& e = ex.elements()[ex.elements().size() / 2];
+      const tspline::ElementMap em(e, map.control_points());
+      const Eigen::Vector2d uv = e.lo + Eigen::Vector2d(0.25, 0.75).cwiseProduct(e.hi - e.lo);
+      CHECK((em.at_local(0.25, 0.75).x - map.derivatives(uv, 1, e.cell).x).norm() < 1e-8);
+      CHECK((em.at(uv).J - map.derivatives(uv, 1, e.cell).J).norm() < 1e-6 * scale_j);
+    }
   }
 
   TEST_CASE("quadrature per Bezier element integrates every blending function exactly (not so per cell)") {

@@ -275,6 +275,32 @@ TEST_SUITE("map_certification") {
     CHECK(mc.min_relative_lower_bound <= 1.0);
     CHECK(mc.min_det_lower_bound > 0.0);
     for (char ok : mc.cell_certified) CHECK(ok == 1);
+    // The bounds per cell: the minimum of its elements' certificates, and
+    // their minimum the map's.
+    const tspline::BezierExtraction ex(map.basis());
+    REQUIRE(mc.cell_det_lower_bound.size() == map.mesh().num_cells());
+    REQUIRE(mc.cell_relative_lower_bound.size() == map.mesh().num_cells());
+    double min_det = std::numeric_limits<double>::infinity();
+    for (int c = 0; c < static_cast<int>(map.mesh().num_cells()); ++c) {
+      double det = std::numeric_limits<double>::infinity(), rel = det;
+      for (std::size_t k = ex.cell_begin(c); k < ex.cell_begin(c + 1); ++k) {
+        const tspline::ElementCertificate e = tspline::certify_element(ex.elements()[k], map.control_points());
+        det = std::min(det, e.det_lower_bound), rel = std::min(rel, e.relative_lower_bound);
+      }
+      CHECK(mc.cell_det_lower_bound[c] == det);
+      CHECK(mc.cell_relative_lower_bound[c] == rel);
+      min_det = std::min(min_det, det);
+    }
+    CHECK(mc.min_det_lower_bound == min_det);
+    // Only some elements examined: the others' cells have no bound (NaN).
+    std::vector<char> only(ex.elements().size(), 0);
+    only[ex.cell_begin(3)] = 1;
+    const tspline::MapCertification part =
+        tspline::certify_map(ex, map.mesh().num_cells(), map.control_points(), {}, &only);
+    CHECK(part.elements == 1);
+    CHECK(part.cell_det_lower_bound[3] == mc.cell_det_lower_bound[3]);
+    CHECK(std::isnan(part.cell_det_lower_bound[0]));
+    CHECK(std::isnan(part.cell_relative_lower_bound[0]));
     check_agreement(map, 50);
     // The identity: det J = 1 everywhere, so the bound is exactly 1.
     const tspline::MapCertification id =

@@ -4,6 +4,7 @@
 #include <array>
 
 #include "tspline/spline/bezier_extraction.h"
+#include "tspline/spline/element_map.h"
 #include "tspline/validity/map_quality.h"
 
 namespace tspline::io {
@@ -72,10 +73,11 @@ toolkit::io::VtuMesh bezier_vtu(const TSplineMap& map, const MapCertification* c
     // The fields at the 4 x 4 equispaced points, and W = sum w_k B_k there.
     const Matrix4 W = M * w * M.transpose();  // W(a, b) at (s, t) = (a/3, b/3)
     std::array<Matrix4, 5> F;                 // J_r, det J, scaled Jacobian, xi, eta
+    const ElementMap element_map(el, P);
     for (int b = 0; b < 4; ++b)
       for (int a = 0; a < 4; ++a) {
         const Eigen::Vector2d uv = el.lo + Eigen::Vector2d(a / 3.0, b / 3.0).cwiseProduct(el.hi - el.lo);
-        const Eigen::Matrix2d J = map.derivatives(uv, 1, el.cell).J;
+        const Eigen::Matrix2d J = element_map.at_local(a / 3.0, b / 3.0).J;
         F[0](a, b) = mean_ratio_jacobian(J), F[1](a, b) = J.determinant(), F[2](a, b) = scaled_jacobian(J);
         F[3](a, b) = uv.x(), F[4](a, b) = uv.y();
       }

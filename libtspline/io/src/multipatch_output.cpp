@@ -1,7 +1,9 @@
 #include "tspline/io/multipatch_output.h"
 
 #include <filesystem>
+#include <deque>
 #include <functional>
+#include <future>
 #include <type_traits>
 #include <utility>
 
@@ -104,6 +106,19 @@ toolkit::io::VtuMesh merge(Parts& parts) {
   return out;
 }
 
+// The bytes of a mesh's arrays, roughly (the vectors' contents).
+std::size_t approximate_bytes(const toolkit::io::VtuMesh& m) {
+  std::size_t bytes = m.points.size() * sizeof(Eigen::Vector2d) + m.points3d.size() * sizeof(Eigen::Vector3d);
+  for (const std::vector<int>& c : m.cells) bytes += sizeof(c) + c.size() * sizeof(int);
+  for (const auto& [k, v] : m.point_scalars) bytes += v.size() * sizeof(double);
+  for (const auto& [k, v] : m.cell_scalars) bytes += v.size() * sizeof(double);
+  for (const auto& [k, v] : m.point_ints) bytes += v.size() * sizeof(int);
+  for (const auto& [k, v] : m.cell_ints) bytes += v.size() * sizeof(int);
+  for (const auto& [k, v] : m.point_vectors) bytes += v.size() * sizeof(Eigen::Vector2d);
+  for (const auto& [k, v] : m.cell_vectors) bytes += v.size() * sizeof(Eigen::Vector2d);
+  return bytes + m.cell_types.size() * sizeof(int) + m.higher_order_degrees.size() * sizeof(std::array<int, 3>);
+}
+
 }  // namespace
 
 toolkit::io::VtuMesh merge_patches(const std::vector<toolkit::io::VtuMesh>& parts) { return merge(parts); }
@@ -194,9 +209,12 @@ void write_multipatch_outputs(const MultiPatchResult& R, const std::string& out_
   }
   write_multipatch_file((dir / output_files::kTSpline).string(), maps, metas, R.layout.interfaces, R.layout.cuts,
                         report.value("input", ""));
-  // One VTU file at a time: its patches' parts built on the pool's threads,
-  // merged and written; only one file's parts are in memory at a time (a sea
-  // of 9,000 patches: writing all six at once took 0.9 GiB more).
+  // One VTU file at a time: its patches' parts built on the pool's threads
+  // and merged. The writing (VTK's zlib compression is serial) runs on threads
+  // of its own, one file after the other, while the next files' parts are
+  // built, as long as the merged files waiting to be written fit in
+  // kWritingBytes; a larger file is written before the next is built (a sea of
+  // 9,000 patches: writing all six at once took 0.9 GiB more).
   using Part = std::function<toolkit::io::VtuMesh(std::size_t)>;
   const std::vector<std::pair<std::string_view, Part>> files = {
       {output_files::kSurface, [&](std::size_t p) { return surface_vtu(*R.patches[p].map, samples); }},
@@ -212,6 +230,18 @@ void write_multipatch_outputs(const MultiPatchResult& R, const std::string& out_
            uv[v] = mesh.vertex_param(v) + Eigen::Vector2d(1.25 * static_cast<double>(p), 0.0);
          return tmesh_vtu(mesh, uv);
        }}};
+  constexpr std::size_t kWritingBytes = std::size_t{256} << 20;
+  struct Writing {
+    std::shared_future<void> done;
+    std::size_t bytes = 0;
+  };
+  std::deque<Writing> writing;  // in the order of the files; each waits for the one before
+  std::size_t writing_bytes = 0;
+  auto wait_oldest = [&] {
+    writing.front().done.get();  // raises the write's error, if any
+    writing_bytes -= writing.front().bytes;
+    writing.pop_front();
+  };
   for (const auto& [name, part] : files) {
     toolkit::io::VtuMesh merged;
     {
@@ -221,8 +251,24 @@ void write_multipatch_outputs(const MultiPatchResult& R, const std::string& out_
       }, 2);
       merged = merge_patches(std::move(parts));
     }
-    toolkit::io::write_vtu((dir / name).string(), std::move(merged));
+    const std::size_t bytes = approximate_bytes(merged);
+    while (!writing.empty() && writing_bytes + bytes > kWritingBytes) wait_oldest();
+    const std::string path = (dir / name).string();
+    if (bytes > kWritingBytes) {
+      toolkit::io::write_vtu(path, std::move(merged));
+      continue;
+    }
+    std::shared_future<void> before = writing.empty() ? std::shared_future<void>() : writing.back().done;
+    writing.push_back({std::async(std::launch::async,
+                                  [path, before, mesh = std::move(merged)]() mutable {
+                                    if (before.valid()) before.get();  // a failed write stops the later ones
+                                    toolkit::io::write_vtu(path, std::move(mesh));
+                                  })
+                           .share(),
+                       bytes});
+    writing_bytes += bytes;
   }
+  while (!writing.empty()) wait_oldest();
   toolkit::io::write_text_atomic((dir / output_files::kReport).string(), report.dump(2) + "\n");
 }
 

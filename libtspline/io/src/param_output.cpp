@@ -18,6 +18,7 @@
 #include "tspline/io/output_files.h"
 #include "tspline/io/tspline_file.h"
 #include "tspline/spline/bezier_extraction.h"
+#include "tspline/spline/element_map.h"
 #include "tspline/validity/map_certification.h"
 #include "tspline/validity/map_quality.h"
 #include "tspline/validity/map_quality_bounds.h"
@@ -27,8 +28,12 @@ namespace tspline::io {
 toolkit::io::VtuMesh surface_vtu(const TSplineMap& map, int k) {
   std::vector<double> jr, det, js;
   std::vector<Eigen::Vector2d> param;
+  // The samples of a cell from its Bezier elements (element_map.h).
+  const BezierExtraction extraction(map.basis());
+  CellMapEvaluator cell_map(extraction, map.control_points());
   toolkit::io::VtuMesh out = cell_grid_vtu(map.mesh(), k, [&](int c, const Eigen::Vector2d& uv) {
-    const MapDerivatives d = map.derivatives(uv, 1, c);
+    cell_map.set_cell(c);
+    const MapDerivatives d = cell_map.at(uv);
     jr.push_back(mean_ratio_jacobian(d.J));
     det.push_back(d.J.determinant());
     js.push_back(scaled_jacobian(d.J));
@@ -91,10 +96,13 @@ toolkit::io::VtuMesh physical_tmesh_vtu(const TSplineMap& map, int k, const MapC
   // One point per parametric position: a segment is sampled from its
   // lexicographically smaller end, so both cells along it get the same doubles.
   std::map<std::pair<double, double>, int> index;
+  const BezierExtraction extraction(map.basis());
+  CellMapEvaluator cell_map(extraction, map.control_points());
   auto point = [&](const Eigen::Vector2d& uv, int c, int v) {
     const auto [it, added] = index.emplace(std::make_pair(uv.x(), uv.y()), static_cast<int>(out.points.size()));
     if (added) {
-      out.points.push_back(map.derivatives(uv, 0, c).x);
+      cell_map.set_cell(c);
+      out.points.push_back(cell_map.at(uv).x);
       param.push_back(uv);
       vertex.push_back(v);
       hanging.push_back(v >= 0 && mesh.vertex_is_hanging(v) ? 1 : 0);
@@ -126,9 +134,11 @@ toolkit::io::VtuMesh physical_tmesh_vtu(const TSplineMap& map, int k, const MapC
     certified[c] = certificate ? (certificate->cell_certified[c] ? 1 : 0) : -1;
     valid[c] = certificate ? certified[c] : quality ? ((*quality)[c].min_det > 0.0 ? 1 : 0) : -1;
   }
-  if (certificate) {
-    // The certified bounds per cell: the minimum over its Bezier elements.
-    const BezierExtraction extraction(map.basis());
+  if (certificate && certificate->cell_det_lower_bound.size() == mesh.num_cells()) {
+    lower = certificate->cell_det_lower_bound;  // the minimum over the cell's Bezier elements
+    relative = certificate->cell_relative_lower_bound;
+  } else if (certificate) {
+    // A certificate without the bounds per cell (made elsewhere): the elements again.
     const std::vector<Eigen::Vector2d>& P = map.control_points();
     for (const BezierElement& e : extraction.elements()) {
       const ElementCertificate cert = certify_element(e, P, options);

@@ -164,6 +164,8 @@ MapCertification certify_map(const BezierExtraction& extraction, std::size_t num
   const std::vector<BezierElement>& es = extraction.elements();
   // One partial result per range of elements, merged in order (failures by element).
   std::vector<MapCertification> part(static_cast<std::size_t>(detail::pool_threads()));
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  std::vector<double> element_det(es.size(), nan), element_relative(es.size(), nan);
   detail::parallel_ranges(es.size(), detail::pool_threads(), [&](std::size_t b, std::size_t end, int slot) {
     MapCertification& r = part[slot];
     r.min_relative_lower_bound = std::numeric_limits<double>::infinity();
@@ -172,6 +174,7 @@ MapCertification certify_map(const BezierExtraction& extraction, std::size_t num
       if (only && !(*only)[k]) continue;
       const BezierElement& e = es[k];
       const ElementCertificate cert = certify_element(e, P, opt);
+      element_det[k] = cert.det_lower_bound, element_relative[k] = cert.relative_lower_bound;
       ++r.elements;
       r.max_depth_used = std::max(r.max_depth_used, cert.depth);
       r.min_relative_lower_bound = std::min(r.min_relative_lower_bound, cert.relative_lower_bound);
@@ -192,6 +195,14 @@ MapCertification certify_map(const BezierExtraction& extraction, std::size_t num
   }, 64);
   MapCertification r;
   r.cell_certified.assign(num_cells, 1);
+  r.cell_det_lower_bound.assign(num_cells, nan), r.cell_relative_lower_bound.assign(num_cells, nan);
+  for (std::size_t k = 0; k < es.size(); ++k) {
+    if (std::isnan(element_det[k])) continue;
+    double& d = r.cell_det_lower_bound[es[k].cell];
+    double& q = r.cell_relative_lower_bound[es[k].cell];
+    d = std::isnan(d) ? element_det[k] : std::min(d, element_det[k]);
+    q = std::isnan(q) ? element_relative[k] : std::min(q, element_relative[k]);
+  }
   r.min_relative_lower_bound = std::numeric_limits<double>::infinity();
   r.min_det_lower_bound = std::numeric_limits<double>::infinity();
   for (MapCertification& p : part) {

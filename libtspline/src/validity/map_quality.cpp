@@ -4,6 +4,7 @@
 #include "tspline/detail/tensor_grid.h"
 #include "tspline/detail/thread_pool.h"
 #include "tspline/spline/bezier_extraction.h"
+#include "tspline/spline/element_map.h"
 
 #include <Eigen/LU>
 #include <algorithm>
@@ -23,43 +24,6 @@ double scaled_jacobian(const Eigen::Matrix2d& J) {
   return n > 0.0 ? J.determinant() / n : 0.0;
 }
 
-namespace {
-
-// J = dS/d(xi, eta) at local (s, t) of element e, from the map's Bernstein
-// coefficients on e relative to the point c (X - c w, Y - c w; w = sum C).
-Eigen::Matrix2d element_jacobian_at(const BezierElement& e, const double* X, const double* Y, const double* W, double s,
-                                    double t) {
-  const std::array<double, 4> bs = bernstein3(s), bt = bernstein3(t);
-  const double rs = 1.0 - s, rt = 1.0 - t;
-  const double ds[4] = {-3.0 * rs * rs, 3.0 * rs * rs - 6.0 * s * rs, 6.0 * s * rs - 3.0 * s * s, 3.0 * s * s};
-  const double dt[4] = {-3.0 * rt * rt, 3.0 * rt * rt - 6.0 * t * rt, 6.0 * t * rt - 3.0 * t * t, 3.0 * t * t};
-  double v[3] = {}, vs[3] = {}, vt[3] = {};
-  const double* c[3] = {X, Y, W};
-  for (int j = 0; j < 4; ++j)
-    for (int i = 0; i < 4; ++i) {
-      const double b = bs[i] * bt[j], bS = ds[i] * bt[j], bT = bs[i] * dt[j];
-      for (int f = 0; f < 3; ++f) v[f] += c[f][i + 4 * j] * b, vs[f] += c[f][i + 4 * j] * bS, vt[f] += c[f][i + 4 * j] * bT;
-    }
-  const double iw = 1.0 / v[2], hx = e.hi.x() - e.lo.x(), hy = e.hi.y() - e.lo.y();
-  Eigen::Matrix2d J;
-  J << (vs[0] - v[0] * vs[2] * iw) * iw / hx, (vt[0] - v[0] * vt[2] * iw) * iw / hy,
-      (vs[1] - v[1] * vs[2] * iw) * iw / hx, (vt[1] - v[1] * vt[2] * iw) * iw / hy;
-  return J;
-}
-
-// The Bernstein coefficients of the map on e relative to c = a control point of e.
-void element_coefficients(const BezierElement& e, const std::vector<Eigen::Vector2d>& P, double* X, double* Y,
-                          double* W) {
-  const Eigen::Vector2d c = P[e.functions.front()];
-  std::fill(X, X + 16, 0.0), std::fill(Y, Y + 16, 0.0), std::fill(W, W + 16, 0.0);
-  for (Eigen::Index r = 0; r < e.C.rows(); ++r) {
-    const Eigen::Vector2d d = P[e.functions[r]] - c;
-    for (int i = 0; i < 16; ++i) X[i] += d.x() * e.C(r, i), Y[i] += d.y() * e.C(r, i), W[i] += e.C(r, i);
-  }
-}
-
-}  // namespace
-
 MapQualityStats map_quality(const TSplineMap& map, int gauss, std::vector<CellMapQuality>* per_cell) {
   return map_quality(map, BezierExtraction(map.basis()), gauss, per_cell);
 }
@@ -72,20 +36,16 @@ MapQualityStats map_quality(const TSplineMap& map, const BezierExtraction& extra
   const int nc = static_cast<int>(mesh.num_cells());
   // Each Gauss point of a cell on the Bezier element of the cell that holds it
   // (the elements tile the cell), evaluated from the element's coefficients.
-  const std::vector<BezierElement>& es = extraction.elements();
   const std::vector<Eigen::Vector2d>& P = map.control_points();
   std::vector<CellMapQuality> cells(static_cast<std::size_t>(nc));
   std::vector<double> cell_sum(static_cast<std::size_t>(nc), 0.0), cell_max_det(static_cast<std::size_t>(nc));
   std::vector<std::size_t> cell_nonpositive(static_cast<std::size_t>(nc), 0);
   detail::parallel_ranges(static_cast<std::size_t>(nc), detail::pool_threads(), [&](std::size_t b, std::size_t end, int) {
-    std::vector<std::array<double, 48>> coeffs;
+    CellMapEvaluator cell_map(extraction, P);
     for (std::size_t cu = b; cu < end; ++cu) {
       const int c = static_cast<int>(cu);
       const Eigen::Vector2d lo = mesh.cell_min(c), hi = mesh.cell_max(c);
-      const std::size_t e0 = extraction.cell_begin(c), e1 = extraction.cell_begin(c + 1);
-      coeffs.resize(e1 - e0);
-      for (std::size_t k = e0; k < e1; ++k)
-        element_coefficients(es[k], P, coeffs[k - e0].data(), coeffs[k - e0].data() + 16, coeffs[k - e0].data() + 32);
+      cell_map.set_cell(c);
       CellMapQuality q;
       q.min_det = std::numeric_limits<double>::infinity();
       double sum = 0.0, max_det = -std::numeric_limits<double>::infinity();
@@ -93,13 +53,7 @@ MapQualityStats map_quality(const TSplineMap& map, const BezierExtraction& extra
       for (double a : gp)
         for (double bb : gp) {
           const Eigen::Vector2d uv(lo.x() + a * (hi.x() - lo.x()), lo.y() + bb * (hi.y() - lo.y()));
-          std::size_t k = e0;
-          while (k + 1 < e1 && !(uv.x() >= es[k].lo.x() && uv.x() < es[k].hi.x() && uv.y() >= es[k].lo.y() &&
-                                 uv.y() < es[k].hi.y()))
-            ++k;
-          const Eigen::Vector2d st = es[k].local(uv);
-          const double* cf = coeffs[k - e0].data();
-          const Eigen::Matrix2d J = element_jacobian_at(es[k], cf, cf + 16, cf + 32, st.x(), st.y());
+          const Eigen::Matrix2d J = cell_map.at(uv).J;
           const double det = J.determinant(), jr = mean_ratio_jacobian(J), js = scaled_jacobian(J);
           q.min_mean_ratio = std::min(q.min_mean_ratio, jr);
           q.min_det = std::min(q.min_det, det);
@@ -159,11 +113,10 @@ DenseMapQuality dense_map_quality(const BezierExtraction& extraction, const std:
       ++q.elements;
       // S - c = (X - c w) / w: coefficients relative to a control point of the
       // element, so that far-from-origin coordinates do not cancel in the derivatives.
-      double X[16], Y[16], W[16];
-      element_coefficients(e, P, X, Y, W);
-      detail::tensor_values(grid, X, x, xs, xt, scratch.data());
-      detail::tensor_values(grid, Y, y, ys, yt, scratch.data());
-      detail::tensor_values(grid, W, w, ws, wt, scratch.data());
+      const ElementMap em(e, P);
+      detail::tensor_values(grid, em.X, x, xs, xt, scratch.data());
+      detail::tensor_values(grid, em.Y, y, ys, yt, scratch.data());
+      detail::tensor_values(grid, em.W, w, ws, wt, scratch.data());
       const double hx = e.hi.x() - e.lo.x(), hy = e.hi.y() - e.lo.y();
       for (int j = 0; j <= k; ++j)
         for (int i = 0; i <= k; ++i) {

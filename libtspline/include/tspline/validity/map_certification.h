@@ -91,6 +91,10 @@ struct MapCertification {
   double min_det_lower_bound = 0.0;  ///< min over elements, parametric coordinates
   int max_depth_used = 0;
   std::vector<char> cell_certified;  ///< per T-mesh cell: all its elements certified
+  /// Per T-mesh cell, the minimum over its elements of det_lower_bound and of
+  /// relative_lower_bound (ElementCertificate); NaN for a cell none of whose
+  /// elements was examined (certify_map with `only`).
+  std::vector<double> cell_det_lower_bound, cell_relative_lower_bound;
   std::vector<CertificationFailure> failures;
   double seconds = 0.0;
   bool certified_valid() const { return elements > 0 && certified == elements; }
