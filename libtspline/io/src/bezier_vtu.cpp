@@ -64,6 +64,10 @@ toolkit::io::VtuMesh bezier_vtu(const TSplineMap& map, const MapCertification* c
   std::vector<double> weight(np), jr(np), det(np), sj(np);
   std::vector<Eigen::Vector2d> param(np), lo, hi;
   std::vector<int> cell, level, patch;
+  out.cells.reserve(elements.size()), out.cell_types.reserve(elements.size());
+  out.higher_order_degrees.reserve(elements.size());
+  cell.reserve(elements.size()), level.reserve(elements.size()), patch.reserve(elements.size());
+  lo.reserve(elements.size()), hi.reserve(elements.size());
   for (std::size_t e = 0; e < elements.size(); ++e) {
     const BezierElement& el = elements[e];
     const Eigen::Matrix<double, 16, 3> H = homogeneous_bezier_points(el, P);  // (X_k, w_k), k = i + 4 j

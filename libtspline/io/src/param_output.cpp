@@ -26,8 +26,11 @@
 namespace tspline::io {
 
 toolkit::io::VtuMesh surface_vtu(const TSplineMap& map, int k) {
+  if (k < 1 || k > 64) throw std::invalid_argument("samples per cell edge must be in [1, 64]");
   std::vector<double> jr, det, js;
   std::vector<Eigen::Vector2d> param;
+  const std::size_t points = map.mesh().num_cells() * static_cast<std::size_t>((k + 1) * (k + 1));
+  jr.reserve(points), det.reserve(points), js.reserve(points), param.reserve(points);
   // The samples of a cell from its Bezier elements (element_map.h).
   const BezierExtraction extraction(map.basis());
   CellMapEvaluator cell_map(extraction, map.control_points());
@@ -148,6 +151,10 @@ toolkit::io::VtuMesh physical_tmesh_vtu(const TSplineMap& map, int k, const MapC
       r = std::isnan(r) ? cert.relative_lower_bound : std::min(r, cert.relative_lower_bound);
     }
   }
+  // The points were counted as they came: the arrays at their final size (all
+  // patches' parts are held at once before they are merged).
+  out.points.shrink_to_fit(), param.shrink_to_fit(), vertex.shrink_to_fit();
+  hanging.shrink_to_fit(), boundary.shrink_to_fit();
   out.cell_ints["level"] = std::move(level);
   out.cell_ints["valid"] = std::move(valid);
   out.cell_ints["certified"] = std::move(certified);
