@@ -213,6 +213,64 @@ TEST_SUITE("io") {
     }
   }
 
+  TEST_CASE("merge_vtu, write_vtu_parts and write_vtu_pieces: the parts as one mesh, the same file contents") {
+    TempDir dir;
+    // Three parts: the sample mesh, the same moved (an extra array that the
+    // others lack is dropped), and a triangle.
+    std::vector<VtuMesh> parts = {sample_mesh(), sample_mesh(), sample_mesh()};
+    for (Eigen::Vector2d& p : parts[1].points) p += Eigen::Vector2d(10.0, -3.0);
+    parts[1].point_scalars["only_here"] = std::vector<double>(parts[1].points.size(), 1.0);
+    parts[2].points = {{0.0, 0.0}, {1.0, 0.0}, {0.0, 1.0}};
+    parts[2].cells = {{0, 1, 2}};
+    for (auto& [name, v] : parts[2].point_scalars) v = {1.0, 2.0, 3.0};
+    parts[2].point_ints["id"] = {7, 8, 9};
+    parts[2].point_vectors["velocity"] = {{1, 2}, {3, 4}, {5, 6}};
+    parts[2].cell_scalars["quality"] = {0.5};
+    parts[2].cell_ints = {{"kind", {3}}, {"region", {9}}};
+    const VtuMesh merged = merge_vtu(parts, "part");
+    REQUIRE(merged.points.size() == 8 + 8 + 3);
+    REQUIRE(merged.cells.size() == 4 + 4 + 1);
+    CHECK(merged.cells[4] == std::vector<int>{8, 9, 10, 11});  // offset by the first part's 8 points
+    CHECK(merged.cells[8] == std::vector<int>{16, 17, 18});
+    CHECK(merged.points[9] == parts[1].points[1]);
+    CHECK(merged.point_scalars.count("only_here") == 0);
+    CHECK(merged.cell_ints.at("part") == std::vector<int>{0, 0, 0, 0, 1, 1, 1, 1, 2});
+    CHECK(merged.cell_ints.at("region") == std::vector<int>{1, 1, 2, 3, 1, 1, 2, 3, 9});
+    CHECK(merged.point_ints.at("id")[17] == 8);
+    // The merged mesh written whole, the parts written without merging, and
+    // the parts as pieces (one part per piece, its part index added): VTK
+    // reads the same grid from all three.
+    write_vtu(dir / "merged.vtu", merged);
+    std::vector<VtuMesh> copy = parts;
+    write_vtu_parts(dir / "parts.vtu", std::move(copy), "part");
+    CHECK(copy.empty());
+    CHECK(read_all(dir / "parts.vtu") == read_all(dir / "merged.vtu"));  // byte for byte
+    int made = 0;
+    write_vtu_pieces(dir / "pieces.vtu", 3, [&](int i) {
+      ++made;
+      VtuMesh piece = parts[static_cast<std::size_t>(i)];
+      piece.point_scalars.erase("only_here");
+      piece.cell_ints["part"] = std::vector<int>(piece.cells.size(), i);
+      return piece;
+    });
+    CHECK(made == 3);
+    const std::string text = read_all(dir / "pieces.vtu");
+    std::size_t pieces = 0;
+    for (std::size_t at = text.find("<Piece"); at != std::string::npos; at = text.find("<Piece", at + 1)) ++pieces;
+    CHECK(pieces == 3);
+    check_same(merged, read_vtu(dir / "pieces.vtu"));
+    check_same(merged, read_vtu(dir / "parts.vtu"));
+    // A piece that cannot be made: its error, and no file.
+    CHECK_THROWS_WITH_AS(write_vtu_pieces(dir / "broken.vtu", 2,
+                                          [&](int i) -> VtuMesh {
+                                            if (i == 1) throw std::runtime_error("piece 1 failed");
+                                            return parts[0];
+                                          }),
+                         "piece 1 failed", std::runtime_error);
+    CHECK_FALSE(fs::exists(dir / "broken.vtu"));
+    CHECK_THROWS_AS(write_vtu_pieces(dir / "none.vtu", 0, [&](int) { return parts[0]; }), std::invalid_argument);
+  }
+
   TEST_CASE("write_vtu: empty mesh and mesh without arrays") {
     TempDir dir;
     VtuMesh empty;

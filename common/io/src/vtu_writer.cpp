@@ -8,7 +8,12 @@
 #include <vtkErrorCode.h>
 #include <vtkExecutive.h>
 #include <vtkIdTypeArray.h>
+#include <vtkInformation.h>
+#include <vtkInformationVector.h>
 #include <vtkIntArray.h>
+#include <vtkObjectFactory.h>
+#include <vtkStreamingDemandDrivenPipeline.h>
+#include <vtkUnstructuredGridAlgorithm.h>
 #include <vtkNew.h>
 #include <vtkPointData.h>
 #include <vtkPoints.h>
@@ -16,11 +21,15 @@
 #include <vtkUnstructuredGrid.h>
 #include <vtkXMLUnstructuredGridWriter.h>
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <cstring>
+#include <exception>
+#include <functional>
 #include <limits>
 #include <set>
+#include <span>
 #include <type_traits>
 #include <stdexcept>
 #include <string>
@@ -98,95 +107,240 @@ int cell_type(const std::vector<int>& cell, bool quads_as_polygons) {
   }
 }
 
-vtkNew<vtkDoubleArray> make_double_array(const std::string& name, const std::vector<double>& v) {
-  vtkNew<vtkDoubleArray> a;
-  a->SetName(name.c_str());
-  a->SetNumberOfComponents(1);
-  a->SetNumberOfTuples(static_cast<vtkIdType>(v.size()));
-  for (std::size_t i = 0; i < v.size(); ++i) a->SetValue(static_cast<vtkIdType>(i), v[i]);
-  return a;
+// ---------------------------------------------------------------- parts
+
+template <class Part>
+void release(Part&, auto& v) {
+  if constexpr (!std::is_const_v<Part>) std::decay_t<decltype(v)>().swap(v);
 }
 
-vtkNew<vtkDoubleArray> make_vector_array(const std::string& name, const std::vector<Eigen::Vector2d>& v) {
-  vtkNew<vtkDoubleArray> a;
-  a->SetName(name.c_str());
-  a->SetNumberOfComponents(3);
-  a->SetNumberOfTuples(static_cast<vtkIdType>(v.size()));
-  for (std::size_t i = 0; i < v.size(); ++i) {
-    const double t[3] = {v[i].x(), v[i].y(), 0.0};
-    a->SetTypedTuple(static_cast<vtkIdType>(i), t);
+// What a sequence of parts makes as one mesh (merge_vtu): the array names that
+// every part has, and whether cell types, degrees and weights are kept.
+struct PartsLayout {
+  bool quads_as_polygons = true;
+  std::set<std::string> point_scalars, point_ints, point_vectors, cell_scalars, cell_ints, cell_vectors;
+  bool typed = true, degrees = true;
+  std::string rational_weights;
+  std::vector<std::size_t> point_offset;  // per part, and the total at the end
+  std::size_t cells = 0, connectivity = 0;
+};
+
+template <class Map>
+std::set<std::string> common_names(std::span<const VtuMesh> parts, Map VtuMesh::*member) {
+  std::set<std::string> names;
+  if (parts.empty()) return names;
+  for (const auto& [name, values] : parts.front().*member) names.insert(name);
+  for (const VtuMesh& p : parts.subspan(1))
+    std::erase_if(names, [&](const std::string& n) { return !(p.*member).count(n); });
+  return names;
+}
+
+PartsLayout parts_layout(std::span<const VtuMesh> parts, const std::string& part_array) {
+  PartsLayout L;
+  if (!parts.empty()) {
+    L.quads_as_polygons = parts.front().quads_as_polygons;
+    L.rational_weights = parts.front().rational_weights;
   }
-  return a;
+  L.point_scalars = common_names(parts, &VtuMesh::point_scalars);
+  L.point_ints = common_names(parts, &VtuMesh::point_ints);
+  L.point_vectors = common_names(parts, &VtuMesh::point_vectors);
+  L.cell_scalars = common_names(parts, &VtuMesh::cell_scalars);
+  L.cell_ints = common_names(parts, &VtuMesh::cell_ints);
+  L.cell_vectors = common_names(parts, &VtuMesh::cell_vectors);
+  if (!part_array.empty()) {
+    L.cell_scalars.erase(part_array), L.cell_vectors.erase(part_array);
+    L.cell_ints.insert(part_array);
+  }
+  std::size_t points = 0;
+  for (const VtuMesh& p : parts) {
+    L.point_offset.push_back(points);
+    points += p.points.size() + p.points3d.size();
+    L.cells += p.cells.size();
+    for (const auto& cell : p.cells) L.connectivity += cell.size();
+    L.typed = L.typed && p.cell_types.size() == p.cells.size();
+    L.degrees = L.degrees && p.higher_order_degrees.size() == p.cells.size();
+    if (p.rational_weights != L.rational_weights) L.rational_weights.clear();
+  }
+  L.point_offset.push_back(points);
+  if (!L.point_scalars.count(L.rational_weights)) L.rational_weights.clear();
+  if (points > static_cast<std::size_t>(std::numeric_limits<int>::max()))
+    throw std::invalid_argument("write_vtu: too many points");
+  return L;
 }
 
-vtkNew<vtkIntArray> make_int_array(const std::string& name, const std::vector<int>& v) {
-  vtkNew<vtkIntArray> a;
-  a->SetName(name.c_str());
-  a->SetNumberOfComponents(1);
-  a->SetNumberOfTuples(static_cast<vtkIdType>(v.size()));
-  for (std::size_t i = 0; i < v.size(); ++i) a->SetValue(static_cast<vtkIdType>(i), v[i]);
-  return a;
+// Each part's values of array `name` one after the other, through put(i, value).
+template <class Part, class Map, class Put>
+void gather(std::span<Part> parts, Map VtuMesh::*member, const std::string& name, Put put) {
+  vtkIdType i = 0;
+  for (Part& p : parts) {
+    auto& values = (p.*member).at(name);
+    for (const auto& x : values) put(i++, x);
+    release(p, values);
+  }
 }
 
-// The grid of `mesh`. With a non-const mesh (write_vtu(path, VtuMesh&&)) each
-// of its arrays is released once VTK has its copy, so that the two are never
-// whole at once (a sea of 9,000 patches: surface.vtu's mesh and its grid
-// were 1 GB together).
-template <class Mesh>
-vtkNew<vtkUnstructuredGrid> build_grid(Mesh& mesh) {
-  auto release = [](auto& v) {
-    if constexpr (!std::is_const_v<std::remove_reference_t<decltype(v)>>) std::decay_t<decltype(v)>().swap(v);
-  };
+// Each cell's part index.
+template <class Part>
+std::vector<int> part_index(std::span<Part> parts, std::size_t cells) {
+  std::vector<int> index;
+  index.reserve(cells);
+  for (std::size_t k = 0; k < parts.size(); ++k) index.insert(index.end(), parts[k].cells.size(), static_cast<int>(k));
+  return index;
+}
+
+// The grid of the parts as one mesh (merge_vtu). With non-const parts
+// (write_vtu(path, VtuMesh&&), write_vtu_parts) each of their arrays is
+// released once VTK has its copy, so that the two are never whole at once (a
+// sea of 9,000 patches: surface.vtu's mesh and its grid were 1 GB together).
+template <class Part>
+vtkNew<vtkUnstructuredGrid> build_grid(std::span<Part> parts, const std::string& part_array) {
+  const PartsLayout L = parts_layout(std::span<const VtuMesh>(parts.data(), parts.size()), part_array);
   vtkNew<vtkUnstructuredGrid> grid;
 
   vtkNew<vtkPoints> points;
   points->SetDataTypeToDouble();
-  points->SetNumberOfPoints(static_cast<vtkIdType>(mesh.points.size() + mesh.points3d.size()));
-  for (std::size_t i = 0; i < mesh.points.size(); ++i)
-    points->SetPoint(static_cast<vtkIdType>(i), mesh.points[i].x(), mesh.points[i].y(), 0.0);
-  for (std::size_t i = 0; i < mesh.points3d.size(); ++i)
-    points->SetPoint(static_cast<vtkIdType>(i), mesh.points3d[i].x(), mesh.points3d[i].y(), mesh.points3d[i].z());
+  points->SetNumberOfPoints(static_cast<vtkIdType>(L.point_offset.back()));
+  vtkIdType at = 0;
+  for (Part& p : parts) {
+    for (const Eigen::Vector2d& x : p.points) points->SetPoint(at++, x.x(), x.y(), 0.0);
+    for (const Eigen::Vector3d& x : p.points3d) points->SetPoint(at++, x.x(), x.y(), x.z());
+    release(p, p.points), release(p, p.points3d);
+  }
   grid->SetPoints(points);
-  release(mesh.points), release(mesh.points3d);
 
+  // Part indices before the parts' cells are released.
+  std::vector<int> index = part_array.empty() ? std::vector<int>() : part_index(parts, L.cells);
   vtkNew<vtkCellArray> cells;
   vtkNew<vtkUnsignedCharArray> types;
-  types->SetNumberOfTuples(static_cast<vtkIdType>(mesh.cells.size()));
-  std::size_t connectivity = 0;
-  for (const auto& cell : mesh.cells) connectivity += cell.size();
-  cells->AllocateExact(static_cast<vtkIdType>(mesh.cells.size()), static_cast<vtkIdType>(connectivity));
+  types->SetNumberOfTuples(static_cast<vtkIdType>(L.cells));
+  cells->AllocateExact(static_cast<vtkIdType>(L.cells), static_cast<vtkIdType>(L.connectivity));
   std::vector<vtkIdType> ids;
-  for (std::size_t c = 0; c < mesh.cells.size(); ++c) {
-    const auto& cell = mesh.cells[c];
-    ids.assign(cell.begin(), cell.end());
-    cells->InsertNextCell(static_cast<vtkIdType>(ids.size()), ids.data());
-    const int type = mesh.cell_types.empty() ? cell_type(cell, mesh.quads_as_polygons) : mesh.cell_types[c];
-    types->SetValue(static_cast<vtkIdType>(c), static_cast<unsigned char>(type));
+  vtkIdType c = 0;
+  for (std::size_t k = 0; k < parts.size(); ++k) {
+    Part& p = parts[k];
+    const vtkIdType offset = static_cast<vtkIdType>(L.point_offset[k]);
+    for (std::size_t i = 0; i < p.cells.size(); ++i) {
+      const auto& cell = p.cells[i];
+      ids.resize(cell.size());
+      for (std::size_t j = 0; j < cell.size(); ++j) ids[j] = cell[j] + offset;
+      cells->InsertNextCell(static_cast<vtkIdType>(ids.size()), ids.data());
+      const int type = L.typed ? p.cell_types[i] : cell_type(cell, L.quads_as_polygons);
+      types->SetValue(c++, static_cast<unsigned char>(type));
+    }
+    release(p, p.cells), release(p, p.cell_types);
   }
   grid->SetCells(types, cells);
-  release(mesh.cells), release(mesh.cell_types);
 
+  const vtkIdType np = static_cast<vtkIdType>(L.point_offset.back()), nc = static_cast<vtkIdType>(L.cells);
+  auto doubles = [&](const std::string& name, auto member, vtkIdType n) {
+    vtkNew<vtkDoubleArray> a;
+    a->SetName(name.c_str());
+    a->SetNumberOfTuples(n);
+    gather(parts, member, name, [&](vtkIdType i, double x) { a->SetValue(i, x); });
+    return a;
+  };
+  auto ints = [&](const std::string& name, auto member, vtkIdType n) {
+    vtkNew<vtkIntArray> a;
+    a->SetName(name.c_str());
+    a->SetNumberOfTuples(n);
+    if (name == part_array)
+      for (vtkIdType i = 0; i < n; ++i) a->SetValue(i, index[static_cast<std::size_t>(i)]);
+    else
+      gather(parts, member, name, [&](vtkIdType i, int x) { a->SetValue(i, x); });
+    return a;
+  };
+  auto vectors = [&](const std::string& name, auto member, vtkIdType n) {
+    vtkNew<vtkDoubleArray> a;
+    a->SetName(name.c_str());
+    a->SetNumberOfComponents(3);
+    a->SetNumberOfTuples(n);
+    gather(parts, member, name, [&](vtkIdType i, const Eigen::Vector2d& x) {
+      const double t[3] = {x.x(), x.y(), 0.0};
+      a->SetTypedTuple(i, t);
+    });
+    return a;
+  };
   vtkPointData* pd = grid->GetPointData();
-  for (auto& [name, v] : mesh.point_scalars) pd->AddArray(make_double_array(name, v)), release(v);
-  for (auto& [name, v] : mesh.point_ints) pd->AddArray(make_int_array(name, v)), release(v);
-  for (auto& [name, v] : mesh.point_vectors) pd->AddArray(make_vector_array(name, v)), release(v);
-  if (!mesh.rational_weights.empty())
-    pd->SetActiveAttribute(mesh.rational_weights.c_str(), vtkDataSetAttributes::RATIONALWEIGHTS);
+  for (const std::string& name : L.point_scalars) pd->AddArray(doubles(name, &VtuMesh::point_scalars, np));
+  for (const std::string& name : L.point_ints) pd->AddArray(ints(name, &VtuMesh::point_ints, np));
+  for (const std::string& name : L.point_vectors) pd->AddArray(vectors(name, &VtuMesh::point_vectors, np));
+  if (!L.rational_weights.empty())
+    pd->SetActiveAttribute(L.rational_weights.c_str(), vtkDataSetAttributes::RATIONALWEIGHTS);
   vtkCellData* cd = grid->GetCellData();
-  for (auto& [name, v] : mesh.cell_scalars) cd->AddArray(make_double_array(name, v)), release(v);
-  for (auto& [name, v] : mesh.cell_ints) cd->AddArray(make_int_array(name, v)), release(v);
-  for (auto& [name, v] : mesh.cell_vectors) cd->AddArray(make_vector_array(name, v)), release(v);
-  if (!mesh.higher_order_degrees.empty()) {
+  for (const std::string& name : L.cell_scalars) cd->AddArray(doubles(name, &VtuMesh::cell_scalars, nc));
+  for (const std::string& name : L.cell_ints) cd->AddArray(ints(name, &VtuMesh::cell_ints, nc));
+  for (const std::string& name : L.cell_vectors) cd->AddArray(vectors(name, &VtuMesh::cell_vectors, nc));
+  if (L.degrees && L.cells > 0) {
     vtkNew<vtkIntArray> a;
     a->SetName("HigherOrderDegrees");
     a->SetNumberOfComponents(3);
-    a->SetNumberOfTuples(static_cast<vtkIdType>(mesh.higher_order_degrees.size()));
-    for (std::size_t c = 0; c < mesh.higher_order_degrees.size(); ++c)
-      a->SetTypedTuple(static_cast<vtkIdType>(c), mesh.higher_order_degrees[c].data());
+    a->SetNumberOfTuples(nc);
+    vtkIdType i = 0;
+    for (Part& p : parts) {
+      for (const std::array<int, 3>& d : p.higher_order_degrees) a->SetTypedTuple(i++, d.data());
+      release(p, p.higher_order_degrees);
+    }
     cd->SetHigherOrderDegrees(a);
-    release(mesh.higher_order_degrees);
   }
   return grid;
+}
+
+// merge_vtu: the same rules as build_grid, into a VtuMesh.
+template <class Part>
+VtuMesh merge(std::span<Part> parts, const std::string& part_array) {
+  const PartsLayout L = parts_layout(std::span<const VtuMesh>(parts.data(), parts.size()), part_array);
+  VtuMesh out;
+  out.quads_as_polygons = L.quads_as_polygons;
+  out.rational_weights = L.rational_weights;
+  const std::size_t np = L.point_offset.back(), nc = L.cells;
+  std::vector<int> index = part_array.empty() ? std::vector<int>() : part_index(parts, nc);
+  // Every array at its final size at once (growing by doubling held up to
+  // twice the memory); 3D points if any part has them (the others at z = 0).
+  const bool three_d = std::any_of(parts.begin(), parts.end(), [](const VtuMesh& p) { return !p.points3d.empty(); });
+  if (three_d) out.points3d.reserve(np);
+  else out.points.reserve(np);
+  out.cells.reserve(nc);
+  for (std::size_t k = 0; k < parts.size(); ++k) {
+    Part& p = parts[k];
+    if (three_d) {
+      for (const Eigen::Vector2d& x : p.points) out.points3d.emplace_back(x.x(), x.y(), 0.0);
+      out.points3d.insert(out.points3d.end(), p.points3d.begin(), p.points3d.end());
+    } else {
+      out.points.insert(out.points.end(), p.points.begin(), p.points.end());
+    }
+    release(p, p.points), release(p, p.points3d);
+    const int offset = static_cast<int>(L.point_offset[k]);
+    for (auto& cell : p.cells) {
+      std::vector<int> moved;  // released parts give their cells away (no second allocation)
+      if constexpr (std::is_const_v<Part>) moved = cell;
+      else moved = std::move(cell);
+      for (int& i : moved) i += offset;
+      out.cells.push_back(std::move(moved));
+    }
+    release(p, p.cells);
+    if (L.typed) out.cell_types.insert(out.cell_types.end(), p.cell_types.begin(), p.cell_types.end());
+    if (L.degrees)
+      out.higher_order_degrees.insert(out.higher_order_degrees.end(), p.higher_order_degrees.begin(),
+                                      p.higher_order_degrees.end());
+    release(p, p.cell_types), release(p, p.higher_order_degrees);
+  }
+  auto collect = [&](const std::set<std::string>& names, auto member, std::size_t n) {
+    for (const std::string& name : names) {
+      auto& values = (out.*member)[name];
+      values.reserve(n);
+      gather(parts, member, name, [&](vtkIdType, const auto& x) { values.push_back(x); });
+    }
+  };
+  collect(L.point_scalars, &VtuMesh::point_scalars, np);
+  collect(L.point_ints, &VtuMesh::point_ints, np);
+  collect(L.point_vectors, &VtuMesh::point_vectors, np);
+  collect(L.cell_scalars, &VtuMesh::cell_scalars, nc);
+  std::set<std::string> cell_ints = L.cell_ints;
+  if (!part_array.empty()) cell_ints.erase(part_array);
+  collect(cell_ints, &VtuMesh::cell_ints, nc);
+  collect(L.cell_vectors, &VtuMesh::cell_vectors, nc);
+  if (!part_array.empty()) out.cell_ints[part_array] = std::move(index);
+  return out;
 }
 
 // ---------------------------------------------------------------- pvd
@@ -224,7 +378,44 @@ std::string format_double(double x) {
 
 namespace {
 
-void write_grid(const std::string& path, vtkUnstructuredGrid* grid) {
+// A source that makes piece i of n when the writer asks for it (VTK's
+// streaming: the writer writes the pieces one after the other into one file,
+// and only one piece is in memory at a time).
+class PieceSource : public vtkUnstructuredGridAlgorithm {
+ public:
+  static PieceSource* New();
+  vtkTypeMacro(PieceSource, vtkUnstructuredGridAlgorithm)
+  std::function<VtuMesh(int)> make;
+  std::exception_ptr error;  // of the first piece that could not be made
+
+ protected:
+  PieceSource() { SetNumberOfInputPorts(0); }
+  int RequestInformation(vtkInformation*, vtkInformationVector**, vtkInformationVector* out) override {
+    out->GetInformationObject(0)->Set(CAN_HANDLE_PIECE_REQUEST(), 1);
+    return 1;
+  }
+  int RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector* out) override {
+    vtkInformation* info = out->GetInformationObject(0);
+    const int piece = info->Get(vtkStreamingDemandDrivenPipeline::UPDATE_PIECE_NUMBER());
+    // After a failure the pieces are empty: returning 0 would make the writer
+    // ask for the piece again and again (VTK 9.1); the error is raised once
+    // Write() returns, and the temporary file is removed.
+    if (error) return 1;
+    try {
+      VtuMesh mesh = make(piece);
+      validate(mesh);
+      vtkNew<vtkUnstructuredGrid> grid = build_grid(std::span<VtuMesh>(&mesh, 1), "");
+      vtkUnstructuredGrid::GetData(info)->ShallowCopy(grid);
+    } catch (...) {
+      error = std::current_exception();
+    }
+    return 1;
+  }
+};
+vtkStandardNewMacro(PieceSource);
+
+// Writes the grid, or the source's pieces, atomically.
+void write_grid(const std::string& path, vtkUnstructuredGrid* grid, PieceSource* source = nullptr, int pieces = 1) {
   write_atomic(path, [&](const std::string& tmp) {
     vtkNew<vtkXMLUnstructuredGridWriter> writer;
     vtkNew<ErrorCollector> errors;
@@ -233,7 +424,12 @@ void write_grid(const std::string& path, vtkUnstructuredGrid* grid) {
     vtkNew<ErrorCollector> executive_errors;
     writer->GetExecutive()->AddObserver(vtkCommand::ErrorEvent, executive_errors);
     writer->SetFileName(tmp.c_str());
-    writer->SetInputData(grid);
+    if (source) {
+      writer->SetInputConnection(source->GetOutputPort());
+      writer->SetNumberOfPieces(pieces);
+    } else {
+      writer->SetInputData(grid);
+    }
     writer->SetDataModeToAppended();
     writer->EncodeAppendedDataOff();
     writer->SetCompressorTypeToZLib();
@@ -245,6 +441,7 @@ void write_grid(const std::string& path, vtkUnstructuredGrid* grid) {
     // Write() returns 1 even when the file could not be opened or written:
     // the error code is what tells.
     const int ok = writer->Write();
+    if (source && source->error) std::rethrow_exception(source->error);  // a piece could not be made
     const unsigned long code = writer->GetErrorCode();
     if (ok != 1 || code != vtkErrorCode::NoError || !errors->message.empty()) {
       std::string reason;
@@ -263,15 +460,39 @@ void write_grid(const std::string& path, vtkUnstructuredGrid* grid) {
 
 void write_vtu(const std::string& path, const VtuMesh& mesh) {
   validate(mesh);  // before anything touches the file system
-  vtkNew<vtkUnstructuredGrid> grid = build_grid(mesh);
+  vtkNew<vtkUnstructuredGrid> grid = build_grid(std::span<const VtuMesh>(&mesh, 1), "");
   write_grid(path, grid);
 }
 
 void write_vtu(const std::string& path, VtuMesh&& mesh) {
   validate(mesh);
-  vtkNew<vtkUnstructuredGrid> grid = build_grid(mesh);
+  vtkNew<vtkUnstructuredGrid> grid = build_grid(std::span<VtuMesh>(&mesh, 1), "");
   mesh = VtuMesh();
   write_grid(path, grid);
+}
+
+VtuMesh merge_vtu(const std::vector<VtuMesh>& parts, const std::string& part_array) {
+  return merge(std::span<const VtuMesh>(parts), part_array);
+}
+
+VtuMesh merge_vtu(std::vector<VtuMesh>&& parts, const std::string& part_array) {
+  VtuMesh out = merge(std::span<VtuMesh>(parts), part_array);
+  parts.clear();
+  return out;
+}
+
+void write_vtu_parts(const std::string& path, std::vector<VtuMesh>&& parts, const std::string& part_array) {
+  for (const VtuMesh& p : parts) validate(p);
+  vtkNew<vtkUnstructuredGrid> grid = build_grid(std::span<VtuMesh>(parts), part_array);
+  parts.clear();
+  write_grid(path, grid);
+}
+
+void write_vtu_pieces(const std::string& path, int pieces, const std::function<VtuMesh(int)>& piece) {
+  if (pieces < 1) throw std::invalid_argument("write_vtu_pieces: the number of pieces must be >= 1");
+  vtkNew<PieceSource> source;
+  source->make = piece;
+  write_grid(path, nullptr, source, pieces);
 }
 
 void write_pvd(const std::string& path, const std::vector<PvdEntry>& entries) {

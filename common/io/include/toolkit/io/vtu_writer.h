@@ -3,6 +3,7 @@
 // .pvd collections. Library-neutral mesh description so callers need no VTK.
 #include <Eigen/Core>
 #include <array>
+#include <functional>
 #include <map>
 #include <string>
 #include <vector>
@@ -43,6 +44,24 @@ void write_vtu(const std::string& path, const VtuMesh& mesh);
 /// The same, releasing each of `mesh`'s arrays as soon as VTK has its copy
 /// (the peak memory of a large mesh about halves); `mesh` is left empty.
 void write_vtu(const std::string& path, VtuMesh&& mesh);
+
+/// The meshes one after the other as one mesh: points and cells in order (each
+/// part's point indices offset by the points before it), with an Int32 cell
+/// array `part_array` (if not empty) holding each cell's part index. Arrays not
+/// present in every part are dropped, and so are cell types, higher-order
+/// degrees and rational weights unless every part has the same.
+VtuMesh merge_vtu(const std::vector<VtuMesh>& parts, const std::string& part_array = "");
+/// The same, releasing each part once it is appended (`parts` is left empty).
+VtuMesh merge_vtu(std::vector<VtuMesh>&& parts, const std::string& part_array = "");
+/// Writes merge_vtu(parts, part_array) without making it: the parts' arrays go
+/// to VTK one by one, each released once VTK has its copy, so that the parts
+/// and the written grid are never whole at once (`parts` is left empty).
+void write_vtu_parts(const std::string& path, std::vector<VtuMesh>&& parts, const std::string& part_array = "");
+/// Writes one .vtu file of `pieces` pieces (<Piece> elements; VTK readers and
+/// ParaView read them as one grid), piece i made by piece(i) when the writer
+/// gets to it and released once written: only one piece is in memory at a
+/// time. An exception from piece() is passed on (nothing is written).
+void write_vtu_pieces(const std::string& path, int pieces, const std::function<VtuMesh(int)>& piece);
 
 /// One dataset of a .pvd collection.
 struct PvdEntry {
