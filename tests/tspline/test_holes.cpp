@@ -367,6 +367,25 @@ TEST_SUITE("holes") {
       CHECK(flagged == 0);
       CHECK(uncertified == 0);
       CHECK(phys.cell_scalars.at("patch").back() == static_cast<double>(R.patches.size() - 1));
+
+      // The VTU files in pieces of one patch each: the same grids as in one piece.
+      const auto pieces_dir = test_support::scratch_dir("holes", "v2_pieces");
+      tspline::io::write_multipatch_outputs(R, pieces_dir.string(), report, 2, 1);
+      for (const char* f : {"surface.vtu", "surface_bezier.vtu", "physical_tmesh.vtu", "control_net.vtu",
+                            "boundary.vtu", "parametric_tmesh.vtu"}) {
+        CAPTURE(f);
+        const toolkit::io::VtuMesh one = toolkit::io::read_vtu((dir / f).string());
+        const toolkit::io::VtuMesh many = toolkit::io::read_vtu((pieces_dir / f).string());
+        CHECK(many.points == one.points);
+        CHECK(many.cells == one.cells);
+        CHECK(many.point_scalars == one.point_scalars);
+        CHECK(many.cell_scalars == one.cell_scalars);
+        std::size_t piece_tags = 0;
+        const std::string text = test_support::slurp(pieces_dir / f);
+        for (std::size_t at = text.find("<Piece"); at != std::string::npos; at = text.find("<Piece", at + 1))
+          ++piece_tags;
+        CHECK(piece_tags == R.patches.size());
+      }
     }
   }
 

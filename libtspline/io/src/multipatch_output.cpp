@@ -2,6 +2,8 @@
 
 #include <filesystem>
 #include <functional>
+#include <future>
+#include <stdexcept>
 #include <type_traits>
 #include <utility>
 
@@ -101,7 +103,7 @@ json multipatch_report(const MultiPatchResult& R, const std::string& input_path,
 }
 
 void write_multipatch_outputs(const MultiPatchResult& R, const std::string& out_dir, const json& report,
-                              int samples) {
+                              int samples, std::size_t piece_cells) {
   const std::filesystem::path dir(out_dir);
   const std::size_t n = R.patches.size();
   std::vector<const TSplineMap*> maps(n);
@@ -115,7 +117,7 @@ void write_multipatch_outputs(const MultiPatchResult& R, const std::string& out_
   }
   write_multipatch_file((dir / output_files::kTSpline).string(), maps, metas, R.layout.interfaces, R.layout.cuts,
                         report.value("input", ""));
-  // Each VTU file written in pieces of whole patches, about kPieceCells T-mesh
+  // Each VTU file written in pieces of whole patches, about piece_cells T-mesh
   // cells each (write_vtu_pieces: VTK asks for one piece after the other);
   // a piece's patches are made on the pool's threads, merged, written and
   // released before the next piece is made, so that a sea of 9,000 patches
@@ -136,26 +138,48 @@ void write_multipatch_outputs(const MultiPatchResult& R, const std::string& out_
            uv[v] = mesh.vertex_param(v) + Eigen::Vector2d(1.25 * static_cast<double>(p), 0.0);
          return tmesh_vtu(mesh, uv);
        }}};
-  constexpr std::size_t kPieceCells = 16384;
+  if (piece_cells < 1) throw std::invalid_argument("write_multipatch_outputs: piece_cells must be >= 1");
   std::vector<std::size_t> piece_begin = {0};  // patches [piece_begin[i], piece_begin[i + 1]) make piece i
   for (std::size_t p = 0, cells = 0; p < n; ++p) {
     cells += R.patches[p].map->mesh().num_cells();
-    if (cells >= kPieceCells && p + 1 < n) piece_begin.push_back(p + 1), cells = 0;
+    if (cells >= piece_cells && p + 1 < n) piece_begin.push_back(p + 1), cells = 0;
   }
   piece_begin.push_back(n);
   const int pieces = static_cast<int>(piece_begin.size() - 1);
-  for (const auto& [name, part] : files) {
-    toolkit::io::write_vtu_pieces((dir / name).string(), pieces, [&, &part = part](int i) {
-      const std::size_t first = piece_begin[static_cast<std::size_t>(i)];
-      std::vector<toolkit::io::VtuMesh> parts(piece_begin[static_cast<std::size_t>(i) + 1] - first);
-      detail::parallel_ranges(parts.size(), detail::pool_threads(), [&](std::size_t begin, std::size_t end, int) {
-        for (std::size_t k = begin; k < end; ++k) parts[k] = part(first + k);
-      }, 2);
-      toolkit::io::VtuMesh piece = merge_patches(std::move(parts));
-      for (int& patch : piece.cell_ints.at("patch")) patch += static_cast<int>(first);
+  // Piece i of file f: the patches' parts on the pool's threads, merged.
+  auto make_piece = [&](std::size_t f, int i) {
+    const std::size_t first = piece_begin[static_cast<std::size_t>(i)];
+    std::vector<toolkit::io::VtuMesh> parts(piece_begin[static_cast<std::size_t>(i) + 1] - first);
+    detail::parallel_ranges(parts.size(), detail::pool_threads(), [&](std::size_t begin, std::size_t end, int) {
+      for (std::size_t k = begin; k < end; ++k) parts[k] = files[f].second(first + k);
+    }, 2);
+    toolkit::io::VtuMesh piece = merge_patches(std::move(parts));
+    for (int& patch : piece.cell_ints.at("patch")) patch += static_cast<int>(first);
+    return piece;
+  };
+  // While VTK compresses a piece (serially), the next piece, of this file or
+  // the next one, is made on another thread: one piece ahead at most.
+  struct Ahead {
+    std::size_t file = 0;
+    int piece = -1;
+    std::future<toolkit::io::VtuMesh> mesh;
+  } ahead;
+  for (std::size_t f = 0; f < files.size(); ++f) {
+    toolkit::io::write_vtu_pieces((dir / files[f].first).string(), pieces, [&](int i) {
+      toolkit::io::VtuMesh piece;
+      if (ahead.mesh.valid() && ahead.file == f && ahead.piece == i) piece = ahead.mesh.get();
+      else piece = make_piece(f, i);
+      if (ahead.mesh.valid()) ahead.mesh.wait();  // not the one asked for (VTK asks in order): dropped
+      const bool last = i + 1 == pieces;
+      if (!(last && f + 1 == files.size())) {
+        ahead.file = last ? f + 1 : f;
+        ahead.piece = last ? 0 : i + 1;
+        ahead.mesh = std::async(std::launch::async, make_piece, ahead.file, ahead.piece);
+      }
       return piece;
     });
   }
+  if (ahead.mesh.valid()) ahead.mesh.get();  // raises its error, if any (none is left unused)
   toolkit::io::write_text_atomic((dir / output_files::kReport).string(), report.dump(2) + "\n");
 }
 

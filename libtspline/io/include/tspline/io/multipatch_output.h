@@ -26,8 +26,10 @@ nlohmann::json multipatch_report(const MultiPatchResult& result, const std::stri
 
 /// Writes tspline.json (version 2), surface.vtu, surface_bezier.vtu, control_net.vtu,
 /// parametric_tmesh.vtu (patch p shifted by 1.25 p in xi), physical_tmesh.vtu,
-/// boundary.vtu and report.json (last) into out_dir, each atomically.
+/// boundary.vtu and report.json (last) into out_dir, each atomically. Each VTU
+/// file is written in pieces of whole patches of about `piece_cells` T-mesh
+/// cells (toolkit::io::write_vtu_pieces), one piece in memory at a time.
 void write_multipatch_outputs(const MultiPatchResult& result, const std::string& out_dir,
-                              const nlohmann::json& report, int samples);
+                              const nlohmann::json& report, int samples, std::size_t piece_cells = 16384);
 
 }  // namespace tspline::io
