@@ -400,15 +400,28 @@ class PieceSource : public vtkUnstructuredGridAlgorithm {
     // After a failure the pieces are empty: returning 0 would make the writer
     // ask for the piece again and again (VTK 9.1); the error is raised once
     // Write() returns, and the temporary file is removed.
-    if (error) return 1;
+    vtkUnstructuredGrid* output = vtkUnstructuredGrid::GetData(info);
+    if (error) return set_empty(output);
     try {
       VtuMesh mesh = make(piece);
       validate(mesh);
       vtkNew<vtkUnstructuredGrid> grid = build_grid(std::span<VtuMesh>(&mesh, 1), "");
-      vtkUnstructuredGrid::GetData(info)->ShallowCopy(grid);
+      output->ShallowCopy(grid);
     } catch (...) {
       error = std::current_exception();
+      return set_empty(output);
     }
+    return 1;
+  }
+  // An empty grid with (empty) points and cells: the pipeline has released the
+  // previous piece, and with no cell array the writer (VTK 9.1) would write the
+  // cells of its last piece from their released memory.
+  static int set_empty(vtkUnstructuredGrid* output) {
+    vtkNew<vtkPoints> points;
+    vtkNew<vtkCellArray> cells;
+    vtkNew<vtkUnsignedCharArray> types;
+    output->SetPoints(points);
+    output->SetCells(types, cells);
     return 1;
   }
 };
