@@ -2,6 +2,8 @@
 
 #include <filesystem>
 #include <functional>
+#include <initializer_list>
+#include <string_view>
 #include <future>
 #include <stdexcept>
 #include <type_traits>
@@ -115,8 +117,6 @@ void write_multipatch_outputs(const MultiPatchResult& R, const std::string& out_
     metas[p].boundary = r.front.boundary.polygon();
     metas[p].corners = r.front.boundary.corners().index;
   }
-  write_multipatch_file((dir / output_files::kTSpline).string(), maps, metas, R.layout.interfaces, R.layout.cuts,
-                        report.value("input", ""));
   // Each VTU file written in pieces of whole patches, about piece_cells T-mesh
   // cells each (write_vtu_pieces: VTK asks for one piece after the other);
   // a piece's patches are made on the pool's threads, merged, written and
@@ -157,29 +157,64 @@ void write_multipatch_outputs(const MultiPatchResult& R, const std::string& out_
     for (int& patch : piece.cell_ints.at("patch")) patch += static_cast<int>(first);
     return piece;
   };
-  // While VTK compresses a piece (serially), the next piece, of this file or
-  // the next one, is made on another thread: one piece ahead at most.
-  struct Ahead {
-    std::size_t file = 0;
-    int piece = -1;
-    std::future<toolkit::io::VtuMesh> mesh;
-  } ahead;
-  for (std::size_t f = 0; f < files.size(); ++f) {
-    toolkit::io::write_vtu_pieces((dir / files[f].first).string(), pieces, [&](int i) {
-      toolkit::io::VtuMesh piece;
-      if (ahead.mesh.valid() && ahead.file == f && ahead.piece == i) piece = ahead.mesh.get();
-      else piece = make_piece(f, i);
-      if (ahead.mesh.valid()) ahead.mesh.wait();  // not the one asked for (VTK asks in order): dropped
-      const bool last = i + 1 == pieces;
-      if (!(last && f + 1 == files.size())) {
-        ahead.file = last ? f + 1 : f;
-        ahead.piece = last ? 0 : i + 1;
-        ahead.mesh = std::async(std::launch::async, make_piece, ahead.file, ahead.piece);
-      }
-      return piece;
-    });
+  // Two lanes of files written at once, each on its own thread (VTK
+  // compresses serially: one lane held a core idle while it compressed the
+  // large surface files; new_caledonia's outputs took 3.5 s so), of about equal
+  // weight: tspline.json and surface.vtu with the small files, and
+  // surface_bezier.vtu with the T-mesh files. In a lane, while VTK compresses
+  // a piece, the next piece (of this file or the lane's next one) is made on
+  // another thread: one piece ahead at most.
+  auto write_lane = [&](const std::vector<std::size_t>& lane, bool with_tspline_file) {
+    if (with_tspline_file)
+      write_multipatch_file((dir / output_files::kTSpline).string(), maps, metas, R.layout.interfaces, R.layout.cuts,
+                            report.value("input", ""));
+    struct Ahead {
+      std::size_t file = 0;
+      int piece = -1;
+      std::future<toolkit::io::VtuMesh> mesh;
+    } ahead;
+    for (std::size_t k = 0; k < lane.size(); ++k) {
+      const std::size_t f = lane[k];
+      toolkit::io::write_vtu_pieces((dir / files[f].first).string(), pieces, [&](int i) {
+        toolkit::io::VtuMesh piece;
+        if (ahead.mesh.valid() && ahead.file == f && ahead.piece == i) piece = ahead.mesh.get();
+        else piece = make_piece(f, i);
+        if (ahead.mesh.valid()) ahead.mesh.wait();  // not the one asked for (VTK asks in order): dropped
+        const bool last = i + 1 == pieces;
+        if (!(last && k + 1 == lane.size())) {
+          ahead.file = last ? lane[k + 1] : f;
+          ahead.piece = last ? 0 : i + 1;
+          ahead.mesh = std::async(std::launch::async, make_piece, ahead.file, ahead.piece);
+        }
+        return piece;
+      });
+    }
+    if (ahead.mesh.valid()) ahead.mesh.get();  // raises its error, if any (none is left unused)
+  };
+  auto lane_of = [&](std::initializer_list<std::string_view> names) {
+    std::vector<std::size_t> lane;
+    for (const std::string_view name : names)
+      for (std::size_t f = 0; f < files.size(); ++f)
+        if (files[f].first == name) lane.push_back(f);
+    return lane;
+  };
+  {
+    namespace of = output_files;
+    std::future<void> other = std::async(std::launch::async, write_lane,
+                                         lane_of({of::kBezierSurface, of::kPhysicalTMesh, of::kParametricTMesh}), false);
+    std::exception_ptr error;
+    try {
+      write_lane(lane_of({of::kSurface, of::kControlNet, of::kBoundary}), true);
+    } catch (...) {
+      error = std::current_exception();
+    }
+    try {
+      other.get();  // waits for the other lane in any case
+    } catch (...) {
+      if (!error) error = std::current_exception();
+    }
+    if (error) std::rethrow_exception(error);
   }
-  if (ahead.mesh.valid()) ahead.mesh.get();  // raises its error, if any (none is left unused)
   toolkit::io::write_text_atomic((dir / output_files::kReport).string(), report.dump(2) + "\n");
 }
 
