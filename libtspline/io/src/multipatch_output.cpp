@@ -1,11 +1,12 @@
 #include "tspline/io/multipatch_output.h"
 
+#include <exception>
 #include <filesystem>
 #include <functional>
-#include <initializer_list>
-#include <string_view>
 #include <future>
+#include <initializer_list>
 #include <stdexcept>
+#include <string_view>
 #include <type_traits>
 #include <utility>
 
