@@ -136,6 +136,14 @@ std::vector<ParamOption> make_table() {
       [](const ParamSettings& s) { return json(s.cuts_file); }));
   t.back().show_default = false;
   t.push_back(option(
+      "from", OptionKind::Text,
+      "A previous map (its tspline.json) of this boundary before it moved, vertex i moved to vertex i: the new "
+      "map keeps its T-mesh, knots and corners, starts from it moved with the boundary and is untangled, "
+      "improved and refined only where it needs it (moving domains, shape optimization)",
+      [](ParamSettings& s, const std::string& v) { s.from_file = v; },
+      [](const ParamSettings& s) { return json(s.from_file); }));
+  t.back().show_default = false;
+  t.push_back(option(
       "repair-crossings", OptionKind::Flag,
       "Replace a hole whose ring crosses itself (a bow-tie islet of quantized data) by its convex hull, with "
       "a note giving both areas; by default such a ring is an input error naming its edges",

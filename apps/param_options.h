@@ -32,6 +32,8 @@ struct ParamSettings {
   std::string cuts_file;  ///< polylines, one cut per blank-line-separated block ("" for none)
   /// Holes that cross themselves become their convex hulls (DomainCleaningOptions).
   bool repair_crossing_holes = false;
+  /// A previous map (tspline.json) of the same boundary before it moved: warm start ("" for none).
+  std::string from_file;
   int samples = 4;        ///< surface.vtu: k x k sub-quads per cell
 };
 

@@ -5,7 +5,9 @@
 #include "toolkit/io/atomic_file.h"
 #include "tspline/boundary/domain.h"
 #include "tspline/boundary/polygon_validation.h"
+#include "tspline/deform/reparameterization.h"
 #include "tspline/errors.h"
+#include "tspline/io/multipatch_file.h"
 #include "tspline/io/multipatch_output.h"
 #include "tspline/io/output_files.h"
 #include "tspline/io/param_output.h"
@@ -56,6 +58,36 @@ json single_report(const ParamRun& run) {
   report["input_geometry"] = run.domain.description;  // format, layer, CRS, projection (gis_reader.h)
   report["layout"] = {{"chosen", run.result.layout}, {"reason", run.result.reason}};
   return report;
+}
+
+/// The map of a moved boundary from the previous map in `from` (--from).
+tspline::DomainParameterization warm_start(const std::string& from, const tspline::Domain& rings,
+                                           const tspline::ParameterizationOptions& opt,
+                                           const tspline::AdaptiveOptions& adaptive, ParamRun& run,
+                                           const ParamHooks& hooks) {
+  const tspline::io::LoadedMaps old = tspline::io::read_maps_file(from);
+  if (old.version != 1)
+    throw tspline::InputError("--from " + from + ": a multi-patch map (format version " +
+                              std::to_string(old.version) +
+                              "); warm starts of multi-patch maps are not supported yet, only of one patch");
+  if (!rings.holes.empty())
+    throw tspline::InputError("--from " + from + ": the previous map has one ring, the moved domain " +
+                              std::to_string(rings.holes.size() + 1) + " (rings must correspond one to one)");
+  if (opt.corners)
+    throw tspline::InputError("--corners with --from: the corners are the previous map's");
+  const tspline::io::LoadedTSpline& prev = old.patches.front();
+  const tspline::Polygon moved = tspline::corresponding_polygon(prev.meta.boundary, rings.outer, "the outer ring");
+  tspline::DomainParameterization out;
+  out.layout = "single";
+  out.reason = "warm start from the previous map " + from;
+  out.single = tspline::reparameterize(
+      prev.map, prev.meta.boundary, prev.meta.corners, moved, opt, adaptive, std::nullopt,
+      [&](int it, const tspline::TMesh& mesh, const std::vector<Eigen::Vector2d>&, const tspline::TSplineMap& map,
+          const std::vector<tspline::CellMapQuality>& cells) {
+        run.iterations.push_back({it, map, cells});
+        if (hooks.on_iteration) hooks.on_iteration(it, mesh.num_cells(), map.basis().size());
+      });
+  return out;
 }
 
 }  // namespace
@@ -118,7 +150,10 @@ ParamRun run_param(tspline::io::DomainInput domain, std::string source, const Pa
     }
     report_notes();
   }
-  run.result = tspline::parameterize_domain(
+  if (!settings.from_file.empty()) {
+    run.result = warm_start(settings.from_file, rings, opt, settings.adaptive, run, hooks);
+  } else {
+    run.result = tspline::parameterize_domain(
       rings, opt, settings.adaptive, choice,
       [&](int it, const tspline::TMesh& mesh, const std::vector<Eigen::Vector2d>&,
           const tspline::TSplineMap& map, const std::vector<tspline::CellMapQuality>& cells) {
@@ -127,6 +162,7 @@ ParamRun run_param(tspline::io::DomainInput domain, std::string source, const Pa
         if (hooks.on_iteration) hooks.on_iteration(it, mesh.num_cells(), map.basis().size());
       },
       hooks.on_patch);
+  }
   if (run.result.patches) run.iterations.clear();  // adapt.pvd is written for a single patch only
   run.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   run.report = run.result.patches ? multipatch_report(run) : single_report(run);

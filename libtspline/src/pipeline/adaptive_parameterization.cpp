@@ -107,16 +107,17 @@ std::vector<Eigen::Vector2d> place_new_vertices(const TMesh& coarse, const std::
 class AdaptiveRun {
  public:
   AdaptiveRun(ParameterizationResult& r, const ParameterizationOptions& opt, const AdaptiveOptions& ad,
-              const IterationCallback& on_iteration)
-      : r_(r), f_(r.front), opt_(opt), ad_(ad), on_iteration_(on_iteration) {}
+              const IterationCallback& on_iteration, std::optional<WarmStart> warm = std::nullopt)
+      : r_(r), f_(r.front), opt_(opt), ad_(ad), on_iteration_(on_iteration), warm_(std::move(warm)) {}
 
   void run() {
     for (int it = 0;; ++it) {
       const auto t0 = std::chrono::steady_clock::now();
       round_ = it;
       AdaptIteration rec;
-      TSplineMap map = it == 0 ? fit_tspline(f_.mesh, f_.optimized, f_.boundary, &rec.fit)
-                               : transfer_map(*previous_, f_.mesh, &rec.fit);
+      TSplineMap map = it > 0   ? transfer_map(*previous_, f_.mesh, &rec.fit)
+                       : warm_ ? std::move(warm_->map)
+                               : fit_tspline(f_.mesh, f_.optimized, f_.boundary, &rec.fit);
       t_fit_ += seconds_since(t0);
       if (it == 0) freeze_boundary(map, rec);
       MapCertification cert;
@@ -195,12 +196,76 @@ class AdaptiveRun {
   // (the untangling energy favours the mean of 1/J_r, the threshold the minimum).
   MapQualityStats untangle_and_assess(TSplineMap& map, AdaptIteration& rec, MapCertification& cert,
                                       std::vector<CellMapQuality>& cells) {
-    std::optional<TSplineMap> interpolant;
-    MapCertification interpolant_cert;
     // One Bezier extraction for every check below: the untangling moves the
     // control points only, so the map, its interpolant and the map kept share
     // the T-mesh and the basis.
     const BezierExtraction extraction(map.basis());
+    MapQualityStats quality;
+    if (!keep_warm_start(map, extraction, rec, cert, cells, quality))
+      quality = untangle_and_compare(map, extraction, rec, cert, cells);
+    {
+      std::ostringstream s;
+      s << "map (iteration " << round_ << "): " << f_.mesh.num_cells() << " cells, " << map.basis().size()
+        << " functions, J_r min " << rec.dense_quality.min_mean_ratio << " over the whole map (dense sample and Gauss points), "
+        << quality.min_mean_ratio << " at Gauss points; ";
+      if (ad_.certify)
+        s << cert.certified << " of " << cert.elements << " elements certified det J > 0"
+          << (cert.certified_valid() ? ", det J >= " + std::to_string(cert.min_relative_lower_bound) + " x element mean"
+                                     : "");
+      log("map", s.str());
+    }
+    rec.cells = f_.mesh.num_cells();
+    rec.vertices = f_.mesh.num_vertices();
+    rec.functions = map.basis().size();
+    rec.inverted_cells = f_.quality_optimized.inverted_cells;
+    rec.quality = quality;
+    rec.certification = cert;
+    rec.certification.cell_certified.clear();
+    rec.certification.failures.clear();
+    if (on_iteration_) {
+      std::vector<Eigen::Vector2d> x(f_.mesh.num_vertices());
+      for (int v = 0; v < static_cast<int>(x.size()); ++v) x[v] = map.point(f_.mesh.vertex_param(v));
+      on_iteration_(round_, f_.mesh, x, map, cells);
+    }
+    return quality;
+  }
+
+  // A warm start's first round: the moved map as it is, if it is certified and
+  // its whole-map J_r is no lower than the previous map's (a rigid motion, no
+  // motion, or one that the map follows without loss); else it is optimized.
+  bool keep_warm_start(const TSplineMap& map, const BezierExtraction& extraction, AdaptIteration& rec,
+                       MapCertification& cert, std::vector<CellMapQuality>& cells, MapQualityStats& quality) {
+    if (!warm_ || round_ != 0 || !ad_.certify) return false;
+    const auto t1 = std::chrono::steady_clock::now();
+    MapCertification wc = certify_map(extraction, map.mesh().num_cells(), map.control_points(), ad_.certification);
+    t_certify_ += seconds_since(t1);
+    if (!wc.certified_valid()) return false;
+    const auto t2 = std::chrono::steady_clock::now();
+    std::vector<CellMapQuality> wcells;
+    const MapQualityStats wq = map_quality(map, extraction, ad_.gauss, &wcells);
+    const DenseMapQuality dense = whole_map_quality(map, wcells, &extraction);
+    t_check_ += seconds_since(t2);
+    const double ref = warm_->reference_mean_ratio;
+    // Round-off: a rigid motion changes J_r by a few ulps of the control points.
+    if (!(dense.min_mean_ratio >= ref - 1e-9 * std::max(1.0, std::abs(ref)))) return false;
+    log("warm_start", "warm start: the moved map is certified and its whole-map J_r " +
+                          std::to_string(dense.min_mean_ratio) + " is no lower than the previous map's " +
+                          std::to_string(ref) + "; kept as moved");
+    warm_kept_ = true;
+    cert = std::move(wc);
+    cells = std::move(wcells);
+    quality = wq;
+    rec.dense_quality = dense;
+    rec.control_points_optimized = false;
+    return true;
+  }
+
+  // The global untangling; the interpolant (or warm start) competes with its
+  // untangled version when it is certified.
+  MapQualityStats untangle_and_compare(TSplineMap& map, const BezierExtraction& extraction, AdaptIteration& rec,
+                                       MapCertification& cert, std::vector<CellMapQuality>& cells) {
+    std::optional<TSplineMap> interpolant;
+    MapCertification interpolant_cert;
     const std::size_t num_cells = map.mesh().num_cells();
     if (ad_.optimize_control_points && ad_.certify) {
       const auto t1 = std::chrono::steady_clock::now();
@@ -249,30 +314,6 @@ class AdaptiveRun {
     }
     rec.dense_quality = whole_map_quality(map, cells, &extraction);
     t_check_ += seconds_since(t2);
-    {
-      std::ostringstream s;
-      s << "map (iteration " << round_ << "): " << f_.mesh.num_cells() << " cells, " << map.basis().size()
-        << " functions, J_r min " << rec.dense_quality.min_mean_ratio << " over the whole map (dense sample and Gauss points), "
-        << quality.min_mean_ratio << " at Gauss points; ";
-      if (ad_.certify)
-        s << cert.certified << " of " << cert.elements << " elements certified det J > 0"
-          << (cert.certified_valid() ? ", det J >= " + std::to_string(cert.min_relative_lower_bound) + " x element mean"
-                                     : "");
-      log("map", s.str());
-    }
-    rec.cells = f_.mesh.num_cells();
-    rec.vertices = f_.mesh.num_vertices();
-    rec.functions = map.basis().size();
-    rec.inverted_cells = f_.quality_optimized.inverted_cells;
-    rec.quality = quality;
-    rec.certification = cert;
-    rec.certification.cell_certified.clear();
-    rec.certification.failures.clear();
-    if (on_iteration_) {
-      std::vector<Eigen::Vector2d> x(f_.mesh.num_vertices());
-      for (int v = 0; v < static_cast<int>(x.size()); ++v) x[v] = map.point(f_.mesh.vertex_param(v));
-      on_iteration_(round_, f_.mesh, x, map, cells);
-    }
     return quality;
   }
 
@@ -297,6 +338,7 @@ class AdaptiveRun {
   void polish() {
     Snapshot& b = *best_;
     if (!ad_.optimize_control_points || ad_.polish_stages <= 0 || b.dense.min_mean_ratio >= ad_.polish_below) return;
+    if (warm_kept_ && best_it_ == 0) return;  // the moved map, as good as the previous one
     if (ad_.certify && !b.certification.certified_valid()) return;
     const auto t1 = std::chrono::steady_clock::now();
     MapUntanglingOptions uo = untangling_options();
@@ -374,6 +416,10 @@ class AdaptiveRun {
             (ad_.certify ? ", and det J > 0 is certified on every element" : "");
     } else if (!r_.boundary_problem.empty()) {
       why = r_.boundary_problem;
+    } else if (warm_ && it == 0 && certified &&
+               rec.dense_quality.min_mean_ratio >= warm_->keep_fraction * warm_->reference_mean_ratio) {
+      why = "warm start: certified, whole-map J_r " + std::to_string(rec.dense_quality.min_mean_ratio) +
+            " against the previous map's " + std::to_string(warm_->reference_mean_ratio);
     } else if (it >= ad_.max_adapt) {
       why = "reached --max-adapt " + std::to_string(ad_.max_adapt);
     } else if (certified && best_->score.certified && ad_.min_quality_gain > 0.0 && it > last_gain_it_) {
@@ -454,6 +500,8 @@ class AdaptiveRun {
   int best_it_ = 0;
   int last_gain_it_ = 0;
   std::optional<TSplineMap> previous_;
+  std::optional<WarmStart> warm_;
+  bool warm_kept_ = false;  // the warm start was kept as moved (no optimization)
   double t_boundary_ = 0.0, t_fit_ = 0.0, t_untangle_ = 0.0, t_check_ = 0.0, t_certify_ = 0.0, t_refine_ = 0.0;
 };
 
@@ -469,6 +517,20 @@ ParameterizationResult run_parameterization(const Polygon& polygon, const Parame
   r.adaptive = ad;
   r.adaptive.untangling.progress = nullptr;
   AdaptiveRun(r, opt, ad, on_iteration).run();  // steps 2-5
+  return r;
+}
+
+ParameterizationResult run_parameterization_from(FrontResult front, WarmStart warm,
+                                                 const ParameterizationOptions& opt, const AdaptiveOptions& ad,
+                                                 const IterationCallback& on_iteration) {
+  validate_options(ad);
+  ParameterizationResult r(std::move(front));
+  r.options = opt;
+  r.options.progress = nullptr;
+  r.options.smoothing.progress = nullptr;
+  r.adaptive = ad;
+  r.adaptive.untangling.progress = nullptr;
+  AdaptiveRun(r, opt, ad, on_iteration, std::move(warm)).run();
   return r;
 }
 

@@ -186,16 +186,22 @@ TSplineMap fit_tspline(const TMesh& mesh, const std::vector<Eigen::Vector2d>& x,
   return map;
 }
 
-TSplineMap transfer_map(const TSplineMap& source, TMesh mesh, FitReport* report) {
+TSplineMap interpolate_map(TMesh mesh, const std::function<Eigen::Vector2d(const Eigen::Vector2d&)>& target,
+                           FitReport* report) {
   const auto t0 = std::chrono::steady_clock::now();
   TSplineMap map(std::move(mesh));
   InterpolationData data;
   for (const BlendingFunction& f : map.basis().functions()) {
     data.params.push_back(f.interpolation_point);
-    data.targets.push_back(source.point(f.interpolation_point));
+    data.targets.push_back(target(f.interpolation_point));
   }
   solve_interpolation(map, data, report, t0);
   return map;
+}
+
+TSplineMap transfer_map(const TSplineMap& source, TMesh mesh, FitReport* report) {
+  return interpolate_map(
+      std::move(mesh), [&source](const Eigen::Vector2d& uv) { return source.point(uv); }, report);
 }
 
 }  // namespace tspline

@@ -134,8 +134,28 @@ using IterationCallback = std::function<void(int, const TMesh&, const std::vecto
 /// \throw InputError naming the first option out of range (options_validation.cpp).
 void validate_options(const AdaptiveOptions& options);
 
+/// A map to start the adaptive loop from instead of the interpolant of the
+/// front half's T-mesh (a moved boundary: deform/reparameterization.h).
+struct WarmStart {
+  TSplineMap map;  ///< on front.mesh, its boundary curve on front.boundary's polygon
+  /// Whole-map J_r (dense sample) of the map it was moved from. Round 0 keeps
+  /// the warm map as it is if it is certified and at least this good; else it
+  /// is untangled and improved like a fitted map.
+  double reference_mean_ratio = 0.0;
+  /// Round 0 stops (no refinement) once certified with at least this fraction
+  /// of reference_mean_ratio; below it the usual refinement rules apply.
+  double keep_fraction = 0.9;
+};
+
 /// \throw InputError for invalid input or options; NumericalError if a fit fails.
 ParameterizationResult run_parameterization(const Polygon& polygon, const ParameterizationOptions& options,
                                             const AdaptiveOptions& adaptive, const IterationCallback& on_iteration = {});
+
+/// Steps 2-5 from a warm start on `front` (its mesh, vertex positions and
+/// boundary map: the front half is not run). \throw as run_parameterization.
+ParameterizationResult run_parameterization_from(FrontResult front, WarmStart warm,
+                                                 const ParameterizationOptions& options,
+                                                 const AdaptiveOptions& adaptive,
+                                                 const IterationCallback& on_iteration = {});
 
 }  // namespace tspline

@@ -12,6 +12,7 @@
 // of S follows the polygon (the paper uses the straight physical edge; the
 // difference is within the boundary tolerance).
 #include <Eigen/Core>
+#include <functional>
 #include <vector>
 
 #include "tspline/boundary/boundary_map.h"
@@ -45,6 +46,14 @@ InterpolationData interpolation_data(const TSplineBasis& basis, const std::vecto
 /// (relative residual above 1e-8).
 TSplineMap fit_tspline(const TMesh& mesh, const std::vector<Eigen::Vector2d>& vertex_x, const BoundaryMap& boundary,
                        FitReport* report = nullptr);
+
+/// The interpolant on the basis of `mesh` of the function `target` of the
+/// parametric point: control points such that the map equals target(xi_b) at
+/// every function's interpolation point xi_b (Eq. 8 with these targets). A
+/// target that is itself a map of this basis is reproduced up to round-off
+/// (the system is square and nonsingular). \throw NumericalError as fit_tspline.
+TSplineMap interpolate_map(TMesh mesh, const std::function<Eigen::Vector2d(const Eigen::Vector2d&)>& target,
+                           FitReport* report = nullptr);
 
 /// The map `source` carried onto the basis of a finer T-mesh (one that refines
 /// source's): the interpolant of source at the new interpolation points. On
