@@ -338,7 +338,8 @@ class AdaptiveRun {
   void polish() {
     Snapshot& b = *best_;
     if (!ad_.optimize_control_points || ad_.polish_stages <= 0 || b.dense.min_mean_ratio >= ad_.polish_below) return;
-    if (warm_kept_ && best_it_ == 0) return;  // the moved map, as good as the previous one
+    // A warm start's optimization already ran at the polish power (untangling_options).
+    if (warm_ && warm_->reference_mean_ratio < ad_.polish_below) return;
     if (ad_.certify && !b.certification.certified_valid()) return;
     const auto t1 = std::chrono::steady_clock::now();
     MapUntanglingOptions uo = untangling_options();
@@ -372,6 +373,11 @@ class AdaptiveRun {
   MapUntanglingOptions untangling_options() const {
     MapUntanglingOptions uo = ad_.untangling;
     uo.certification = ad_.certification;
+    // A warm start from a polished map (whole-map J_r below polish_below) is
+    // near the minimum of the polish energy: optimize that energy, not the
+    // default one (whose minimum has the lower min J_r) followed by the polish.
+    if (warm_ && warm_->reference_mean_ratio < ad_.polish_below) uo.quality_power = ad_.polish_power;
+    if (warm_) uo.max_quality_stages = std::min(uo.max_quality_stages, warm_->quality_stages);
     if (!uo.progress && opt_.progress)
       uo.progress = [this](const UntanglingProgress& p) {
         ProgressEvent e;

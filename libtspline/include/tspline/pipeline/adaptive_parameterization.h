@@ -145,6 +145,9 @@ struct WarmStart {
   /// Round 0 stops (no refinement) once certified with at least this fraction
   /// of reference_mean_ratio; below it the usual refinement rules apply.
   double keep_fraction = 0.9;
+  /// Quality stages of the untangling at most (MapUntanglingOptions::
+  /// max_quality_stages): the warm map starts near the previous optimum.
+  int quality_stages = 2;
 };
 
 /// \throw InputError for invalid input or options; NumericalError if a fit fails.
