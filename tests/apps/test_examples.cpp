@@ -144,4 +144,21 @@ TEST_SUITE("examples") {
     CHECK(value_after(r.out, "before: inverted") > 10);
     CHECK(value_after(r.out, "after: inverted") == 0.0);
   }
+
+  TEST_CASE("ex7: a moving boundary re-parameterized from the previous map") {
+    const fs::path d = scratch("ex7");
+    const std::string coast = std::string(TSPLINE_TEST_DATA_DIR) + "/coastlines/puerto_rico.txt";
+    const auto r = run_program(EXAMPLE_MOVING_BOUNDARY, q(coast) + " " + q(d / "out"), d);
+    CAPTURE(r.out);
+    CAPTURE(r.err);
+    // The example checks that every step is certified and at least half as good as the cold start.
+    REQUIRE(r.exit_code == 0);
+    CHECK(contains(r.out, "  20 "));
+    CHECK(contains(r.out, "of 20 steps kept the T-mesh"));
+    CHECK(!contains(r.out, " NO "));
+    for (const char* png : {"first.png", "last.png"}) {
+      CAPTURE(png);
+      CHECK(fs::file_size(d / "out" / png) > 10000);
+    }
+  }
 }

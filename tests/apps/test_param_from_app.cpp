@@ -1,0 +1,121 @@
+// `tspline param MOVED --from OLD/tspline.json`: the warm start from the command
+// line. No motion writes the same control points; a rigid motion the moved
+// ones; a boundary that does not match, or a multi-patch file, is an input
+// error (exit 1) that names the problem and writes nothing.
+#include <doctest/doctest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "test_support.h"
+
+namespace fs = std::filesystem;
+using test_support::contains;
+using test_support::run_program;
+
+namespace {
+
+std::string q(const fs::path& p) { return test_support::quoted(p); }
+
+std::vector<Eigen::Vector2d> control_points(const fs::path& tspline_json) {
+  std::ifstream in(tspline_json);
+  const nlohmann::json doc = nlohmann::json::parse(in);
+  std::vector<Eigen::Vector2d> out;
+  for (const auto& f : doc.at("functions"))
+    out.emplace_back(f.at("control_point")[0].get<double>(), f.at("control_point")[1].get<double>());
+  return out;
+}
+
+void write_ring(const fs::path& path, const std::vector<Eigen::Vector2d>& v) {
+  std::ofstream out(path);
+  out.precision(17);
+  for (const auto& p : v) out << p.x() << ' ' << p.y() << '\n';
+}
+
+}  // namespace
+
+TEST_SUITE("param_from_app") {
+  TEST_CASE("tspline param --from: no motion, a rigid motion, and mismatched inputs") {
+    const fs::path d = test_support::scratch_dir("param_from", "isle_of_man");
+    const std::string coast = std::string(TSPLINE_TEST_DATA_DIR) + "/coastlines/isle_of_man.txt";
+    const auto first = run_program(TSPLINE_APP_PATH, "param " + q(coast) + " --quiet --out " + q(d / "first"), d);
+    REQUIRE(first.exit_code == 0);
+    const std::vector<Eigen::Vector2d> P = control_points(d / "first" / "tspline.json");
+
+    const auto same = run_program(TSPLINE_APP_PATH,
+                                  "param " + q(coast) + " --from " + q(d / "first" / "tspline.json") + " --out " +
+                                      q(d / "same"),
+                                  d);
+    CAPTURE(same.err);
+    REQUIRE(same.exit_code == 0);
+    CHECK(contains(same.out, "warm start"));
+    const std::vector<Eigen::Vector2d> S = control_points(d / "same" / "tspline.json");
+    REQUIRE(S.size() == P.size());
+    double err = 0.0;
+    for (std::size_t i = 0; i < P.size(); ++i) err = std::max(err, (S[i] - P[i]).norm());
+    CHECK(err < 1e-11);  // km coordinates of an island 50 km across
+
+    // The file's vertices rotated by 30 degrees about the origin and shifted.
+    std::vector<Eigen::Vector2d> ring;
+    {
+      std::ifstream in(coast);
+      std::string line;
+      while (std::getline(in, line)) {
+        if (line.empty() || line[0] == '#') continue;
+        std::istringstream s(line);
+        double x = 0, y = 0;
+        s >> x >> y;
+        ring.emplace_back(x, y);
+      }
+    }
+    const double th = M_PI / 6;
+    Eigen::Matrix2d R;
+    R << std::cos(th), -std::sin(th), std::sin(th), std::cos(th);
+    const Eigen::Vector2d t(-20.0, 7.5);
+    std::vector<Eigen::Vector2d> rotated;
+    for (const auto& p : ring) rotated.push_back(R * p + t);
+    write_ring(d / "rotated.txt", rotated);
+    const auto rigid = run_program(TSPLINE_APP_PATH,
+                                   "param " + q(d / "rotated.txt") + " --quiet --from " +
+                                       q(d / "first" / "tspline.json") + " --out " + q(d / "rigid"),
+                                   d);
+    CAPTURE(rigid.err);
+    REQUIRE(rigid.exit_code == 0);
+    const std::vector<Eigen::Vector2d> M = control_points(d / "rigid" / "tspline.json");
+    REQUIRE(M.size() == P.size());
+    err = 0.0;
+    for (std::size_t i = 0; i < P.size(); ++i) err = std::max(err, (M[i] - (R * P[i] + t)).norm());
+    CHECK(err < 1e-11);
+
+    // One vertex fewer: an input error naming the counts, and no output folder.
+    write_ring(d / "short.txt", std::vector<Eigen::Vector2d>(ring.begin(), ring.end() - 1));
+    const auto shorter = run_program(TSPLINE_APP_PATH,
+                                     "param " + q(d / "short.txt") + " --from " + q(d / "first" / "tspline.json") +
+                                         " --out " + q(d / "short"),
+                                     d);
+    CHECK(shorter.exit_code == 1);
+    CHECK(contains(shorter.err, "the outer ring of the moved boundary has 71 vertices"));
+    CHECK(!fs::exists(d / "short" / "tspline.json"));
+    // Two vertices swapped: the ring crosses itself (edges named by file index).
+    std::vector<Eigen::Vector2d> crossing = ring;
+    std::swap(crossing[5], crossing[40]);
+    write_ring(d / "crossing.txt", crossing);
+    const auto crossed = run_program(TSPLINE_APP_PATH,
+                                     "param " + q(d / "crossing.txt") + " --from " + q(d / "first" / "tspline.json") +
+                                         " --out " + q(d / "crossing"),
+                                     d);
+    CHECK(crossed.exit_code == 1);
+    CHECK(contains(crossed.err, "not simple"));
+    CHECK(!fs::exists(d / "crossing" / "tspline.json"));
+    // Not a T-spline file.
+    const auto bad = run_program(TSPLINE_APP_PATH,
+                                 "param " + q(coast) + " --from " + q(coast) + " --out " + q(d / "bad"), d);
+    CHECK(bad.exit_code == 1);
+    CHECK(!fs::exists(d / "bad" / "tspline.json"));
+  }
+}
