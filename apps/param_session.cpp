@@ -60,28 +60,21 @@ json single_report(const ParamRun& run) {
   return report;
 }
 
-/// The map of a moved boundary from the previous map in `from` (--from).
-tspline::DomainParameterization warm_start(const std::string& from, const tspline::Domain& rings,
+/// The map of a moved boundary from the previous map (--from, Map.deform).
+tspline::DomainParameterization warm_start(const PreviousMap& prev, const tspline::Domain& rings,
                                            const tspline::ParameterizationOptions& opt,
                                            const tspline::AdaptiveOptions& adaptive, ParamRun& run,
                                            const ParamHooks& hooks) {
-  const tspline::io::LoadedMaps old = tspline::io::read_maps_file(from);
-  if (old.version != 1)
-    throw tspline::InputError("--from " + from + ": a multi-patch map (format version " +
-                              std::to_string(old.version) +
-                              "); warm starts of multi-patch maps are not supported yet, only of one patch");
   if (!rings.holes.empty())
-    throw tspline::InputError("--from " + from + ": the previous map has one ring, the moved domain " +
+    throw tspline::InputError(prev.name + ": the previous map has one ring, the moved domain " +
                               std::to_string(rings.holes.size() + 1) + " (rings must correspond one to one)");
-  if (opt.corners)
-    throw tspline::InputError("--corners with --from: the corners are the previous map's");
-  const tspline::io::LoadedTSpline& prev = old.patches.front();
+  if (opt.corners) throw tspline::InputError("--corners with --from: the corners are the previous map's");
   const tspline::Polygon moved = tspline::corresponding_polygon(prev.meta.boundary, rings.outer, "the outer ring");
   tspline::DomainParameterization out;
   out.layout = "single";
-  out.reason = "warm start from the previous map " + from;
+  out.reason = "warm start from the previous map " + prev.name;
   out.single = tspline::reparameterize(
-      prev.map, prev.meta.boundary, prev.meta.corners, moved, opt, adaptive, std::nullopt,
+      *prev.map, prev.meta.boundary, prev.meta.corners, moved, opt, adaptive, std::nullopt,
       [&](int it, const tspline::TMesh& mesh, const std::vector<Eigen::Vector2d>&, const tspline::TSplineMap& map,
           const std::vector<tspline::CellMapQuality>& cells) {
         run.iterations.push_back({it, map, cells});
@@ -107,7 +100,8 @@ bool ParamRun::certified_valid() const {
 }
 
 ParamRun run_param(tspline::io::DomainInput domain, std::string source, const ParamSettings& settings,
-                   const ParamHooks& hooks, std::chrono::steady_clock::time_point started) {
+                   const ParamHooks& hooks, std::chrono::steady_clock::time_point started,
+                   std::optional<PreviousMap> previous) {
   ParamRun run;
   run.source = std::move(source);
   run.domain = std::move(domain);
@@ -150,8 +144,17 @@ ParamRun run_param(tspline::io::DomainInput domain, std::string source, const Pa
     }
     report_notes();
   }
-  if (!settings.from_file.empty()) {
-    run.result = warm_start(settings.from_file, rings, opt, settings.adaptive, run, hooks);
+  std::optional<tspline::io::LoadedMaps> file;
+  if (!previous && !settings.from_file.empty()) {
+    file = tspline::io::read_maps_file(settings.from_file);
+    if (file->version != 1)
+      throw tspline::InputError("--from " + settings.from_file + ": a multi-patch map (format version " +
+                                std::to_string(file->version) +
+                                "); warm starts are supported for maps of one patch only, so far");
+    previous = PreviousMap{&file->patches.front().map, file->patches.front().meta, settings.from_file};
+  }
+  if (previous) {
+    run.result = warm_start(*previous, rings, opt, settings.adaptive, run, hooks);
   } else {
     run.result = tspline::parameterize_domain(
       rings, opt, settings.adaptive, choice,

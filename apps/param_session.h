@@ -8,11 +8,13 @@
 #include <cstddef>
 #include <functional>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "param_options.h"
 #include "tspline/io/gis_reader.h"
+#include "tspline/io/tspline_file.h"
 #include "tspline/pipeline/domain_parameterization.h"
 
 namespace tspline_app {
@@ -48,15 +50,26 @@ struct ParamHooks {
   tspline::PatchCallback on_patch;
 };
 
+/// A previous map of the same boundary before it moved (warm start: --from,
+/// Map.deform). Single patch: its map and the polygon and corners it stores.
+struct PreviousMap {
+  const tspline::TSplineMap* map = nullptr;
+  tspline::io::TSplineFileMeta meta;
+  std::string name;  ///< for messages: the file, or "the previous map"
+};
+
 /// Runs `tspline param` on a domain: corners and cuts checked against the
 /// layout, the rings of a domain with holes cleaned with the run's boundary
 /// tolerance, parameterize_domain, report.json. `started`: when the run began
 /// (report.json's seconds count from there, reading the file included).
+/// With `previous` (or settings.from_file), the map of the moved boundary
+/// from that map (tspline::reparameterize) instead of parameterize_domain.
 /// \throw tspline::InputError for invalid domains or options (--corners with
 /// several patches, --cuts); as parameterize_domain otherwise.
 ParamRun run_param(tspline::io::DomainInput domain, std::string source, const ParamSettings& settings,
                    const ParamHooks& hooks = {},
-                   std::chrono::steady_clock::time_point started = std::chrono::steady_clock::now());
+                   std::chrono::steady_clock::time_point started = std::chrono::steady_clock::now(),
+                   std::optional<PreviousMap> previous = std::nullopt);
 
 /// The files `tspline param` writes (output_files.h), for a single patch or
 /// several, into out_dir (created if missing), each atomically, report.json last.

@@ -93,6 +93,28 @@ Map parameterize(const py::object& domain, const py::kwargs& kwargs) {
   return map_of_run(std::move(run));
 }
 
+Map deform(const Map& m, const py::object& domain, const py::kwargs& kwargs) {
+  if (m.version != 1 || m.maps.size() != 1)
+    throw tspline::InputError("deform: a multi-patch map; warm starts are supported for maps of one patch only, "
+                              "so far");
+  std::optional<std::string> crs;
+  tspline_app::ParamSettings settings = settings_from_keywords(kwargs, &crs);
+  if (!settings.from_file.empty()) throw tspline::InputError("deform: 'from' is this map");
+  settings.domain.crs = crs;
+  const auto started = std::chrono::steady_clock::now();
+  DomainArgument in = domain_from_python(domain, settings.domain);
+  tspline_app::ParamHooks hooks;
+  hooks.progress = interruptible();
+  std::shared_ptr<tspline_app::ParamRun> run;
+  {
+    py::gil_scoped_release release;
+    run = std::make_shared<tspline_app::ParamRun>(tspline_app::run_param(
+        std::move(in.domain), in.source, settings, hooks, started,
+        tspline_app::PreviousMap{&m.patch(0), m.metas.front(), "the previous map"}));
+  }
+  return map_of_run(std::move(run));
+}
+
 Map load(const py::object& path_obj) {
   const auto path = path_of(path_obj);
   if (!path) throw py::type_error("load: expected a path (str or os.PathLike)");
@@ -371,6 +393,11 @@ void bind_maps(py::module_& m) {
            "PDF by the extension) as `tspline render`: view 'jacobian' (J_r), 'tmesh', 'control-net' or "
            "'layout'; "
            "samples: k x k sub-quads per cell.")
+      .def("deform", &deform, py::arg("domain"),
+           "deform(domain, **options) -> Map: the map of the moved boundary `domain` (the same ring, vertex i "
+           "moved to vertex i; any input tspline.parameterize takes) from this map, as `tspline param DOMAIN "
+           "--from`: the same T-mesh, knots and corners, the interior started from this map moved with the "
+           "boundary, untangled, improved and refined only where it needs it. One patch only, so far.")
       .def(
           "poisson",
           [](const py::object& self, py::kwargs kwargs) {
