@@ -5,6 +5,7 @@
 #include "toolkit/io/atomic_file.h"
 #include "tspline/boundary/domain.h"
 #include "tspline/boundary/polygon_validation.h"
+#include "tspline/deform/layout_reparameterization.h"
 #include "tspline/deform/reparameterization.h"
 #include "tspline/errors.h"
 #include "tspline/io/multipatch_file.h"
@@ -61,20 +62,49 @@ json single_report(const ParamRun& run) {
 }
 
 /// The map of a moved boundary from the previous map (--from, Map.deform).
-tspline::DomainParameterization warm_start(const PreviousMap& prev, const tspline::Domain& rings,
+/// `read`: the rings as read (every vertex, the file's numbering).
+tspline::DomainParameterization warm_start(const PreviousMap& prev, const tspline::io::DomainInput& read,
                                            const tspline::ParameterizationOptions& opt,
                                            const tspline::AdaptiveOptions& adaptive, ParamRun& run,
                                            const ParamHooks& hooks) {
-  if (!rings.holes.empty())
-    throw tspline::InputError(prev.name + ": the previous map has one ring, the moved domain " +
-                              std::to_string(rings.holes.size() + 1) + " (rings must correspond one to one)");
   if (opt.corners) throw tspline::InputError("--corners with --from: the corners are the previous map's");
-  const tspline::Polygon moved = tspline::corresponding_polygon(prev.meta.boundary, rings.outer, "the outer ring");
   tspline::DomainParameterization out;
-  out.layout = "single";
   out.reason = "warm start from the previous map " + prev.name;
+  if (prev.layout) {
+    if (!prev.domain)
+      throw tspline::InputError(prev.name + ": the file does not record the rings of its domain (written by an older "
+                                "version); map the domain from scratch once, then warm-start from that map");
+    const std::size_t rings = prev.domain->holes.size() + 1;
+    if (read.holes.size() + 1 != rings)
+      throw tspline::InputError(prev.name + ": the previous map's domain has " + std::to_string(rings) +
+                                " rings, the moved domain " + std::to_string(read.holes.size() + 1) +
+                                " (ring k moves to ring k)");
+    tspline::PreviousLayout old;
+    old.domain = *prev.domain;
+    old.maps = prev.maps;
+    for (const tspline::io::TSplineFileMeta& m : prev.metas) {
+      old.polygons.push_back(m.boundary);
+      old.corners.push_back(m.corners);
+    }
+    old.interfaces = prev.interfaces;
+    old.cuts = prev.cuts;
+    tspline::Domain moved;
+    moved.outer = tspline::corresponding_polygon(prev.domain->outer, read.outer, tspline::ring_name(0));
+    for (std::size_t h = 0; h < read.holes.size(); ++h)
+      moved.holes.push_back(
+          tspline::corresponding_polygon(prev.domain->holes[h], read.holes[h], tspline::ring_name(h + 1)));
+    out.layout = "quad";
+    out.patches = tspline::reparameterize_layout(old, moved, opt, adaptive, {}, hooks.on_patch);
+    return out;
+  }
+  if (!read.holes.empty())
+    throw tspline::InputError(prev.name + ": the previous map has one ring, the moved domain " +
+                              std::to_string(read.holes.size() + 1) + " (rings must correspond one to one)");
+  const tspline::io::TSplineFileMeta& meta = prev.metas.front();
+  const tspline::Polygon moved = tspline::corresponding_polygon(meta.boundary, read.outer, tspline::ring_name(0));
+  out.layout = "single";
   out.single = tspline::reparameterize(
-      *prev.map, prev.meta.boundary, prev.meta.corners, moved, opt, adaptive, std::nullopt,
+      *prev.maps.front(), meta.boundary, meta.corners, moved, opt, adaptive, std::nullopt,
       [&](int it, const tspline::TMesh& mesh, const std::vector<Eigen::Vector2d>&, const tspline::TSplineMap& map,
           const std::vector<tspline::CellMapQuality>& cells) {
         run.iterations.push_back({it, map, cells});
@@ -147,14 +177,19 @@ ParamRun run_param(tspline::io::DomainInput domain, std::string source, const Pa
   std::optional<tspline::io::LoadedMaps> file;
   if (!previous && !settings.from_file.empty()) {
     file = tspline::io::read_maps_file(settings.from_file);
-    if (file->version != 1)
-      throw tspline::InputError("--from " + settings.from_file + ": a multi-patch map (format version " +
-                                std::to_string(file->version) +
-                                "); warm starts are supported for maps of one patch only, so far");
-    previous = PreviousMap{&file->patches.front().map, file->patches.front().meta, settings.from_file};
+    previous.emplace();
+    for (const tspline::io::LoadedTSpline& t : file->patches) {
+      previous->maps.push_back(&t.map);
+      previous->metas.push_back(t.meta);
+    }
+    previous->layout = file->version != 1;
+    previous->interfaces = file->interfaces;
+    previous->cuts = file->cuts;
+    previous->domain = file->domain;
+    previous->name = settings.from_file;
   }
   if (previous) {
-    run.result = warm_start(*previous, rings, opt, settings.adaptive, run, hooks);
+    run.result = warm_start(*previous, run.domain, opt, settings.adaptive, run, hooks);
   } else {
     run.result = tspline::parameterize_domain(
       rings, opt, settings.adaptive, choice,

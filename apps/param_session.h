@@ -14,7 +14,7 @@
 
 #include "param_options.h"
 #include "tspline/io/gis_reader.h"
-#include "tspline/io/tspline_file.h"
+#include "tspline/io/multipatch_file.h"
 #include "tspline/pipeline/domain_parameterization.h"
 
 namespace tspline_app {
@@ -51,11 +51,16 @@ struct ParamHooks {
 };
 
 /// A previous map of the same boundary before it moved (warm start: --from,
-/// Map.deform). Single patch: its map and the polygon and corners it stores.
+/// Map.deform): its patches' maps, polygons and corners, and for a layout its
+/// interfaces, cuts and rings.
 struct PreviousMap {
-  const tspline::TSplineMap* map = nullptr;
-  tspline::io::TSplineFileMeta meta;
-  std::string name;  ///< for messages: the file, or "the previous map"
+  std::vector<const tspline::TSplineMap*> maps;     ///< one per patch
+  std::vector<tspline::io::TSplineFileMeta> metas;  ///< per patch: its polygon and corners
+  bool layout = false;                              ///< a multi-patch map (format version 2)
+  std::vector<tspline::Interface> interfaces;       ///< layout: as in its file
+  std::vector<tspline::Cut> cuts;
+  std::optional<tspline::Domain> domain;  ///< layout: the rings it was built on (the file's "domain")
+  std::string name;                       ///< for messages: the file, or "the previous map"
 };
 
 /// Runs `tspline param` on a domain: corners and cuts checked against the

@@ -93,10 +93,21 @@ Map parameterize(const py::object& domain, const py::kwargs& kwargs) {
   return map_of_run(std::move(run));
 }
 
+// The map as the previous map of a warm start.
+tspline_app::PreviousMap previous_of(const Map& m) {
+  tspline_app::PreviousMap prev;
+  prev.maps = m.maps;
+  prev.metas = m.metas;
+  prev.layout = m.version != 1;
+  prev.interfaces = m.interfaces;
+  prev.cuts = m.cuts;
+  if (m.run && m.run->result.patches) prev.domain = m.run->result.patches->domain;
+  else if (m.file && m.file->domain) prev.domain = *m.file->domain;
+  prev.name = "the previous map";
+  return prev;
+}
+
 Map deform(const Map& m, const py::object& domain, const py::kwargs& kwargs) {
-  if (m.version != 1 || m.maps.size() != 1)
-    throw tspline::InputError("deform: a multi-patch map; warm starts are supported for maps of one patch only, "
-                              "so far");
   std::optional<std::string> crs;
   tspline_app::ParamSettings settings = settings_from_keywords(kwargs, &crs);
   if (!settings.from_file.empty()) throw tspline::InputError("deform: 'from' is this map");
@@ -110,7 +121,7 @@ Map deform(const Map& m, const py::object& domain, const py::kwargs& kwargs) {
     py::gil_scoped_release release;
     run = std::make_shared<tspline_app::ParamRun>(tspline_app::run_param(
         std::move(in.domain), in.source, settings, hooks, started,
-        tspline_app::PreviousMap{&m.patch(0), m.metas.front(), "the previous map"}));
+        previous_of(m)));
   }
   return map_of_run(std::move(run));
 }
@@ -236,7 +247,10 @@ py::dict check(const Map& m, int depth, std::size_t max_listed) {
 void save_tspline(const Map& m, const std::filesystem::path& file) {
   const std::string path = file.string();
   if (m.version == 1) return tspline::io::write_tspline_file(path, *m.maps.front(), m.metas.front());
-  tspline::io::write_multipatch_file(path, m.maps, m.metas, m.interfaces, m.cuts, m.source);
+  const tspline::Domain* domain = m.run && m.run->result.patches ? &m.run->result.patches->domain
+                                  : m.file && m.file->domain    ? &*m.file->domain
+                                                                : nullptr;
+  tspline::io::write_multipatch_file(path, m.maps, m.metas, m.interfaces, m.cuts, m.source, domain);
 }
 
 void save(const Map& m, const std::filesystem::path& dir) {
@@ -396,8 +410,8 @@ void bind_maps(py::module_& m) {
       .def("deform", &deform, py::arg("domain"),
            "deform(domain, **options) -> Map: the map of the moved boundary `domain` (the same ring, vertex i "
            "moved to vertex i; any input tspline.parameterize takes) from this map, as `tspline param DOMAIN "
-           "--from`: the same T-mesh, knots and corners, the interior started from this map moved with the "
-           "boundary, untangled, improved and refined only where it needs it. One patch only, so far.")
+           "--from`: the same layout, T-meshes, knots and corners, the interior started from this map moved with "
+           "the boundary, untangled, improved and refined only where it needs it.")
       .def(
           "poisson",
           [](const py::object& self, py::kwargs kwargs) {

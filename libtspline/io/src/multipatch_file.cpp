@@ -39,7 +39,7 @@ const char* side_name(int side) { return kSides[side & 3]; }
 
 void write_multipatch_file(const std::string& path, const std::vector<const TSplineMap*>& maps,
                            const std::vector<TSplineFileMeta>& metas, const std::vector<Interface>& interfaces,
-                           const std::vector<Cut>& cuts, const std::string& source) {
+                           const std::vector<Cut>& cuts, const std::string& source, const Domain* domain) {
   if (maps.size() != metas.size() || maps.empty())
     throw InputError("write_multipatch_file: one metadata record per map is required");
   for (std::size_t i = 0; i < interfaces.size(); ++i) {
@@ -72,7 +72,20 @@ void write_multipatch_file(const std::string& path, const std::vector<const TSpl
       for (const auto& p : cuts[c]) pts.push_back({p.x(), p.y()});
       out << (c ? ",\n    " : "\n    ") << pts.dump();
     }
-    out << "\n  ]\n}\n";
+    out << "\n  ]";
+    if (domain) {
+      // The rings, one per line: {"polygon": [[x, y], ...], "file_index": [...]}.
+      out << ",\n  \"domain\": [";
+      std::vector<const Polygon*> rings = {&domain->outer};
+      for (const Polygon& h : domain->holes) rings.push_back(&h);
+      for (std::size_t r = 0; r < rings.size(); ++r) {
+        json pts = json::array();
+        for (const auto& p : rings[r]->vertices) pts.push_back({p.x(), p.y()});
+        out << (r ? ",\n    " : "\n    ") << json({{"polygon", pts}, {"file_index", rings[r]->file_index}}).dump();
+      }
+      out << "\n  ]";
+    }
+    out << "\n}\n";
     out.flush();
     if (!out) throw IoError("cannot write '" + path + "': write failed (disk full?)");
   });
@@ -111,6 +124,32 @@ LoadedMaps read_maps_file(const std::string& path) {
       cut.emplace_back(q[0].get<double>(), q[1].get<double>());
     }
     out.cuts.push_back(std::move(cut));
+  }
+  if (doc.contains("domain")) {
+    const json& rings = doc["domain"];
+    if (!rings.is_array() || rings.empty()) throw InputError(path + ": /domain: expected a non-empty array of rings");
+    Domain d;
+    for (std::size_t r = 0; r < rings.size(); ++r) {
+      const std::string where = path + ": /domain/" + std::to_string(r);
+      Polygon ring;
+      const json& pts = member(rings[r], "polygon", where);
+      const json& idx = member(rings[r], "file_index", where);
+      if (!pts.is_array() || !idx.is_array() || idx.size() != pts.size())
+        throw InputError(where + ": expected \"polygon\" and \"file_index\" arrays of one size");
+      for (const json& q : pts) {
+        if (!q.is_array() || q.size() != 2 || !q[0].is_number() || !q[1].is_number())
+          throw InputError(where + "/polygon: expected points [x, y]");
+        ring.vertices.emplace_back(q[0].get<double>(), q[1].get<double>());
+      }
+      for (const json& f : idx) {
+        if (!f.is_number_integer() || f.get<long long>() < 0)
+          throw InputError(where + "/file_index: expected non-negative integers");
+        ring.file_index.push_back(f.get<std::size_t>());
+      }
+      if (r == 0) d.outer = std::move(ring);
+      else d.holes.push_back(std::move(ring));
+    }
+    out.domain = std::move(d);
   }
   const json& faces = member(doc, "interfaces", path + ": /");
   if (!faces.is_array()) throw InputError(path + ": /interfaces: expected an array");

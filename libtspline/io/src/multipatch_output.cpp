@@ -168,7 +168,7 @@ void write_multipatch_outputs(const MultiPatchResult& R, const std::string& out_
   auto write_lane = [&](const std::vector<std::size_t>& lane, bool with_tspline_file) {
     if (with_tspline_file)
       write_multipatch_file((dir / output_files::kTSpline).string(), maps, metas, R.layout.interfaces, R.layout.cuts,
-                            report.value("input", ""));
+                            report.value("input", ""), &R.domain);
     struct Ahead {
       std::size_t file = 0;
       int piece = -1;

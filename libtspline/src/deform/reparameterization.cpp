@@ -21,6 +21,13 @@ Polygon corresponding_polygon(const Polygon& old, const Polygon& read, const std
   for (std::size_t f : old.file_index) max_index = std::max(max_index, f);
   const bool cleaned = max_index + 1 != old.vertices.size();  // the old run removed vertices of the file
   const std::size_t n = read.vertices.size();
+  // Where each file index sits in `read` (its own file_index, or its order).
+  std::vector<std::size_t> at(n);
+  for (std::size_t k = 0; k < n; ++k) {
+    const std::size_t f = read.file_index.size() == n ? read.file_index[k] : k;
+    if (f >= n) throw InputError(ring + " of the moved boundary: file index " + std::to_string(f) + " out of range");
+    at[f] = k;
+  }
   if ((!cleaned && n != old.vertices.size()) || (cleaned && n <= max_index))
     throw InputError(ring + " of the moved boundary has " + std::to_string(n) + " vertices, the previous map's " +
                      (cleaned ? "file had at least " + std::to_string(max_index + 1)
@@ -29,7 +36,7 @@ Polygon corresponding_polygon(const Polygon& old, const Polygon& read, const std
   Polygon out;
   out.file_index = old.file_index;
   out.vertices.reserve(old.vertices.size());
-  for (std::size_t f : old.file_index) out.vertices.push_back(read.vertices[f]);
+  for (std::size_t f : old.file_index) out.vertices.push_back(read.vertices[at[f]]);
   return out;
 }
 
@@ -38,8 +45,21 @@ ParameterizationResult reparameterize(const TSplineMap& old_map, const Polygon& 
                                       const ParameterizationOptions& options, const AdaptiveOptions& adaptive,
                                       std::optional<double> reference_mean_ratio,
                                       const IterationCallback& on_iteration) {
-  const auto t0 = std::chrono::steady_clock::now();
   if (moved.vertices.size() != old_polygon.vertices.size())
+    throw InputError("the moved boundary has " + std::to_string(moved.vertices.size()) +
+                     " vertices, the previous map's " + std::to_string(old_polygon.vertices.size()));
+  return reparameterize(old_map, old_polygon, corners, moved,
+                        fit_boundary_deformation(old_polygon.vertices, moved.vertices), options, adaptive,
+                        reference_mean_ratio, on_iteration);
+}
+
+ParameterizationResult reparameterize(const TSplineMap& old_map, const Polygon& old_polygon,
+                                      const std::array<std::size_t, 4>& corners, const Polygon& moved,
+                                      const BoundaryDeformation& d, const ParameterizationOptions& options,
+                                      const AdaptiveOptions& adaptive, std::optional<double> reference_mean_ratio,
+                                      const IterationCallback& on_iteration) {
+  const auto t0 = std::chrono::steady_clock::now();
+  if (moved.vertices.size() != old_polygon.vertices.size() || d.residual.size() != old_polygon.vertices.size())
     throw InputError("the moved boundary has " + std::to_string(moved.vertices.size()) +
                      " vertices, the previous map's " + std::to_string(old_polygon.vertices.size()));
   // Simple, finite, in range; the same orientation (a reflection is no motion
@@ -60,7 +80,6 @@ ParameterizationResult reparameterize(const TSplineMap& old_map, const Polygon& 
   }
   const BoundaryMap old_boundary(old_polygon, c);
   BoundaryMap new_boundary(moved, c);
-  const BoundaryDeformation d = fit_boundary_deformation(old_polygon.vertices, moved.vertices);
   WarmStart warm{warm_start_map(old_map, old_boundary, d), 0.0};
   if (reference_mean_ratio) {
     warm.reference_mean_ratio = *reference_mean_ratio;

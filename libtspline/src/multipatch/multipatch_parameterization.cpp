@@ -296,18 +296,23 @@ MultiPatchResult run_multipatch_parameterization(const Domain& domain, PatchLayo
     log("interfaces: re-running " + std::to_string(std::count(stale.begin(), stale.end(), 1)) +
         " patches with the union of the knots of their interfaces");
   }
+  finish_multipatch_result(R, adaptive, options.max_level);
+  return R;
+}
+
+void finish_multipatch_result(MultiPatchResult& R, const AdaptiveOptions& adaptive, int max_level) {
   // Refining a patch to the knots of one interface can refine its others (the
   // T-mesh stays balanced): repeat until every interface has one set of knots.
-  for (int round = 0; round < 16 && equalize_interface_knots(R, adaptive, options.max_level) > 0; ++round) {
+  for (int round = 0; round < 16 && equalize_interface_knots(R, adaptive, max_level) > 0; ++round) {
   }
   measure_interfaces(R);
   // The patches' areas on the pool's threads, summed in patch order.
+  const std::size_t P = R.patches.size();
   std::vector<double> areas(P);
   detail::parallel_ranges(P, detail::pool_threads(), [&](std::size_t begin, std::size_t end, int) {
     for (std::size_t p = begin; p < end; ++p) areas[p] = map_area(*R.patches[p].map);
   }, 2);
   R.map_area = std::accumulate(areas.begin(), areas.end(), 0.0);
-  return R;
 }
 
 }  // namespace tspline

@@ -10,6 +10,7 @@
 #include <string>
 
 #include "tspline/boundary/polygon.h"
+#include "tspline/deform/boundary_deformation.h"
 #include "tspline/pipeline/adaptive_parameterization.h"
 
 namespace tspline {
@@ -31,6 +32,16 @@ Polygon corresponding_polygon(const Polygon& old, const Polygon& read, const std
 ParameterizationResult reparameterize(const TSplineMap& old_map, const Polygon& old_polygon,
                                       const std::array<std::size_t, 4>& corners, const Polygon& moved,
                                       const ParameterizationOptions& options, const AdaptiveOptions& adaptive,
+                                      std::optional<double> reference_mean_ratio = std::nullopt,
+                                      const IterationCallback& on_iteration = {});
+
+/// The same with the deformation given (its residual: one entry per vertex of
+/// old_polygon): a patch of a layout moves with the layout's global affine
+/// part, so that two patches agree on their common side.
+ParameterizationResult reparameterize(const TSplineMap& old_map, const Polygon& old_polygon,
+                                      const std::array<std::size_t, 4>& corners, const Polygon& moved,
+                                      const BoundaryDeformation& deformation, const ParameterizationOptions& options,
+                                      const AdaptiveOptions& adaptive,
                                       std::optional<double> reference_mean_ratio = std::nullopt,
                                       const IterationCallback& on_iteration = {});
 

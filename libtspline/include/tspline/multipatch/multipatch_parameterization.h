@@ -72,6 +72,12 @@ Eigen::Vector2d side_point_uv(int side, double t);
 /// Called when a patch starts (patch index, round) for progress lines.
 using PatchCallback = std::function<void(std::size_t patch, int round)>;
 
+/// The last steps of a multi-patch run once every patch has its map: each
+/// patch refined to the union of the knots of its interfaces (the map carried
+/// over, kept only if still certified), the interfaces measured
+/// (R.interfaces) and the map's area summed (R.map_area).
+void finish_multipatch_result(MultiPatchResult& R, const AdaptiveOptions& adaptive, int max_level);
+
 /// \param cuts the cuts, or nullopt for the automatic choice.
 /// \throw InputError for an invalid domain or cuts, or no automatic layout;
 /// NumericalError as run_parameterization.
