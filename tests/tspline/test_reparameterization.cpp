@@ -5,10 +5,13 @@
 #include <doctest/doctest.h>
 
 #include <cmath>
+#include <limits>
 #include <string>
 
 #include "test_support.h"
 #include "tspline/deform/boundary_deformation.h"
+#include "tspline/deform/layout_reparameterization.h"
+#include "tspline/io/gis_reader.h"
 #include "tspline/deform/reparameterization.h"
 #include "tspline/errors.h"
 #include "tspline/io/polygon_reader.h"
@@ -49,6 +52,44 @@ bool same_tmesh(const tspline::TMesh& a, const tspline::TMesh& b) {
 tspline::ParameterizationResult reparameterize(const tspline::ParameterizationResult& old, const Polygon& moved) {
   return tspline::reparameterize(*old.map, old.front.boundary.polygon(), old.front.boundary.corners().index, moved,
                                  {}, {});
+}
+
+// The plate with a hole (8 patches, automatic cuts), validated, and its map.
+struct Plate {
+  tspline::Domain domain;
+  tspline::MultiPatchResult map;
+};
+const Plate& plate() {
+  static const Plate p = [] {
+    const tspline::io::DomainInput in =
+        tspline::io::read_domain(std::string(TSPLINE_TEST_DATA_DIR) + "/holes/plate_with_hole.txt");
+    const tspline::Domain d = tspline::validate_domain({in.outer, in.holes});
+    tspline::MultiPatchResult r = tspline::run_multipatch_parameterization(d, std::nullopt, {}, {});
+    return Plate{r.domain, std::move(r)};
+  }();
+  return p;
+}
+
+tspline::PreviousLayout previous_of(const tspline::MultiPatchResult& R) {
+  tspline::PreviousLayout old;
+  old.domain = R.domain;
+  for (std::size_t p = 0; p < R.patches.size(); ++p) {
+    old.maps.push_back(&*R.patches[p].map);
+    old.polygons.push_back(R.patches[p].front.boundary.polygon());
+    old.corners.push_back(R.patches[p].front.boundary.corners().index);
+  }
+  old.interfaces = R.layout.interfaces;
+  old.cuts = R.layout.cuts;
+  return old;
+}
+
+template <class F>
+tspline::Domain moved_domain(const tspline::Domain& d, F f) {
+  tspline::Domain m = d;
+  for (Eigen::Vector2d& v : m.outer.vertices) v = f(v);
+  for (Polygon& h : m.holes)
+    for (Eigen::Vector2d& v : h.vertices) v = f(v);
+  return m;
 }
 
 }  // namespace
@@ -192,6 +233,71 @@ TEST_SUITE("reparameterization") {
     for (int i = 0; i < 10; ++i) read.vertices.push_back({std::cos(i * 0.6), std::sin(i * 0.6)});
     CHECK_THROWS_WITH_AS(tspline::corresponding_polygon(old, read, "the outer ring"),
                          doctest::Contains("the outer ring of the moved boundary has 10 vertices"),
+                         tspline::InputError);
+  }
+
+  TEST_CASE("a multi-patch map: no motion, a rigid motion, a smooth motion; interfaces stay conforming") {
+    const Plate& P = plate();
+    REQUIRE(P.map.certified_valid());
+    const tspline::PreviousLayout old = previous_of(P.map);
+    const double D = P.map.diameter;
+    auto largest_change = [&](const tspline::MultiPatchResult& R, auto f) {
+      double err = 0.0;
+      for (std::size_t p = 0; p < R.patches.size(); ++p) {
+        const auto& a = P.map.patches[p].map->control_points();
+        const auto& b = R.patches[p].map->control_points();
+        if (a.size() != b.size()) return std::numeric_limits<double>::infinity();
+        for (std::size_t i = 0; i < a.size(); ++i) err = std::max(err, (b[i] - f(a[i])).norm());
+      }
+      return err;
+    };
+    const tspline::MultiPatchResult same = tspline::reparameterize_layout(old, P.domain, {}, {});
+    CHECK(same.certified_valid());
+    const double e0 = largest_change(same, [](const Eigen::Vector2d& x) { return x; });
+    MESSAGE("no motion: largest control point change " << e0 << " (diameter " << D << ")");
+    CHECK(e0 < 1e-12 * D);
+
+    const double th = -0.9;
+    Eigen::Matrix2d R;
+    R << std::cos(th), -std::sin(th), std::sin(th), std::cos(th);
+    const Eigen::Vector2d t(-3.0, 250.0);
+    auto rigid_motion = [&](const Eigen::Vector2d& x) { return Eigen::Vector2d(R * x + t); };
+    const tspline::MultiPatchResult rigid =
+        tspline::reparameterize_layout(old, moved_domain(P.domain, rigid_motion), {}, {});
+    CHECK(rigid.certified_valid());
+    const double e1 = largest_change(rigid, rigid_motion);
+    MESSAGE("rotation and translation: largest control point error " << e1);
+    CHECK(e1 < 1e-11 * D);
+
+    // A smooth motion of 4 % of the diameter: certified, conforming, same T-meshes where no refinement was needed.
+    Eigen::Vector2d lo = P.domain.outer.vertices.front(), hi = lo;
+    for (const auto& v : P.domain.outer.vertices) lo = lo.cwiseMin(v), hi = hi.cwiseMax(v);
+    const Eigen::Vector2d c = 0.5 * (lo + hi);
+    const tspline::MultiPatchResult wavy = tspline::reparameterize_layout(
+        old, moved_domain(P.domain, [&](const Eigen::Vector2d& x) {
+          return Eigen::Vector2d(x.x() + 0.04 * D * std::sin(2 * M_PI * (x.y() - c.y()) / D),
+                                 x.y() + 0.04 * D * std::cos(2 * M_PI * (x.x() - c.x()) / D));
+        }),
+        {}, {});
+    CHECK(wavy.certified_valid());
+    CHECK(wavy.conforming(1e-12));
+    CHECK(wavy.min_mean_ratio_dense() > 0.5 * P.map.min_mean_ratio_dense());
+    CHECK(std::abs(wavy.map_area - wavy.domain_area) < 1e-3 * wavy.domain_area);
+    std::size_t same_tmesh = 0;
+    for (std::size_t p = 0; p < wavy.patches.size(); ++p)
+      same_tmesh += wavy.patches[p].map->mesh().num_cells() == P.map.patches[p].map->mesh().num_cells();
+    MESSAGE("smooth motion: whole-map J_r " << wavy.min_mean_ratio_dense() << " (before "
+                                            << P.map.min_mean_ratio_dense() << "), " << same_tmesh << " of "
+                                            << wavy.patches.size() << " patches kept their T-mesh, gap "
+                                            << wavy.max_gap() / D << " x diameter");
+    // Mismatches: a hole fewer, a vertex fewer.
+    tspline::Domain fewer = P.domain;
+    fewer.holes.clear();
+    CHECK_THROWS_WITH_AS(tspline::reparameterize_layout(old, fewer, {}, {}), doctest::Contains("rings"),
+                         tspline::InputError);
+    tspline::Domain shorter = P.domain;
+    shorter.holes.front().vertices.pop_back(), shorter.holes.front().file_index.pop_back();
+    CHECK_THROWS_WITH_AS(tspline::reparameterize_layout(old, shorter, {}, {}), doctest::Contains("hole 1"),
                          tspline::InputError);
   }
 }
