@@ -4,6 +4,9 @@
 // and certified on the same T-mesh; mismatched boundaries are input errors.
 #include <doctest/doctest.h>
 
+#include <Eigen/LU>
+
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <string>
@@ -13,6 +16,7 @@
 #include "tspline/deform/layout_reparameterization.h"
 #include "tspline/io/gis_reader.h"
 #include "tspline/deform/reparameterization.h"
+#include "tspline/spline/bezier_extraction.h"
 #include "tspline/errors.h"
 #include "tspline/io/polygon_reader.h"
 #include "tspline/validity/map_certification.h"
@@ -299,5 +303,85 @@ TEST_SUITE("reparameterization") {
     shorter.holes.front().vertices.pop_back(), shorter.holes.front().file_index.pop_back();
     CHECK_THROWS_WITH_AS(tspline::reparameterize_layout(old, shorter, {}, {}), doctest::Contains("hole 1"),
                          tspline::InputError);
+  }
+
+  TEST_CASE("the layout's motion: exact on the rings, the field's affine part exact inside, smooth fields followed") {
+    // A disk with an off-centre hole, finely sampled (so that the moved
+    // polygons are close to the field's image of the circles).
+    auto circle = [](Eigen::Vector2d centre, double radius, int n) {
+      Polygon p;
+      for (int k = 0; k < n; ++k) {
+        p.vertices.push_back(centre + radius * Eigen::Vector2d(std::cos(2 * M_PI * k / n), std::sin(2 * M_PI * k / n)));
+        p.file_index.push_back(static_cast<std::size_t>(k));
+      }
+      return p;
+    };
+    const tspline::Domain d = tspline::validate_domain({circle({0, 0}, 2.0, 400), {circle({0.5, 0.3}, 0.6, 150)}});
+    const double D = 4.0 * std::sqrt(2.0);
+    Eigen::Vector2d lo = d.outer.vertices.front(), hi = lo;
+    for (const auto& v : d.outer.vertices) lo = lo.cwiseMin(v), hi = hi.cwiseMax(v);
+    const Eigen::Vector2d c = 0.5 * (lo + hi);
+    // A harmonic motion (the real and imaginary parts of z^2): the mean value
+    // interpolant of its residual is close to it inside.
+    auto field = [&](const Eigen::Vector2d& x) {
+      const Eigen::Vector2d y = x - c;
+      return Eigen::Vector2d(x + 0.02 / D * Eigen::Vector2d(y.x() * y.x() - y.y() * y.y(), 2 * y.x() * y.y()));
+    };
+    const tspline::Domain moved = moved_domain(d, field);
+    const tspline::LayoutMotion motion(d, moved);
+    // On a ring edge: the edge's own motion (linear between its moved ends).
+    for (const Polygon* ring : {&d.outer, &d.holes.front()}) {
+      const std::size_t n = ring->vertices.size();
+      const Polygon& to = ring == &d.outer ? moved.outer : moved.holes.front();
+      for (std::size_t i = 0; i < n; i += 3) {
+        const Eigen::Vector2d a = ring->vertices[i], b = ring->vertices[(i + 1) % n];
+        CHECK((motion(a) - to.vertices[i]).norm() < 1e-12 * D);
+        CHECK((motion(a + 0.3 * (b - a)) - (0.7 * to.vertices[i] + 0.3 * to.vertices[(i + 1) % n])).norm() < 1e-12 * D);
+      }
+    }
+    // Inside, on a grid of points: close to the field (the polygons are fine,
+    // so linear interpolation between vertices hardly departs from it).
+    double worst = 0.0;
+    std::size_t inside = 0;
+    for (int i = 1; i < 40; ++i)
+      for (int j = 1; j < 40; ++j) {
+        const Eigen::Vector2d x = lo + Eigen::Vector2d(i / 40.0 * (hi - lo).x(), j / 40.0 * (hi - lo).y());
+        if (!tspline::domain_contains(d, x)) continue;
+        ++inside;
+        worst = std::max(worst, (motion(x) - field(x)).norm());
+      }
+    REQUIRE(inside > 500);
+    MESSAGE("largest distance of the layout's motion from the field at " << inside
+                                                                         << " points inside: " << worst / D
+                                                                         << " x diameter");
+    CHECK(worst < 5e-4 * D);  // the field moves points by up to 1e-2 D
+    const Eigen::Vector2d a = d.outer.vertices[0], b = d.outer.vertices[1];
+    const Eigen::Vector2d inward = Eigen::Vector2d(-(b - a).y(), (b - a).x()).normalized();  // outer ring is CCW
+    const Eigen::Vector2d m = 0.5 * (a + b);
+    CHECK((motion(m + 1e-7 * D * inward) - motion(m)).norm() < 1e-5 * D);
+  }
+
+  TEST_CASE("map_area: the boundary integral of x dy equals the integral of det J over the square") {
+    // Against 6 x 6 Gauss points per cell (the integrand is smooth inside
+    // each Bezier element; a cell with a T-junction knot line inside is
+    // integrated to about 1e-7 relative).
+    auto area_2d = [](const tspline::TSplineMap& map) {
+      double a = 0.0;
+      std::vector<tspline::QuadraturePoint> q;
+      for (int c = 0; c < static_cast<int>(map.mesh().num_cells()); ++c) {
+        q.clear();
+        tspline::cell_quadrature(map.basis(), c, 6, q);
+        for (const auto& p : q) a += p.weight * map.derivatives(p.uv, 1, c).J.determinant();
+      }
+      return a;
+    };
+    const auto& r = isle_of_man();
+    const double a1 = tspline::map_area(*r.map), b1 = area_2d(*r.map);
+    MESSAGE("Isle of Man: boundary integral " << a1 << ", area integral " << b1);
+    CHECK(std::abs(a1 - b1) < 1e-7 * b1);
+    for (const auto& patch : plate().map.patches) {
+      const double a = tspline::map_area(*patch.map), b = area_2d(*patch.map);
+      CHECK(std::abs(a - b) < 1e-7 * b);
+    }
   }
 }

@@ -4,6 +4,7 @@
 #include <atomic>
 #include <cmath>
 #include <exception>
+#include <map>
 #include <mutex>
 #include <string>
 #include <thread>
@@ -11,6 +12,8 @@
 #include "tspline/boundary/polygon_validation.h"
 #include "tspline/deform/reparameterization.h"
 #include "tspline/errors.h"
+#include "tspline/layout/layout_optimizer.h"
+#include "tspline/layout/layout_quality.h"
 
 namespace tspline {
 namespace {
@@ -19,6 +22,88 @@ std::vector<const Polygon*> rings_of(const Domain& d) {
   std::vector<const Polygon*> r = {&d.outer};
   for (const Polygon& h : d.holes) r.push_back(&h);
   return r;
+}
+
+// The inner nodes of a quad layout (patch corners inside the domain) moved to
+// raise its worst corners on the moved rings (layout_optimizer.h), the ring
+// nodes kept where the motion put them (material points of the coast), the
+// topology kept: a layout carried through many steps would otherwise keep
+// angles that the moving coast has closed. Only for layouts whose patch sides
+// along cuts are straight segments (quad layouts); others are left as moved.
+// Returns the number of inner nodes.
+std::size_t reoptimize_inner_nodes(PatchLayout& layout, const Domain& moved, int max_sweeps) {
+  for (const Cut& c : layout.cuts)
+    if (c.size() != 2) return 0;
+  std::vector<RingCurve> curves;
+  for (const Polygon* r : rings_of(moved)) curves.emplace_back(r->vertices);
+  const RingGeometry geometry = RingGeometry::of_rings(curves);
+  Eigen::Vector2d lo = moved.outer.vertices.front(), hi = lo;
+  for (const auto& v : moved.outer.vertices) lo = lo.cwiseMin(v), hi = hi.cwiseMax(v);
+  const double tol = 1e-9 * (hi - lo).norm();
+  // Nodes: the patch corners, one per position.
+  LayoutMesh m;
+  std::map<std::pair<double, double>, int> id;
+  auto node = [&](const Eigen::Vector2d& x) {
+    const auto [it, added] = id.try_emplace({x.x(), x.y()}, static_cast<int>(m.x.size()));
+    if (added) {
+      m.x.push_back(x);
+      int ring = -1;
+      double arc = 0.0;
+      const int e = geometry.nearest(x);
+      if (e >= 0 && segment_distance(x, geometry.edge(e).a, geometry.edge(e).b) <= tol) {
+        const RingGeometry::Edge& edge = geometry.edge(e);
+        ring = edge.ring;
+        arc = curves[ring].arc(edge.index) + (x - edge.a).norm();
+      }
+      m.ring.push_back(ring);
+      m.arc.push_back(arc);
+    }
+    return it->second;
+  };
+  for (const Patch& p : layout.patches) {
+    std::array<int, 4> q;
+    for (int k = 0; k < 4; ++k) q[k] = node(p.polygon.vertices[p.corners[k]]);
+    m.quads.push_back(q);
+  }
+  // A side along a cut must be the straight segment between its corners.
+  for (const Patch& p : layout.patches)
+    for (int k = 0; k < 4; ++k) {
+      const std::size_t n = p.polygon.vertices.size(), a = p.corners[k], b = p.corners[(k + 1) % 4];
+      if (p.side_cut[k] >= 0 && (a + 1) % n != b) return 0;
+    }
+  std::vector<int> inner;
+  for (std::size_t n = 0; n < m.size(); ++n)
+    if (m.ring[n] < 0) inner.push_back(static_cast<int>(n));
+  if (inner.empty()) return 0;
+  LayoutRings rings;
+  rings.curves = curves;
+  const LayoutQuality quality(rings);
+  const LayoutAdmissible admissible = [&](const LayoutMesh& lm, const LayoutTopology& t, int n) {
+    if (lm.ring[n] < 0 && !geometry.inside(lm.x[n])) return false;
+    for (const auto& [q, j] : t.corners_of(n))
+      for (const int k : {1, 3}) {
+        if (t.on_ring(q, k == 1 ? j : (j + 3) % 4)) continue;
+        const int other = lm.quads[q][(j + k) % 4];
+        if (geometry.crosses(lm.x[n], lm.x[other], lm.ring[n] >= 0, lm.ring[other] >= 0, tol)) return false;
+      }
+    return true;
+  };
+  LayoutOptimizationOptions o;
+  o.max_sweeps = max_sweeps;
+  const std::vector<Eigen::Vector2d> before = m.x;
+  optimize_layout_nodes(m, quality, admissible, inner, o);
+  // The patches' corners and the cuts' ends where their nodes went.
+  for (Patch& p : layout.patches)
+    for (int k = 0; k < 4; ++k) {
+      Eigen::Vector2d& v = p.polygon.vertices[p.corners[k]];
+      v = m.x[id.at({v.x(), v.y()})];
+    }
+  for (Cut& c : layout.cuts)
+    for (Eigen::Vector2d& v : c) {
+      const auto it = id.find({v.x(), v.y()});
+      if (it != id.end()) v = m.x[it->second];
+    }
+  return inner.size();
 }
 
 }  // namespace
@@ -55,21 +140,40 @@ Eigen::Vector2d LayoutMotion::operator()(const Eigen::Vector2d& x) const {
       return (1.0 - t) * new_[i] + t * new_[j];
     }
   }
-  // Inside: the affine part and Shepard's inverse-distance average (power 2)
-  // of the rings' residuals, a smooth field that equals them at the rings.
+  // Inside: the affine part and the mean value interpolant of the rings'
+  // residuals (Floater 2003; Hormann & Floater 2006 for polygons with holes:
+  // signed angles, every ring oriented with the domain on its left, i.e. holes
+  // clockwise). It reproduces the residual's piecewise linear values on the
+  // ring edges (so a point near the coast moves as the coast next to it) and
+  // linear functions.
   Eigen::Vector2d sum = Eigen::Vector2d::Zero();
   double w = 0.0;
-  for (std::size_t k = 0; k < old_.size(); ++k) {
-    const double d2 = (x - old_[k]).squaredNorm();
-    sum += global_.residual[k] / d2;
-    w += 1.0 / d2;
+  for (std::size_t r = 0; r + 1 < ring_start_.size(); ++r) {
+    const std::size_t first = ring_start_[r], n = ring_start_[r + 1] - first;
+    const bool reverse = r > 0;  // validated holes run counter-clockwise
+    auto vertex = [&](std::size_t k) { return first + (reverse ? (n - k) % n : k % n); };
+    // tan(alpha_k / 2) of the signed angle at x from vertex k to vertex k + 1.
+    auto half_tan = [&](std::size_t k) {
+      const Eigen::Vector2d a = old_[vertex(k)] - x, b = old_[vertex(k + 1)] - x;
+      return (a.x() * b.y() - a.y() * b.x()) / (a.norm() * b.norm() + a.dot(b));
+    };
+    double t_prev = half_tan(n - 1);
+    for (std::size_t k = 0; k < n; ++k) {
+      const double t = half_tan(k);
+      const std::size_t i = vertex(k);
+      const double wk = (t_prev + t) / (old_[i] - x).norm();
+      sum += wk * global_.residual[i];
+      w += wk;
+      t_prev = t;
+    }
   }
   return global_.affine(x) + sum / w;
 }
 
 MultiPatchResult reparameterize_layout(const PreviousLayout& old, const Domain& moved_in,
                                        const ParameterizationOptions& options, const AdaptiveOptions& adaptive,
-                                       const MultiPatchOptions& multi, const PatchCallback& on_patch) {
+                                       const MultiPatchOptions& multi, const PatchCallback& on_patch,
+                                       int layout_sweeps) {
   const std::size_t P = old.maps.size();
   if (P == 0 || old.polygons.size() != P || old.corners.size() != P)
     throw InputError("the previous layout has no patches, or not one polygon and corners per patch");
@@ -103,18 +207,25 @@ MultiPatchResult reparameterize_layout(const PreviousLayout& old, const Domain& 
     R.layout.cuts.push_back(std::move(m));
   }
   R.layout.interfaces = old.interfaces;
-  std::vector<BoundaryDeformation> per_patch(P);
   for (std::size_t p = 0; p < P; ++p) {
     Patch patch;
     patch.polygon = old.polygons[p];
     patch.corners = old.corners[p];
+    for (Eigen::Vector2d& v : patch.polygon.vertices) v = motion(v);
+    R.layout.patches.push_back(std::move(patch));
+  }
+  for (const Interface& f : R.layout.interfaces) {
+    R.layout.patches[f.patch_a].side_cut[f.side_a] = static_cast<int>(f.cut);
+    R.layout.patches[f.patch_b].side_cut[f.side_b] = static_cast<int>(f.cut);
+  }
+  if (layout_sweeps > 0) reoptimize_inner_nodes(R.layout, moved, layout_sweeps);
+  std::vector<BoundaryDeformation> per_patch(P);
+  for (std::size_t p = 0; p < P; ++p) {
+    const Patch& patch = R.layout.patches[p];
     per_patch[p].A = motion.deformation().A;
     per_patch[p].b = motion.deformation().b;
-    for (Eigen::Vector2d& v : patch.polygon.vertices) {
-      const Eigen::Vector2d to = motion(v);
-      per_patch[p].residual.push_back(to - per_patch[p].affine(v));
-      v = to;
-    }
+    for (std::size_t k = 0; k < patch.polygon.vertices.size(); ++k)
+      per_patch[p].residual.push_back(patch.polygon.vertices[k] - per_patch[p].affine(old.polygons[p].vertices[k]));
     try {
       const Polygon checked = validate_polygon(patch.polygon);
       if (checked.vertices != patch.polygon.vertices) throw InputError("it turned over");
@@ -124,11 +235,6 @@ MultiPatchResult reparameterize_layout(const PreviousLayout& old, const Domain& 
                        std::to_string(at.x()) + ", " + std::to_string(at.y()) + ") folds (" + e.what() +
                        "); map the moved domain from scratch, or move it in smaller steps");
     }
-    R.layout.patches.push_back(std::move(patch));
-  }
-  for (const Interface& f : R.layout.interfaces) {
-    R.layout.patches[f.patch_a].side_cut[f.side_a] = static_cast<int>(f.cut);
-    R.layout.patches[f.patch_b].side_cut[f.side_b] = static_cast<int>(f.cut);
   }
   {
     Eigen::Vector2d lo = moved.outer.vertices.front(), hi = lo;
@@ -167,7 +273,10 @@ MultiPatchResult reparameterize_layout(const PreviousLayout& old, const Domain& 
             cb(f);
           };
         runs[p].emplace(reparameterize(*old.maps[p], old.polygons[p], old.corners[p], R.layout.patches[p].polygon,
-                                       per_patch[p], po, adaptive));
+                                       per_patch[p], po, adaptive,
+                                       old.reference_mean_ratio.size() == P
+                                           ? std::optional<double>(old.reference_mean_ratio[p])
+                                           : std::nullopt));
       } catch (...) {
         std::lock_guard<std::mutex> lock(error_mutex);
         if (!error) error = std::current_exception();

@@ -11,6 +11,7 @@
 #include "tspline/boundary/polygon_validation.h"
 #include "tspline/deform/boundary_deformation.h"
 #include "tspline/errors.h"
+#include "tspline/spline/bezier_extraction.h"
 #include "tspline/tmesh/mesh_quality.h"
 #include "tspline/validity/map_quality.h"
 
@@ -84,9 +85,12 @@ ParameterizationResult reparameterize(const TSplineMap& old_map, const Polygon& 
   if (reference_mean_ratio) {
     warm.reference_mean_ratio = *reference_mean_ratio;
   } else {
-    const MapQualityStats q = map_quality(old_map, adaptive.gauss);
-    warm.reference_mean_ratio =
-        std::min(q.min_mean_ratio, dense_map_quality(old_map, adaptive.dense_samples).min_mean_ratio);
+    // One Bezier extraction for both checks (as the adaptive loop's).
+    const BezierExtraction extraction(old_map.basis());
+    const MapQualityStats q = map_quality(old_map, extraction, adaptive.gauss);
+    warm.reference_mean_ratio = std::min(
+        q.min_mean_ratio,
+        dense_map_quality(extraction, old_map.control_points(), adaptive.dense_samples).min_mean_ratio);
   }
 
   FrontResult front(std::move(new_boundary));

@@ -246,10 +246,11 @@ class AdaptiveRun {
     const DenseMapQuality dense = whole_map_quality(map, wcells, &extraction);
     t_check_ += seconds_since(t2);
     const double ref = warm_->reference_mean_ratio;
-    // Round-off: a rigid motion changes J_r by a few ulps of the control points.
-    if (!(dense.min_mean_ratio >= ref - 1e-9 * std::max(1.0, std::abs(ref)))) return false;
+    // 1e-9: round-off (a rigid motion changes J_r by a few ulps of the control points).
+    if (!(dense.min_mean_ratio >= ref - (warm_->keep_loss + 1e-9) * std::max(1e-300, std::abs(ref)))) return false;
     log("warm_start", "warm start: the moved map is certified and its whole-map J_r " +
-                          std::to_string(dense.min_mean_ratio) + " is no lower than the previous map's " +
+                          std::to_string(dense.min_mean_ratio) + " is within " +
+                          std::to_string(100.0 * warm_->keep_loss) + " % of the previous map's " +
                           std::to_string(ref) + "; kept as moved");
     warm_kept_ = true;
     cert = std::move(wc);

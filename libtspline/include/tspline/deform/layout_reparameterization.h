@@ -3,8 +3,8 @@
 // layout (patches, corners, interfaces), T-meshes and knots. The rings' motion
 // (vertex i of ring k to vertex i of ring k) moves every point of the layout:
 // points on the rings with the ring edge they lie on, inner layout nodes and
-// cut points by the motion's global affine part plus an inverse-distance
-// average of the rings' residual motion. Each patch then moves like a single
+// cut points by the motion's global affine part plus the mean value
+// interpolant of the rings' residual motion (linear along each ring edge). Each patch then moves like a single
 // patch (reparameterization.h) with the layout's one affine part, so that two
 // patches agree on their common side; knots are equalized across interfaces
 // where a patch had to refine.
@@ -29,6 +29,8 @@ struct PreviousLayout {
   std::vector<std::array<std::size_t, 4>> corners;
   std::vector<Interface> interfaces;
   std::vector<Cut> cuts;
+  /// Per patch, its map's whole-map J_r if known (a run in memory); empty: measured.
+  std::vector<double> reference_mean_ratio;
 };
 
 /// Moves any point of the previous domain (on a ring or inside) with the rings.
@@ -47,13 +49,17 @@ class LayoutMotion {
   std::optional<RingGeometry> rings_;        // the old rings' edges, bucketed
 };
 
-/// The moved domain's map. `moved`: rings in the previous domain's numbering
+/// The moved domain's map. `layout_sweeps`: sweeps of the layout optimizer
+/// (layout_optimizer.h) over the inner nodes of a quad layout on the moved
+/// rings, the ring nodes and the topology kept (0: the nodes stay where the
+/// motion put them). `moved`: rings in the previous domain's numbering
 /// (corresponding_polygon per ring). \throw InputError: other ring or vertex
 /// counts, a moved ring that is not simple or crosses another (validate_domain's
 /// message), a reflection, or a motion so large that a patch of the layout
 /// folds (then map the domain from scratch); NumericalError as the patch runs.
 MultiPatchResult reparameterize_layout(const PreviousLayout& old, const Domain& moved,
                                        const ParameterizationOptions& options, const AdaptiveOptions& adaptive,
-                                       const MultiPatchOptions& multi = {}, const PatchCallback& on_patch = {});
+                                       const MultiPatchOptions& multi = {}, const PatchCallback& on_patch = {},
+                                       int layout_sweeps = 8);
 
 }  // namespace tspline

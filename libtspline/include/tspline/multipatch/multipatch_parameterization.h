@@ -58,8 +58,9 @@ struct MultiPatchResult {
   double min_scaled_jacobian_dense() const;  ///< min over patches of the scaled Jacobian over the dense sample
 };
 
-/// Area of the image of the map: the integral of det J over [0,1]^2 (4 x 4
-/// Gauss points on every Bezier element, exact up to the rational weights).
+/// Area of the image of the map: the integral of det J over [0,1]^2, computed
+/// as the integral of x dy along the image of the square's border (Green's
+/// theorem; exact up to round-off: the border curve is a polynomial spline).
 double map_area(const TSplineMap& map);
 
 /// The largest distance between S_a(side_a at t) and S_b(side_b at 1 - t) over

@@ -139,9 +139,14 @@ void validate_options(const AdaptiveOptions& options);
 struct WarmStart {
   TSplineMap map;  ///< on front.mesh, its boundary curve on front.boundary's polygon
   /// Whole-map J_r (dense sample) of the map it was moved from. Round 0 keeps
-  /// the warm map as it is if it is certified and at least this good; else it
-  /// is untangled and improved like a fitted map.
+  /// the warm map as it is if it is certified and its whole-map J_r is at
+  /// least (1 - keep_loss) times this; else it is untangled and improved like
+  /// a fitted map.
   double reference_mean_ratio = 0.0;
+  /// The relative loss of whole-map J_r a warm map may have and still be kept
+  /// without optimization (over 20 such steps at most 1 - 0.98^20 = 33 %; an
+  /// optimized step restores the quality). 0: only maps as good as before.
+  double keep_loss = 0.02;
   /// Round 0 stops (no refinement) once certified with at least this fraction
   /// of reference_mean_ratio; below it the usual refinement rules apply.
   double keep_fraction = 0.9;
