@@ -79,9 +79,19 @@ Eigen::Vector2d residual_extension(const BoundaryMap& bm, const BoundaryDeformat
 }
 
 TSplineMap warm_start_map(const TSplineMap& old, const BoundaryMap& old_boundary, const BoundaryDeformation& d) {
-  return interpolate_map(old.mesh(), [&](const Eigen::Vector2d& uv) -> Eigen::Vector2d {
-    return d.affine(old.point(uv)) + residual_extension(old_boundary, d, uv);
-  });
+  // The interpolation is linear in the targets and reproduces the space, and
+  // A S_old + b is the map of the control points A P + b (the functions sum to
+  // 1): only the residual's extension needs the solve.
+  std::vector<Eigen::Vector2d> P = old.control_points();
+  for (Eigen::Vector2d& p : P) p = d.affine(p);
+  if (d.max_residual() > 0.0) {
+    const TSplineMap r = interpolate_map(
+        old.mesh(), [&](const Eigen::Vector2d& uv) { return residual_extension(old_boundary, d, uv); });
+    for (std::size_t i = 0; i < P.size(); ++i) P[i] += r.control_points()[i];
+  }
+  TSplineMap out = old;
+  out.set_control_points(std::move(P));
+  return out;
 }
 
 }  // namespace tspline

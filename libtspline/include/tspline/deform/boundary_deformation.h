@@ -41,9 +41,10 @@ Eigen::Vector2d residual_extension(const BoundaryMap& old_boundary, const Bounda
                                    const Eigen::Vector2d& uv);
 
 /// The warm start on the old map's own T-mesh: the interpolant (Eq. 8, same
-/// interpolation points) of A S_old(xi) + b + R(xi). For an affine motion it is
-/// A S_old + b up to round-off (the functions sum to 1, so that map is in the
-/// space, and the interpolation reproduces the space); for no motion, S_old.
+/// interpolation points) of A S_old(xi) + b + R(xi), i.e. control points
+/// A P + b (the functions sum to 1, and the interpolation reproduces the space)
+/// plus the interpolant of R. For an affine motion exactly A S_old + b; for no
+/// motion, S_old.
 /// \throw NumericalError as interpolate_map.
 TSplineMap warm_start_map(const TSplineMap& old, const BoundaryMap& old_boundary, const BoundaryDeformation& d);
 
