@@ -118,4 +118,60 @@ TEST_SUITE("param_from_app") {
     CHECK(bad.exit_code == 1);
     CHECK(!fs::exists(d / "bad" / "tspline.json"));
   }
+
+  TEST_CASE("tspline param --from on a multi-patch map: a rigid motion moves every patch; old files are refused") {
+    const fs::path d = test_support::scratch_dir("param_from", "plate");
+    const std::string plate = std::string(TSPLINE_TEST_DATA_DIR) + "/holes/plate_with_hole.txt";
+    const auto first = run_program(TSPLINE_APP_PATH, "param " + q(plate) + " --quiet --out " + q(d / "first"), d);
+    REQUIRE(first.exit_code == 0);
+    // The rings of the file moved by a rotation and a translation, blank lines between rings kept.
+    const double th = 0.3;
+    std::ifstream in(plate);
+    std::ofstream out(d / "moved.txt");
+    out.precision(17);
+    std::string line;
+    while (std::getline(in, line)) {
+      double x = 0, y = 0;
+      std::istringstream s(line);
+      if (line.empty() || line[0] == '#' || !(s >> x >> y)) {
+        out << line << '\n';
+        continue;
+      }
+      out << std::cos(th) * x - std::sin(th) * y + 5.0 << ' ' << std::sin(th) * x + std::cos(th) * y - 2.0 << '\n';
+    }
+    out.close();
+    const auto moved = run_program(TSPLINE_APP_PATH,
+                                   "param " + q(d / "moved.txt") + " --quiet --from " +
+                                       q(d / "first" / "tspline.json") + " --out " + q(d / "moved"),
+                                   d);
+    CAPTURE(moved.err);
+    REQUIRE(moved.exit_code == 0);
+    std::ifstream a(d / "first" / "tspline.json"), b(d / "moved" / "tspline.json");
+    const nlohmann::json A = nlohmann::json::parse(a), B = nlohmann::json::parse(b);
+    REQUIRE(A.at("patches").size() == B.at("patches").size());
+    CHECK(B.contains("domain"));
+    double err = 0.0;
+    for (std::size_t p = 0; p < A["patches"].size(); ++p) {
+      const auto& fa = A["patches"][p]["functions"];
+      const auto& fb = B["patches"][p]["functions"];
+      REQUIRE(fa.size() == fb.size());
+      for (std::size_t i = 0; i < fa.size(); ++i) {
+        const double x = fa[i]["control_point"][0], y = fa[i]["control_point"][1];
+        const Eigen::Vector2d want(std::cos(th) * x - std::sin(th) * y + 5.0, std::sin(th) * x + std::cos(th) * y - 2.0);
+        err = std::max(err, (Eigen::Vector2d(fb[i]["control_point"][0], fb[i]["control_point"][1]) - want).norm());
+      }
+    }
+    CHECK(err < 1e-12);
+    // A version-2 file without the domain's rings (written before they were recorded).
+    nlohmann::json old = A;
+    old.erase("domain");
+    std::ofstream(d / "old.json") << old.dump();
+    const auto refused = run_program(TSPLINE_APP_PATH,
+                                     "param " + q(d / "moved.txt") + " --from " + q(d / "old.json") + " --out " +
+                                         q(d / "refused"),
+                                     d);
+    CHECK(refused.exit_code == 1);
+    CHECK(contains(refused.err, "does not record the rings"));
+    CHECK(!fs::exists(d / "refused" / "tspline.json"));
+  }
 }
