@@ -175,6 +175,9 @@ ParamRun run_param(tspline::io::DomainInput domain, std::string source, const Pa
     report_notes();
   }
   std::optional<tspline::io::LoadedMaps> file;
+  if ((previous || !settings.from_file.empty()) &&
+      (!settings.cuts_file.empty() || settings.choice.layout != tspline::LayoutMode::Auto))
+    throw tspline::InputError("--layout or --cuts with --from: the layout is the previous map's");
   if (!previous && !settings.from_file.empty()) {
     file = tspline::io::read_maps_file(settings.from_file);
     previous.emplace();

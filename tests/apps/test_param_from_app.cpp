@@ -112,6 +112,13 @@ TEST_SUITE("param_from_app") {
     CHECK(crossed.exit_code == 1);
     CHECK(contains(crossed.err, "not simple"));
     CHECK(!fs::exists(d / "crossing" / "tspline.json"));
+    // A layout option with --from: the layout is the previous map's.
+    const auto layout = run_program(TSPLINE_APP_PATH,
+                                    "param " + q(coast) + " --layout quad --from " +
+                                        q(d / "first" / "tspline.json") + " --out " + q(d / "layout"),
+                                    d);
+    CHECK(layout.exit_code == 1);
+    CHECK(contains(layout.err, "the layout is the previous map's"));
     // Not a T-spline file.
     const auto bad = run_program(TSPLINE_APP_PATH,
                                  "param " + q(coast) + " --from " + q(coast) + " --out " + q(d / "bad"), d);
