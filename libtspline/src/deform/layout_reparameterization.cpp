@@ -1,7 +1,6 @@
 #include "tspline/deform/layout_reparameterization.h"
 
 #include <algorithm>
-#include <atomic>
 #include <cmath>
 #include <exception>
 #include <map>
@@ -78,16 +77,7 @@ std::size_t reoptimize_inner_nodes(PatchLayout& layout, const Domain& moved, int
   LayoutRings rings;
   rings.curves = curves;
   const LayoutQuality quality(rings);
-  const LayoutAdmissible admissible = [&](const LayoutMesh& lm, const LayoutTopology& t, int n) {
-    if (lm.ring[n] < 0 && !geometry.inside(lm.x[n])) return false;
-    for (const auto& [q, j] : t.corners_of(n))
-      for (const int k : {1, 3}) {
-        if (t.on_ring(q, k == 1 ? j : (j + 3) % 4)) continue;
-        const int other = lm.quads[q][(j + k) % 4];
-        if (geometry.crosses(lm.x[n], lm.x[other], lm.ring[n] >= 0, lm.ring[other] >= 0, tol)) return false;
-      }
-    return true;
-  };
+  const LayoutAdmissible admissible = admissible_in(geometry, tol);
   LayoutOptimizationOptions o;
   o.max_sweeps = max_sweeps;
   const std::vector<Eigen::Vector2d> before = m.x;
@@ -254,46 +244,21 @@ MultiPatchResult reparameterize_layout(const PreviousLayout& old, const Domain& 
       cb(e);
     };
   std::vector<std::optional<ParameterizationResult>> runs(P);
-  std::atomic<std::size_t> next{0};
-  std::atomic<bool> failed{false};
-  std::exception_ptr error;
-  std::mutex error_mutex;
-  auto work = [&]() {
-    for (std::size_t p; !failed && (p = next++) < P;) {
-      try {
-        if (on_patch) {
-          std::lock_guard<std::mutex> lock(progress_mutex);
-          on_patch(p, 0);
-        }
-        ParameterizationOptions po = shared;
-        if (shared.progress)
-          po.progress = [cb = shared.progress, p](const ProgressEvent& e) {
-            ProgressEvent f = e;
-            f.text = "patch " + std::to_string(p) + ": " + e.text;
-            cb(f);
-          };
-        runs[p].emplace(reparameterize(*old.maps[p], old.polygons[p], old.corners[p], R.layout.patches[p].polygon,
-                                       per_patch[p], po, adaptive,
-                                       old.reference_mean_ratio.size() == P
-                                           ? std::optional<double>(old.reference_mean_ratio[p])
-                                           : std::nullopt));
-      } catch (...) {
-        std::lock_guard<std::mutex> lock(error_mutex);
-        if (!error) error = std::current_exception();
-        failed = true;
-      }
-    }
-  };
   const unsigned threads =
       multi.threads > 0 ? static_cast<unsigned>(multi.threads) : std::max(1u, std::thread::hardware_concurrency());
-  const unsigned n = static_cast<unsigned>(std::min<std::size_t>(threads, P));
-  if (n <= 1) work();
-  else {
-    std::vector<std::thread> pool;
-    for (unsigned t = 0; t < n; ++t) pool.emplace_back(work);
-    for (std::thread& t : pool) t.join();
-  }
-  if (error) std::rethrow_exception(error);
+  for_each_patch(P, threads, [&](std::size_t p) {
+    if (on_patch) {
+      std::lock_guard<std::mutex> lock(progress_mutex);
+      on_patch(p, 0);
+    }
+    ParameterizationOptions po = shared;
+    po.progress = patch_progress(shared.progress, p);
+    runs[p].emplace(reparameterize(*old.maps[p], old.polygons[p], old.corners[p], R.layout.patches[p].polygon,
+                                   per_patch[p], po, adaptive,
+                                   old.reference_mean_ratio.size() == P
+                                       ? std::optional<double>(old.reference_mean_ratio[p])
+                                       : std::nullopt));
+  });
   R.patches.reserve(P);
   for (auto& r : runs) R.patches.push_back(std::move(*r));
   finish_multipatch_result(R, adaptive, options.max_level);

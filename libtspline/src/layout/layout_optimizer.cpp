@@ -272,4 +272,17 @@ LayoutOptimizationReport optimize_layout_nodes(LayoutMesh& m, const LayoutQualit
   return report;
 }
 
+LayoutAdmissible admissible_in(const RingGeometry& geometry, double tol) {
+  return [&geometry, tol](const LayoutMesh& m, const LayoutTopology& t, int n) {
+    if (m.ring[n] < 0 && !geometry.inside(m.x[n])) return false;
+    for (const auto& [q, j] : t.corners_of(n))
+      for (const int k : {1, 3}) {
+        if (t.on_ring(q, k == 1 ? j : (j + 3) % 4)) continue;
+        const int other = m.quads[q][(j + k) % 4];
+        if (geometry.crosses(m.x[n], m.x[other], m.ring[n] >= 0, m.ring[other] >= 0, tol)) return false;
+      }
+    return true;
+  };
+}
+
 }  // namespace tspline

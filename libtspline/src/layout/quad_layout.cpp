@@ -189,16 +189,7 @@ QuadLayout build_quad_layout(const Domain& d, const QuadLayoutOptions& o) {
   const double tol = 1e-9 * diam;
   const LayoutQuality quality(R);
   // A node may stay where the optimizer moved it: inside the domain, its cuts off the rings.
-  const LayoutAdmissible admissible = [&](const LayoutMesh& m, const LayoutTopology& t, int n) {
-    if (m.ring[n] < 0 && !geometry.inside(m.x[n])) return false;
-    for (const auto& [q, j] : t.corners_of(n))
-      for (const int k : {1, 3}) {
-        if (t.on_ring(q, k == 1 ? j : (j + 3) % 4)) continue;
-        const int other = m.quads[q][(j + k) % 4];
-        if (geometry.crosses(m.x[n], m.x[other], m.ring[n] >= 0, m.ring[other] >= 0, tol)) return false;
-      }
-    return true;
-  };
+  const LayoutAdmissible admissible = admissible_in(geometry, tol);
 
   auto note = [&](const std::string& text) {
     if (o.progress) o.progress(text);

@@ -241,48 +241,22 @@ MultiPatchResult run_multipatch_parameterization(const Domain& domain, PatchLayo
     for (std::size_t p = 0; p < P; ++p)
       if (stale[p]) todo.push_back(p);
     std::vector<std::optional<ParameterizationResult>> runs(todo.size());
-    std::atomic<std::size_t> next{0};
-    std::atomic<bool> failed{false};
-    std::exception_ptr error;
-    std::mutex error_mutex;
-    auto work = [&]() {
-      for (std::size_t i; !failed && (i = next++) < todo.size();) {
-        const std::size_t p = todo[i];
-        try {
-          if (on_patch) {
-            std::lock_guard<std::mutex> lock(progress_mutex);
-            on_patch(p, round);
-          }
-          ParameterizationOptions po = shared;
-          const Patch& patch = R.layout.patches[p];
-          po.corners = std::array<long long, 4>{};
-          for (int k = 0; k < 4; ++k) (*po.corners)[k] = static_cast<long long>(patch.corners[k]);
-          po.corner_trials = 1;
-          po.border_params = required[p];
-          // The patch's events, its text prefixed with the patch.
-          if (shared.progress)
-            po.progress = [cb = shared.progress, p](const ProgressEvent& e) {
-              ProgressEvent f = e;
-              f.text = "patch " + std::to_string(p) + ": " + e.text;
-              cb(f);
-            };
-          runs[i].emplace(run_parameterization(patch.polygon, po, adaptive));
-          if (!runs[i]->map) throw NumericalError("patch " + std::to_string(p) + ": no map was produced");
-        } catch (...) {
-          std::lock_guard<std::mutex> lock(error_mutex);
-          if (!error) error = std::current_exception();
-          failed = true;
-        }
+    for_each_patch(todo.size(), threads, [&](std::size_t i) {
+      const std::size_t p = todo[i];
+      if (on_patch) {
+        std::lock_guard<std::mutex> lock(progress_mutex);
+        on_patch(p, round);
       }
-    };
-    const unsigned n = static_cast<unsigned>(std::min<std::size_t>(threads, todo.size()));
-    if (n <= 1) work();
-    else {
-      std::vector<std::thread> pool;
-      for (unsigned t = 0; t < n; ++t) pool.emplace_back(work);
-      for (std::thread& t : pool) t.join();
-    }
-    if (error) std::rethrow_exception(error);
+      ParameterizationOptions po = shared;
+      const Patch& patch = R.layout.patches[p];
+      po.corners = std::array<long long, 4>{};
+      for (int k = 0; k < 4; ++k) (*po.corners)[k] = static_cast<long long>(patch.corners[k]);
+      po.corner_trials = 1;
+      po.border_params = required[p];
+      po.progress = patch_progress(shared.progress, p);
+      runs[i].emplace(run_parameterization(patch.polygon, po, adaptive));
+      if (!runs[i]->map) throw NumericalError("patch " + std::to_string(p) + ": no map was produced");
+    });
     for (std::size_t i = 0; i < todo.size(); ++i) {
       const std::size_t p = todo[i];
       if (round == 0) R.patches.push_back(std::move(*runs[i]));  // round 0 runs every patch, in order
@@ -316,6 +290,41 @@ MultiPatchResult run_multipatch_parameterization(const Domain& domain, PatchLayo
   }
   finish_multipatch_result(R, adaptive, options.max_level);
   return R;
+}
+
+void for_each_patch(std::size_t n, unsigned threads, const std::function<void(std::size_t)>& task) {
+  std::atomic<std::size_t> next{0};
+  std::atomic<bool> failed{false};
+  std::exception_ptr error;
+  std::mutex error_mutex;
+  auto work = [&]() {
+    for (std::size_t i; !failed && (i = next++) < n;) {
+      try {
+        task(i);
+      } catch (...) {
+        std::lock_guard<std::mutex> lock(error_mutex);
+        if (!error) error = std::current_exception();
+        failed = true;
+      }
+    }
+  };
+  const unsigned k = static_cast<unsigned>(std::min<std::size_t>(threads, n));
+  if (k <= 1) work();
+  else {
+    std::vector<std::thread> pool;
+    for (unsigned t = 0; t < k; ++t) pool.emplace_back(work);
+    for (std::thread& t : pool) t.join();
+  }
+  if (error) std::rethrow_exception(error);
+}
+
+ProgressCallback patch_progress(const ProgressCallback& progress, std::size_t p) {
+  if (!progress) return {};
+  return [progress, p](const ProgressEvent& e) {
+    ProgressEvent f = e;
+    f.text = "patch " + std::to_string(p) + ": " + e.text;
+    progress(f);
+  };
 }
 
 void finish_multipatch_result(MultiPatchResult& R, const AdaptiveOptions& adaptive, int max_level) {

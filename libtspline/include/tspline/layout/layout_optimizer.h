@@ -24,6 +24,7 @@
 
 #include "tspline/layout/layout_mesh.h"
 #include "tspline/layout/layout_quality.h"
+#include "tspline/layout/ring_geometry.h"
 
 namespace tspline {
 
@@ -60,6 +61,12 @@ struct LayoutOptimizationReport {
 LayoutCornerQuality worst_layout_quality(const LayoutMesh& m, const LayoutTopology& t, const LayoutQuality& q);
 
 using LayoutAdmissible = std::function<bool(const LayoutMesh&, const LayoutTopology&, int)>;
+
+/// The check of the true geometry: an inner node inside the domain the rings
+/// of `geometry` bound, and no cut from node n (a quad edge not on a ring)
+/// crossing a ring (ends within tol of a ring count as on it). `geometry` must
+/// outlive the returned function.
+LayoutAdmissible admissible_in(const RingGeometry& geometry, double tol);
 
 /// \param admissible whether node n may stay where it now is (called after a
 /// tentative move that lowers the energy).

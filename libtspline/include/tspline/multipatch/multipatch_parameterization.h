@@ -73,6 +73,14 @@ Eigen::Vector2d side_point_uv(int side, double t);
 /// Called when a patch starts (patch index, round) for progress lines.
 using PatchCallback = std::function<void(std::size_t patch, int round)>;
 
+/// Runs task(i) for every i in [0, n) on min(threads, n) threads of their own
+/// (each patch run uses the process's pool inside), each taking the next i;
+/// after the first exception no task starts, and it is rethrown here.
+void for_each_patch(std::size_t n, unsigned threads, const std::function<void(std::size_t)>& task);
+
+/// The progress callback of patch p: `progress` with "patch p: " before each text (empty if progress is).
+ProgressCallback patch_progress(const ProgressCallback& progress, std::size_t p);
+
 /// The last steps of a multi-patch run once every patch has its map: each
 /// patch refined to the union of the knots of its interfaces (the map carried
 /// over, kept only if still certified), the interfaces measured
