@@ -160,6 +160,9 @@ ParamRun run_param(tspline::io::DomainInput domain, std::string source, const Pa
     how.needle_width =
         tspline::needle_width_for_ring(in.outer, opt.tolerance_absolute, opt.tolerance_relative);
     how.notes = &run.cleaning_notes;
+    const double diagonal = tspline::bounding_box_diagonal(in.outer);
+    how.crossing_repair_area =
+        opt.tolerance_absolute ? *opt.tolerance_absolute : opt.tolerance_relative * diagonal * diagonal;
     how.repair_crossing_holes = settings.repair_crossing_holes;
     auto report_notes = [&] {
       for (const std::string& note : run.cleaning_notes)

@@ -207,6 +207,27 @@ TEST_SUITE("holes") {
     // The hull of (5,5), (6,5), (7,6), (7,5), (6,6): the square [6,7] x [5,6] with the triangle to (5,5).
     CHECK(std::abs(tspline::signed_area(fixed.holes[1])) == doctest::Approx(1.5));
     CHECK(tspline::domain_area(fixed) == doctest::Approx(100.0 - 1.0 - 1.5));
+    // By default a crossing islet is repaired only if its hull is below the
+    // boundary tolerance's area (here 1e-5 x diagonal^2 = 0.002): the hull of
+    // this one is 1.5, an input error; with the limit at 1.5 it is repaired.
+    tspline::DomainCleaningOptions limit;
+    limit.crossing_repair_area = 1.49;
+    CHECK(message_of<tspline::InputError>([&] { (void)tspline::validate_domain(bow, limit); }) == m);
+    limit.crossing_repair_area = 1.5;
+    CHECK(tspline::domain_area(tspline::validate_domain(bow, limit)) == doctest::Approx(100.0 - 1.0 - 1.5));
+    // A Maldives islet (hole 37 of seas/maldives.txt, scaled): a Z of four
+    // vertices whose lobes cancel, its hull 0.0012 < 0.002: repaired by default.
+    const Domain islet{square(0, 0, 10, 10),
+                       {make_polygon({{5.04, 5.03}, {5.04, 5.0}, {5.0, 5.0}, {5.0, 4.97}})}};
+    std::vector<std::string> islet_notes;
+    tspline::DomainCleaningOptions defaults;
+    defaults.notes = &islet_notes;
+    const Domain hulled = tspline::validate_domain(islet, defaults);
+    REQUIRE(islet_notes.size() == 1);
+    CAPTURE(islet_notes[0]);
+    CHECK(contains(islet_notes[0], "hole 1: crosses itself; replaced by its convex hull (4 of its 4 vertices; area 0"));
+    CHECK(contains(islet_notes[0], "-> 0.0012, below the boundary tolerance 0.002)"));
+    CHECK(tspline::domain_area(hulled) == doctest::Approx(100.0 - 0.0012).epsilon(1e-12));
     // The outer ring is never repaired.
     const Domain outer_bow{make_polygon({{0, 0}, {10, 0}, {0, 10}, {10, 10}}), {}};
     CHECK(contains(message_of<tspline::InputError>([&] { (void)tspline::validate_domain(outer_bow, repair); }),

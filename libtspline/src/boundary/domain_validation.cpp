@@ -123,6 +123,10 @@ Domain validate_domain(Domain d, const DomainCleaningOptions& cleaning) {
   const double width = cleaning.needle_width
                            ? *cleaning.needle_width
                            : needle_width_for_ring(d.outer, std::nullopt, kDefaultNeedleWidthRelative);
+  // A crossing islet whose convex hull is smaller than this is below the boundary tolerance.
+  const double repair_area = cleaning.crossing_repair_area
+                                 ? *cleaning.crossing_repair_area
+                                 : (std::isfinite(width) ? width : 0.0) * bounding_box_diagonal(d.outer);
   auto note = [&](const std::string& s) {
     if (cleaning.notes) cleaning.notes->push_back(s);
   };
@@ -140,18 +144,24 @@ Domain validate_domain(Domain d, const DomainCleaningOptions& cleaning) {
         return std::nullopt;
       }
       if (!c.notes.empty()) note(cleaning_summary(name, c));
-      if (r > 0 && cleaning.repair_crossing_holes && c.polygon.vertices.size() >= 3) {
+      if (r > 0 && c.polygon.vertices.size() >= 3) {
         std::vector<Point> pts;
         for (const auto& v : c.polygon.vertices) pts.push_back(point(v));
         if (!CGAL::is_simple_2(pts.begin(), pts.end(), K())) {
           Polygon h = convex_hull_of(c.polygon);
-          std::ostringstream m;
-          m.precision(4);
-          m << name << ": crosses itself; replaced by its convex hull (" << h.vertices.size() << " of its "
-            << c.polygon.vertices.size() << " vertices; area " << std::abs(signed_area(c.polygon))
-            << " (signed, lobes cancelling) -> " << signed_area(h) << ")";
-          note(m.str());
-          c.polygon = std::move(h);
+          const double hull_area = signed_area(h);
+          const bool below_tolerance = hull_area <= repair_area;
+          if (cleaning.repair_crossing_holes || below_tolerance) {
+            std::ostringstream m;
+            m.precision(4);
+            m << name << ": crosses itself; replaced by its convex hull (" << h.vertices.size() << " of its "
+              << c.polygon.vertices.size() << " vertices; area " << std::abs(signed_area(c.polygon))
+              << " (signed, lobes cancelling) -> " << hull_area;
+            if (below_tolerance) m << ", below the boundary tolerance " << repair_area;
+            m << ")";
+            note(m.str());
+            c.polygon = std::move(h);
+          }
         }
       }
       return validate_cleaned_polygon(std::move(c), width, r == 0 ? 4 : 3);

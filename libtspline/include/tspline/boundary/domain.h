@@ -34,7 +34,15 @@ struct DomainCleaningOptions {
   /// vertex 0 (tip of a zero-area spike: edges 6-0 and 0-1 overlap)"), in ring order.
   std::vector<std::string>* notes = nullptr;
   /// A hole whose ring crosses itself (a bow-tie islet of quantized data) is
-  /// replaced by its convex hull, with a note giving both areas; off: it is an
+  /// replaced by its convex hull, with a note giving both areas, if the hull's
+  /// area is at most this: the islet lies wholly below the boundary tolerance
+  /// (the hull contains every reading of the crossing ring, so the domain
+  /// changes by less than the area epsilon the boundary fit may leave between
+  /// the map and one polygon segment, Sect. 3). Unset: epsilon of the needle
+  /// width, needle_width x the outer ring's bounding-box diagonal.
+  std::optional<double> crossing_repair_area;
+  /// Every hole that crosses itself is replaced by its convex hull, whatever
+  /// its size. Off: a crossing hole larger than crossing_repair_area is an
   /// input error naming the ring and edges. The outer ring is never repaired.
   bool repair_crossing_holes = false;
 };
