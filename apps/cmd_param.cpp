@@ -69,7 +69,7 @@ int param_command(const std::string& input, const std::string& out_dir, const Pa
   }
   if (!result.valid()) {
     std::cerr << "tspline: error: the map is not valid: det J <= 0 at " << result.quality.nonpositive_det << " of "
-              << result.quality.points << " quadrature points; adaptive refinement stopped: " << result.stop_reason
+              << result.quality.points << " quadrature points; adaptive refinement stopped: " << with_option_names(result.stop_reason, Spelling::Cli)
               << " (files written; see surface.vtu, point data det_jacobian, or `tspline render OUTDIR`); try "
                  "other --corners, a smaller --tol-rel, or more --max-adapt rounds"
               << std::endl;
@@ -91,13 +91,13 @@ int param_command(const std::string& input, const std::string& out_dir, const Pa
     }
     std::cerr << "tspline: error: the map is not certified valid: " << c.elements - c.certified << " of " << c.elements
               << " elements not certified (" << c.invalid << " with det J < 0 proven, " << c.undecided
-              << " undecided" << where << "); adaptive refinement stopped: " << result.stop_reason
+              << " undecided" << where << "); adaptive refinement stopped: " << with_option_names(result.stop_reason, Spelling::Cli)
               << " (files written; run 'tspline check' on tspline.json for the elements)" << std::endl;
     return 3;
   }
   if (!result.good() && !quiet)
     std::cout << "warning: min J_r " << result.quality.min_mean_ratio << " is below --min-jacobian "
-              << adaptive.min_jacobian << "; adaptive refinement stopped: " << result.stop_reason
+              << adaptive.min_jacobian << "; adaptive refinement stopped: " << with_option_names(result.stop_reason, Spelling::Cli)
               << " (the corner choice fixes the map's aspect ratio: try other --corners)" << std::endl;
   return 0;
 }

@@ -20,13 +20,12 @@ struct RenderArgs {
 void parse_size(const std::string& text, int& w, int& h) {
   const auto x = text.find('x');
   std::size_t used_w = 0, used_h = 0;
-  try {
-    if (x == std::string::npos) throw std::invalid_argument("no x");
-    w = std::stoi(text.substr(0, x), &used_w);
-    h = std::stoi(text.substr(x + 1), &used_h);
-  } catch (const std::exception&) {
-    used_w = 0;
-  }
+  if (x != std::string::npos) try {
+      w = std::stoi(text.substr(0, x), &used_w);
+      h = std::stoi(text.substr(x + 1), &used_h);
+    } catch (const std::exception&) {  // not a number, or out of int's range
+      used_w = 0;
+    }
   if (used_w == 0 || used_w != x || used_h != text.size() - x - 1 || w < 16 || h < 16 || w > 16384 || h > 16384)
     throw tspline::InputError("--size: '" + text + "' is not WIDTHxHEIGHT with 16..16384 pixels per side");
 }

@@ -34,9 +34,10 @@ int exit_code_for(const std::exception_ptr& e, std::string* message) {
   return code;
 }
 
-int report_current_exception(const std::string& program) {
+int report_current_exception(const std::string& program, const std::function<std::string(std::string)>& spell) {
   std::string line;
   const int code = exit_code_for(std::current_exception(), &line);
+  if (spell) line = spell(std::move(line));
   std::cerr << program << ": " << line << std::endl;
   return code;
 }

@@ -9,6 +9,7 @@
 //   4  unexpected internal error (any other exception: a bug)
 //   130 interrupted by SIGINT or SIGTERM (toolkit::Interrupted; 128 + SIGINT)
 #include <exception>
+#include <functional>
 #include <string>
 
 namespace tspline_app {
@@ -30,6 +31,9 @@ int exit_code_for(const std::exception_ptr& e, std::string* message = nullptr);
 
 /// For a `catch (...)` block: prints "PROGRAM: " and the message of the
 /// exception being handled on stderr (one line) and returns its exit code.
-int report_current_exception(const std::string& program);
+/// `spell`, if given, rewrites the message first (the libraries name options by
+/// their fields in backquotes; the program says its flags: with_option_names).
+int report_current_exception(const std::string& program,
+                             const std::function<std::string(std::string)>& spell = {});
 
 }  // namespace tspline_app

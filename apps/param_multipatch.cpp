@@ -3,6 +3,7 @@
 #include <iostream>
 #include <sstream>
 
+#include "param_options.h"
 #include "tspline/errors.h"
 #include "tspline/io/param_output.h"
 
@@ -51,7 +52,7 @@ int write_multipatch_param(const ParamRun& run, const std::string& out_dir, Prog
   if (!R.certified_valid() && adaptive.certify) {
     for (std::size_t p = 0; p < R.patches.size(); ++p)
       if (!R.patches[p].certified_valid())
-        std::cerr << "tspline: error: patch " << p << " is not certified valid: " << R.patches[p].stop_reason
+        std::cerr << "tspline: error: patch " << p << " is not certified valid: " << with_option_names(R.patches[p].stop_reason, Spelling::Cli)
                   << std::endl;
     return 3;
   }

@@ -145,8 +145,9 @@ std::vector<ParamOption> make_table() {
   t.back().show_default = false;
   t.push_back(option(
       "repair-crossings", OptionKind::Flag,
-      "Replace a hole whose ring crosses itself (a bow-tie islet of quantized data) by its convex hull, with "
-      "a note giving both areas; by default such a ring is an input error naming its edges",
+      "Replace every hole whose ring crosses itself (a bow-tie islet of quantized data) by its convex hull, "
+      "with a note giving both areas; by default only a crossing islet whose hull is smaller than the boundary "
+      "tolerance's area is (it lies below the tolerance), a larger one is an input error naming its edges",
       [](ParamSettings& s, const std::string&) { s.repair_crossing_holes = true; },
       [](const ParamSettings& s) { return json(s.repair_crossing_holes); }));
   t.push_back(option(
@@ -273,11 +274,53 @@ std::vector<ParamOption> make_table() {
   t.push_back(number<int>(
       "samples", "surface.vtu: k x k sub-quads per T-mesh cell", [](auto& s) -> auto& { return s.samples; }));
   t.back().range = {{1.0, 64.0}};
+  const std::vector<std::pair<const char*, std::vector<std::string>>> fields = {
+      {"layout", {"layout"}},
+      {"cuts", {"cuts"}},
+      {"corners", {"corners"}},
+      {"corner-trials", {"corner_trials"}},
+      {"tol", {"tolerance_absolute"}},
+      {"tol-rel", {"tolerance_relative"}},
+      {"init-level", {"initial_level"}},
+      {"max-level", {"max_level"}},
+      {"max-sweeps", {"smoothing.max_sweeps"}},
+      {"omega", {"smoothing.over_relaxation"}},
+      {"sweep-tol", {"smoothing.relative_displacement_tolerance"}},
+      {"polygon", {"polygon_index"}},
+      {"layer", {"layer"}},
+      {"feature", {"feature"}},
+      {"planar", {"planar"}},
+      {"min-jacobian", {"min_jacobian"}},
+      {"max-adapt", {"max_adapt"}},
+      {"max-cells", {"max_cells"}},
+      {"repair-crossings", {"repair_crossing_holes"}},
+      {"cert-depth", {"certification.max_depth"}},
+      {"optimizer", {"untangling.optimizer"}},
+      {"samples", {"samples"}},
+};
+  for (const auto& [name, names] : fields)
+    for (ParamOption& o : t)
+      if (o.name == name) o.fields = names;
   for (ParamOption& o : t) o.set = validated(o);  // choices and range before anything is set
   return t;
 }
 
 }  // namespace
+
+std::string with_option_names(std::string message, Spelling spelling) {
+  std::vector<std::pair<std::string, std::string>> names;  // field -> spelling
+  for (const ParamOption& o : param_options())
+    for (const std::string& f : o.fields)
+      names.emplace_back(f, spelling == Spelling::Cli ? "--" + o.name : o.python_name());
+  for (const char* other : {"step", "view", "problem"})
+    names.emplace_back(other, spelling == Spelling::Cli ? std::string("--") + other : std::string(other));
+  for (const auto& [field, spelled] : names) {
+    const std::string quoted = "`" + field + "`";
+    for (std::size_t at = message.find(quoted); at != std::string::npos; at = message.find(quoted, at + spelled.size()))
+      message.replace(at, quoted.size(), spelled);
+  }
+  return message;
+}
 
 std::string ParamOption::python_name() const {
   std::string n = name;

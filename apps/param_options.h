@@ -65,6 +65,11 @@ struct ParamOption {
   /// two front ends) and, for the help, the default (settings_default_text).
   std::function<nlohmann::json(const ParamSettings&)> get;
 
+  /// The library's names of the fields it sets, as the libraries' messages
+  /// name them in backquotes ("`max_cells` must be >= 1"): with_option_names
+  /// turns them into this option's spelling.
+  std::vector<std::string> fields;
+
   /// The Python keyword: '-' replaced by '_'.
   std::string python_name() const;
   /// The default as the help shows it ("" without show_default).
@@ -83,6 +88,16 @@ const ParamOption* find_param_option(std::string_view name);
 /// Every settings field that some option sets, by option name (the `get` of
 /// each entry): equal for two settings iff every option maps to the same values.
 nlohmann::json settings_json(const ParamSettings& settings);
+
+/// How a front end spells its options.
+enum class Spelling { Cli, Python };
+
+/// The message with every backquoted library field name that an option sets
+/// ("`initial_level`", "`certification.max_depth`") replaced by that option's
+/// name in the front end's spelling (--init-level, init_level); also the
+/// `step`, `view` and `problem` of the render and poisson commands. Other
+/// backquoted names (fields only a C++ caller sets) are left as they are.
+std::string with_option_names(std::string message, Spelling spelling);
 
 /// "0,5,10,15" -> the four corner indices. \throw tspline::InputError.
 std::array<long long, 4> parse_corners(const std::string& text);

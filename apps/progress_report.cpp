@@ -4,6 +4,7 @@
 #include <iostream>
 
 #include "interrupt.h"
+#include "param_options.h"
 #include "progress.h"
 #include "tspline/pipeline/progress_event.h"
 
@@ -16,9 +17,13 @@ void Progress::report(const tspline::ProgressEvent& e) {
   const bool transient_kind = e.kind == Kind::Sweep || e.kind == Kind::Untangling;
   switch (mode_) {
     case OutputMode::Quiet: return;
-    case OutputMode::Human:
-      if (transient_kind) return transient(e.text);
-      return log(e.text);
+    case OutputMode::Human: {
+      // The library names options by field (`max_adapt`); this program by flag.
+      const std::string text =
+          e.text.find('`') == std::string::npos ? e.text : with_option_names(e.text, Spelling::Cli);
+      if (transient_kind) return transient(text);
+      return log(text);
+    }
     case OutputMode::Json: {
       if (e.kind == Kind::Sweep && !(e.count < 3 || e.count % 50 == 0)) return;
       // Steps and notes keep the plain log lines' event name, with their stage and kind.

@@ -14,6 +14,7 @@
 
 #include "commands.h"
 #include "exit_codes.h"
+#include "param_options.h"
 #include "interrupt.h"
 
 // LeakSanitizer suppressions of the program (third-party libraries only): apps/petsc_session.cpp.
@@ -45,7 +46,9 @@ int main(int argc, char** argv) {
   try {
     if (command) return command();
   } catch (...) {
-    return tspline_app::report_current_exception("tspline");
+    return tspline_app::report_current_exception("tspline", [](std::string message) {
+      return tspline_app::with_option_names(std::move(message), tspline_app::Spelling::Cli);
+    });
   }
   return 0;
 }

@@ -3,6 +3,7 @@
 //   tspline.InputError (Error, ValueError)        toolkit::InputError: invalid input or options
 //   tspline.IoError (Error, OSError)              toolkit::IoError: a file could not be read or written
 //   tspline.NumericalError (Error, ArithmeticError) toolkit::NumericalError: a numerical step failed
+//   tspline.InternalError (Error, RuntimeError)   toolkit::InternalError: a broken invariant (a bug)
 // with the messages of the command line. Ctrl-C during a run raises
 // KeyboardInterrupt, as anywhere in Python.
 #include "toolkit/errors.h"
@@ -10,6 +11,7 @@
 #include <Python.h>
 
 #include "bindings.h"
+#include "param_options.h"
 
 namespace tspline_python {
 namespace {
@@ -28,7 +30,7 @@ PyObject* new_exception(py::module_& m, const char* name, py::tuple bases, const
 }  // namespace
 
 void bind_errors(py::module_& m) {
-  static PyObject *error, *input_error, *io_error, *numerical_error;
+  static PyObject *error, *input_error, *io_error, *numerical_error, *internal_error;
   error = new_exception(m, "Error", py::make_tuple(py::handle(PyExc_Exception)),
                         "Any error that the tspline library reports.");
   input_error =
@@ -40,15 +42,23 @@ void bind_errors(py::module_& m) {
   numerical_error =
       new_exception(m, "NumericalError", py::make_tuple(py::handle(error), py::handle(PyExc_ArithmeticError)),
                     "A numerical step failed (e.g. a singular system); the command line's exit code 3.");
+  internal_error =
+      new_exception(m, "InternalError", py::make_tuple(py::handle(error), py::handle(PyExc_RuntimeError)),
+                    "A broken invariant inside the library (a bug: please report it); the command line's "
+                    "exit code 4.");
   py::register_exception_translator([](std::exception_ptr p) {
     try {
       if (p) std::rethrow_exception(p);
     } catch (const toolkit::InputError& e) {
-      PyErr_SetString(input_error, e.what());
+      // The library names options by field (`initial_level`); Python by keyword.
+      PyErr_SetString(input_error,
+                      tspline_app::with_option_names(e.what(), tspline_app::Spelling::Python).c_str());
     } catch (const toolkit::IoError& e) {
       PyErr_SetString(io_error, e.what());
     } catch (const toolkit::NumericalError& e) {
       PyErr_SetString(numerical_error, e.what());
+    } catch (const toolkit::InternalError& e) {
+      PyErr_SetString(internal_error, e.what());
     } catch (const toolkit::Interrupted& e) {
       PyErr_SetString(PyExc_KeyboardInterrupt, e.what());
     }

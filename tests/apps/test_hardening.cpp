@@ -164,7 +164,7 @@ TEST_SUITE("hardening") {
     for (int trials : {1, 4}) {  // with automatic corner trials too
       opt.corner_trials = trials;
       const std::string msg = test_support::message_of<tspline::InputError>([&] { tspline::run_front(p, opt); });
-      CHECK(contains(msg, "needs more than 100 cells (--max-cells)"));
+      CHECK(contains(msg, "needs more than 100 cells (`max_cells`)"));
     }
     // With room, the same polygon is meshed within the budget.
     opt.max_cells = 1000;

@@ -157,7 +157,7 @@ TEST_SUITE("gis_input") {
     opt.feature = 5;
     CHECK(test_support::contains(test_support::message_of<tspline::InputError>(
                                      [&] { tspline::io::read_domain((d / "two.gpkg").string(), opt); }),
-                                 "--feature 5 out of range"));
+                                 "`feature` 5 out of range"));
     // The command: a bad layer is one error line, exit 1; --layer on a text polygon too.
     auto r = test_support::run_app("param " + test_support::quoted(d / "two.gpkg") + " --layer x --out " +
                                        test_support::quoted(d / "o"),
@@ -214,7 +214,7 @@ TEST_SUITE("gis_input") {
     const std::string msg = test_support::message_of<tspline::InputError>(
         [&] { tspline::io::read_domain((d / "big.geojson").string()); });
     CHECK(test_support::contains(msg, "not longitude/latitude"));
-    CHECK(test_support::contains(msg, "--planar"));
+    CHECK(test_support::contains(msg, "set `planar` to keep them"));
     tspline::io::DomainReadOptions planar;
     planar.planar = true;
     CHECK(tspline::io::read_domain((d / "big.geojson").string(), planar).outer.vertices.size() == 4);

@@ -110,7 +110,7 @@ def test_planar_keeps_a_geojson_dict_as_given(plate_cli):
     # Without planar=True a GeoJSON dict is longitude/latitude (RFC 7946), as a
     # .geojson file: coordinates beyond 360 / 90 degrees are an input error that says so.
     far = {"type": "Polygon", "coordinates": [[[100 * x, 100 * y] for x, y in ring] for ring in doc["coordinates"]]}
-    with pytest.raises(tspline.InputError, match="longitude/latitude.*--planar"):
+    with pytest.raises(tspline.InputError, match="longitude/latitude.*set planar"):
         tspline.parameterize(far)
 
 

@@ -58,15 +58,42 @@ def test_every_option_of_the_program_is_in_the_table():
         assert o["help"].split()[0] in help_text  # the same help text
 
 
-def test_bad_values_are_refused_by_both():
-    for name, value, text in [("layout", "sideways", "sideways"), ("optimizer", "adam", "adam"),
-                              ("cert_depth", 30, "30"), ("samples", 0, "0"), ("init_level", -1, None),
-                              ("corners", [0, 1, 2], "0,1,2"), ("tol_rel", float("nan"), "nan")]:
-        if text is not None:
-            r = run_app("param", SQUARE, "--out", "/nonexistent/o", "--" + name.replace("_", "-"), text, check=False)
-            assert r.returncode == 1 and r.stderr.count("\n") == 1, (name, r.stderr)
-        with pytest.raises(tspline.InputError, match=name if text is not None else "init-level"):
-            tspline.parameterize(SQUARE, **{name: value})
+GEOJSON = DATA / "gis" / "corsica_lonlat.geojson"
+# For every option that takes a value: a value out of its range (or a path
+# that does not exist), and the domain to give it with. Flags have no bad value.
+BAD_VALUES = {
+    "layout": ("sideways", SQUARE), "optimizer": ("adam", SQUARE), "corners": ("0,1,2", SQUARE),
+    "corner_trials": (0, SQUARE), "tol": (-1.0, SQUARE), "tol_rel": (float("nan"), SQUARE),
+    "init_level": (11, SQUARE), "max_level": (0, SQUARE), "max_sweeps": (0, SQUARE), "omega": (2.5, SQUARE),
+    "sweep_tol": (0.0, SQUARE), "min_jacobian": (1.5, SQUARE), "max_adapt": (-1, SQUARE),
+    "max_cells": (0, SQUARE), "cert_depth": (30, SQUARE), "samples": (0, SQUARE),
+    "polygon": (5, GEOJSON), "feature": (99, GEOJSON), "layer": ("0", SQUARE),
+}
+MISSING_PATHS = {"cuts", "from"}  # a path that does not exist: an IoError / exit 2 naming the file
+
+
+def cli_text(value):
+    return ",".join(map(str, value)) if isinstance(value, list) else str(value)
+
+
+def test_every_option_refuses_its_bad_value_in_both_front_ends_naming_it():
+    options = tspline.param_options()
+    with_value = {o["name"] for o in options if o["type"] != "bool"}
+    assert with_value == set(BAD_VALUES) | MISSING_PATHS  # a new option needs its case here
+    for name, (value, domain) in BAD_VALUES.items():
+        flag = "--" + name.replace("_", "-")
+        r = run_app("param", domain, "--out", "/nonexistent/o", flag, cli_text(value), check=False)
+        assert r.returncode == 1 and r.stderr.count("\n") == 1, (name, r.stderr)
+        assert flag in r.stderr and "`" not in r.stderr, (name, r.stderr)  # the flag, not a field name
+        with pytest.raises(tspline.InputError) as error:
+            tspline.parameterize(domain, **{name: value})
+        message = str(error.value)
+        assert re.search(r"\b%s\b" % name, message) and "--" not in message and "`" not in message, (name, message)
+    for name in MISSING_PATHS:
+        r = run_app("param", SQUARE, "--out", "/nonexistent/o", "--" + name, "/nonexistent/file", check=False)
+        assert r.returncode == 2 and "/nonexistent/file" in r.stderr, (name, r.stderr)
+        with pytest.raises(tspline.IoError, match="/nonexistent/file"):
+            tspline.parameterize(SQUARE, **{name: "/nonexistent/file"})
 
 
 def test_python_types_and_unknown_keywords():

@@ -87,7 +87,7 @@ TEST_SUITE("parameterization_run") {
     CHECK(r.good() == (r.valid() && r.quality.min_mean_ratio >= 0.35));
   }
 
-  TEST_CASE("options out of range are input errors that name the option, before any work") {
+  TEST_CASE("options out of range are input errors that name the option's field, before any work") {
     const tspline::Polygon poly = tspline::io::read_polygon(test_support::polygon_file("square.txt"));
     auto message = [&](const tspline::ParameterizationOptions& o, const tspline::AdaptiveOptions& a) -> std::string {
       try {
@@ -98,13 +98,13 @@ TEST_SUITE("parameterization_run") {
       return "";
     };
     const std::map<std::string, std::function<void(tspline::ParameterizationOptions&, tspline::AdaptiveOptions&)>>
-        cases{{"--omega", [](auto& o, auto&) { o.smoothing.over_relaxation = 2.5; }},
-              {"--max-sweeps", [](auto& o, auto&) { o.smoothing.max_sweeps = -1; }},
-              {"--sweep-tol", [](auto& o, auto&) { o.smoothing.relative_displacement_tolerance = -1.0; }},
-              {"--init-level", [](auto& o, auto&) { o.initial_level = 11; }},
-              {"--min-jacobian", [](auto&, auto& a) { a.min_jacobian = 0.0; }},
-              {"--cert-depth", [](auto&, auto& a) { a.certification.max_depth = 21; }},
-              {"quality_power", [](auto&, auto& a) { a.untangling.quality_power = 0.5; }}};
+        cases{{"`smoothing.over_relaxation`", [](auto& o, auto&) { o.smoothing.over_relaxation = 2.5; }},
+              {"`smoothing.max_sweeps`", [](auto& o, auto&) { o.smoothing.max_sweeps = -1; }},
+              {"`smoothing.relative_displacement_tolerance`", [](auto& o, auto&) { o.smoothing.relative_displacement_tolerance = -1.0; }},
+              {"`initial_level`", [](auto& o, auto&) { o.initial_level = 11; }},
+              {"`min_jacobian`", [](auto&, auto& a) { a.min_jacobian = 0.0; }},
+              {"`certification.max_depth`", [](auto&, auto& a) { a.certification.max_depth = 21; }},
+              {"`untangling.quality_power`", [](auto&, auto& a) { a.untangling.quality_power = 0.5; }}};
     for (const auto& [name, spoil] : cases) {
       CAPTURE(name);
       tspline::ParameterizationOptions o;

@@ -5,6 +5,7 @@
 
 #include "test_support.h"
 
+#include "tspline/errors.h"
 #include "tspline/boundary/boundary_refinement.h"
 #include "tspline/tmesh/coons.h"
 #include "tspline/boundary/corners.h"
@@ -93,7 +94,7 @@ TEST_SUITE("tmesh") {
     TMesh m(1);
     int n = m.refine(m.leaf_at_doubled(1, 1));
     m.refine(n + 3);  // level-3 cells next to level-1 cells
-    CHECK_THROWS_AS(m.build_topology(), std::logic_error);
+    CHECK_THROWS_AS(m.build_topology(), tspline::InternalError);
   }
 
   TEST_CASE("boundary refinement meets the tolerance on every test domain") {

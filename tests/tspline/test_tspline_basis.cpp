@@ -10,6 +10,7 @@
 
 #include "test_support.h"
 
+#include "tspline/errors.h"
 #include "tspline/tmesh/tmesh.h"
 #include "tspline/spline/tspline_basis.h"
 
@@ -428,7 +429,7 @@ TEST_SUITE("tspline_basis") {
       CHECK(B.locate(m.cell_min(c)) == c);  // lower-left corner belongs to the cell
     }
     CHECK(B.locate({1.0, 1.0}) >= 0);
-    CHECK_THROWS_AS(B.locate({1.5, 0.5}), std::out_of_range);
+    CHECK_THROWS_AS(B.locate({1.5, 0.5}), tspline::InputError);
     BasisValues v;
     B.evaluate({0.3, 0.7}, v, 0);
     CHECK(v.R_xi.empty());

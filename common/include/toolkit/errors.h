@@ -32,6 +32,15 @@ class NumericalError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+/// A broken invariant: a bug in the toolkit, never the caller's data (a
+/// T-mesh that lost its 2:1 balance, blending functions that vanish inside
+/// the domain). Exit code 4 in the programs ("internal error"). Data and
+/// option errors are InputError, whatever function finds them.
+class InternalError : public std::logic_error {
+ public:
+  using std::logic_error::logic_error;
+};
+
 /// The run was stopped on request (SIGINT / SIGTERM) before it finished; no
 /// output was written. Exit code 130 in the programs (128 + SIGINT), the shell's
 /// convention for a run ended by Ctrl-C.

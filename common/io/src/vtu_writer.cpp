@@ -52,11 +52,11 @@ template <class Map>
 void check_lengths(const Map& arrays, std::size_t expected, const char* kind, const char* per,
                    std::set<std::string>& names) {
   for (const auto& [name, values] : arrays) {
-    if (name.empty()) throw std::invalid_argument(std::string("write_vtu: ") + kind + " array has an empty name");
+    if (name.empty()) throw toolkit::InputError(std::string("write_vtu: ") + kind + " array has an empty name");
     if (!names.insert(name).second)
-      throw std::invalid_argument("write_vtu: duplicate " + std::string(per) + " array name '" + name + "'");
+      throw toolkit::InputError("write_vtu: duplicate " + std::string(per) + " array name '" + name + "'");
     if (values.size() != expected)
-      throw std::invalid_argument("write_vtu: " + std::string(kind) + " array '" + name + "' has " +
+      throw toolkit::InputError("write_vtu: " + std::string(kind) + " array '" + name + "' has " +
                                   std::to_string(values.size()) + " values, expected " + std::to_string(expected) +
                                   " (one per " + per + ")");
   }
@@ -64,16 +64,16 @@ void check_lengths(const Map& arrays, std::size_t expected, const char* kind, co
 
 void validate(const VtuMesh& mesh) {
   if (!mesh.points.empty() && !mesh.points3d.empty())
-    throw std::invalid_argument("write_vtu: both 2D and 3D points given");
+    throw toolkit::InputError("write_vtu: both 2D and 3D points given");
   const std::size_t np = mesh.points.size() + mesh.points3d.size();
   if (np > static_cast<std::size_t>(std::numeric_limits<int>::max()))
-    throw std::invalid_argument("write_vtu: too many points");
+    throw toolkit::InputError("write_vtu: too many points");
   for (std::size_t c = 0; c < mesh.cells.size(); ++c) {
     const auto& cell = mesh.cells[c];
-    if (cell.empty()) throw std::invalid_argument("write_vtu: cell " + std::to_string(c) + " has no points");
+    if (cell.empty()) throw toolkit::InputError("write_vtu: cell " + std::to_string(c) + " has no points");
     for (int idx : cell) {
       if (idx < 0 || static_cast<std::size_t>(idx) >= np)
-        throw std::invalid_argument("write_vtu: cell " + std::to_string(c) + " references point " +
+        throw toolkit::InputError("write_vtu: cell " + std::to_string(c) + " references point " +
                                     std::to_string(idx) + ", but there are " + std::to_string(np) + " points");
     }
   }
@@ -86,13 +86,13 @@ void validate(const VtuMesh& mesh) {
   check_lengths(mesh.cell_ints, mesh.cells.size(), "cell int", "cell", cell_names);
   check_lengths(mesh.cell_vectors, mesh.cells.size(), "cell vector", "cell", cell_names);
   if (!mesh.cell_types.empty() && mesh.cell_types.size() != mesh.cells.size())
-    throw std::invalid_argument("write_vtu: " + std::to_string(mesh.cell_types.size()) + " cell types for " +
+    throw toolkit::InputError("write_vtu: " + std::to_string(mesh.cell_types.size()) + " cell types for " +
                                 std::to_string(mesh.cells.size()) + " cells");
   if (!mesh.higher_order_degrees.empty() && mesh.higher_order_degrees.size() != mesh.cells.size())
-    throw std::invalid_argument("write_vtu: " + std::to_string(mesh.higher_order_degrees.size()) +
+    throw toolkit::InputError("write_vtu: " + std::to_string(mesh.higher_order_degrees.size()) +
                                 " higher-order degrees for " + std::to_string(mesh.cells.size()) + " cells");
   if (!mesh.rational_weights.empty() && !mesh.point_scalars.count(mesh.rational_weights))
-    throw std::invalid_argument("write_vtu: no point scalar array '" + mesh.rational_weights +
+    throw toolkit::InputError("write_vtu: no point scalar array '" + mesh.rational_weights +
                                 "' for the rational weights");
 }
 
@@ -164,7 +164,7 @@ PartsLayout parts_layout(std::span<const VtuMesh> parts, const std::string& part
   L.point_offset.push_back(points);
   if (!L.point_scalars.count(L.rational_weights)) L.rational_weights.clear();
   if (points > static_cast<std::size_t>(std::numeric_limits<int>::max()))
-    throw std::invalid_argument("write_vtu: too many points");
+    throw toolkit::InputError("write_vtu: too many points");
   return L;
 }
 
@@ -360,7 +360,7 @@ std::string xml_escape_attr(const std::string& s) {
       case '\r': out += "&#13;"; break;
       default:
         if (static_cast<unsigned char>(ch) < 0x20)
-          throw std::invalid_argument("write_pvd: file name contains a control character, not allowed in XML");
+          throw toolkit::InputError("write_pvd: file name contains a control character, not allowed in XML");
         out += ch;
     }
   }
@@ -370,7 +370,7 @@ std::string xml_escape_attr(const std::string& s) {
 std::string format_double(double x) {
   char buf[64];
   const auto [end, ec] = std::to_chars(buf, buf + sizeof buf, x);  // shortest round-trip form
-  if (ec != std::errc()) throw std::logic_error("write_pvd: cannot format a number");
+  if (ec != std::errc()) throw toolkit::InternalError("write_pvd: cannot format a number");
   return std::string(buf, end);
 }
 
@@ -502,7 +502,7 @@ void write_vtu_parts(const std::string& path, std::vector<VtuMesh>&& parts, cons
 }
 
 void write_vtu_pieces(const std::string& path, int pieces, const std::function<VtuMesh(int)>& piece) {
-  if (pieces < 1) throw std::invalid_argument("write_vtu_pieces: the number of pieces must be >= 1");
+  if (pieces < 1) throw toolkit::InputError("write_vtu_pieces: the number of pieces must be >= 1");
   vtkNew<PieceSource> source;
   source->make = piece;
   write_grid(path, nullptr, source, pieces);
@@ -514,7 +514,7 @@ void write_pvd(const std::string& path, const std::vector<PvdEntry>& entries) {
   xml += "<VTKFile type=\"Collection\" version=\"0.1\">\n";
   xml += "  <Collection>\n";
   for (const PvdEntry& e : entries) {
-    if (!std::isfinite(e.timestep)) throw std::invalid_argument("write_pvd: timestep of '" + e.file + "' is not finite");
+    if (!std::isfinite(e.timestep)) throw toolkit::InputError("write_pvd: timestep of '" + e.file + "' is not finite");
     xml += "    <DataSet timestep=\"" + format_double(e.timestep) + "\" part=\"" + std::to_string(e.part) +
            "\" file=\"" + xml_escape_attr(e.file) + "\"/>\n";
   }

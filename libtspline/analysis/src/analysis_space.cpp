@@ -279,7 +279,7 @@ bool AnalysisSpace::holds_all() const {
 
 const PatchSpace& AnalysisSpace::patch(std::size_t p) const {
   if (!patches_[p])
-    throw std::logic_error("analysis space: patch " + std::to_string(p) + " is not held by process " +
+    throw toolkit::InternalError("analysis space: patch " + std::to_string(p) + " is not held by process " +
                            std::to_string(rank_));
   return *patches_[p];
 }

@@ -19,6 +19,7 @@
 #include "tspline/analysis/analysis_space.h"
 #include "tspline/spline/bezier_extraction.h"
 #include "tspline/spline/tspline_map.h"
+#include "toolkit/errors.h"
 
 namespace tspline::detail {
 
@@ -129,7 +130,7 @@ class CellTabulation {
       }
     }
     const double W = Ws[0], Wx = Ws[1], Wy = Ws[2], Wxx = Ws[3], Wxy = Ws[4], Wyy = Ws[5];
-    if (!(W > 0.0)) throw std::logic_error("Poisson: the blending functions vanish at a quadrature point");
+    if (!(W > 0.0)) throw toolkit::InternalError("Poisson: the blending functions vanish at a quadrature point");
     MapDerivatives d;
     d.x = As[0] / W;
     d.J.col(0) = (As[1] - d.x * Wx) / W;

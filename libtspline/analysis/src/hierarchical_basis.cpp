@@ -39,7 +39,7 @@ std::array<double, 5> level_knots(int level, I64 index) {
 }  // namespace
 
 HierarchicalBasis::HierarchicalBasis(const TMesh& mesh) : mesh_(&mesh) {
-  if (!mesh.has_topology()) throw std::logic_error("HierarchicalBasis: the T-mesh has no topology");
+  if (!mesh.has_topology()) throw toolkit::InternalError("HierarchicalBasis: the T-mesh has no topology");
   if (mesh.max_level() > kMaxBasisLevel)
     throw InputError("hierarchical basis: the T-mesh has cells of level " + std::to_string(mesh.max_level()) +
                      ", at most " + std::to_string(kMaxBasisLevel) + " are supported");
@@ -109,7 +109,7 @@ HierarchicalBasis::HierarchicalBasis(const TMesh& mesh) : mesh_(&mesh) {
 
 int HierarchicalBasis::locate(const Eigen::Vector2d& uv) const {
   if (!(uv.x() >= 0.0 && uv.x() <= 1.0 && uv.y() >= 0.0 && uv.y() <= 1.0))
-    throw std::out_of_range("HierarchicalBasis::locate: point outside [0,1]^2");
+    throw toolkit::InputError("HierarchicalBasis::locate: point outside [0,1]^2");
   auto cell_index = [](double t) {
     const I64 i = static_cast<I64>(std::floor(t * static_cast<double>(TMesh::kRoot)));
     return std::clamp<I64>(i, 0, TMesh::kRoot - 1);
@@ -118,7 +118,7 @@ int HierarchicalBasis::locate(const Eigen::Vector2d& uv) const {
 }
 
 void HierarchicalBasis::evaluate(int c, const Eigen::Vector2d& uv, BasisValues& out, int order) const {
-  if (order < 0 || order > 2) throw std::invalid_argument("HierarchicalBasis::evaluate: order must be 0, 1 or 2");
+  if (order < 0 || order > 2) throw toolkit::InputError("HierarchicalBasis::evaluate: order must be 0, 1 or 2");
   const std::span<const int> ids = functions_on_cell(c);
   const std::size_t n = ids.size();
   out.ids.assign(ids.begin(), ids.end());

@@ -101,7 +101,7 @@ ManufacturedProblem manufactured_problem(const std::string& name, const Analysis
   const double L = (b.hi - b.lo).maxCoeff(), D = (b.hi - b.lo).norm();
   if (!(L > 0.0) || !std::isfinite(D) || !((b.hi - b.lo).minCoeff() > 0.0))
   {
-    std::string message = "--problem ";
+    std::string message = "`problem` ";
     message += name;
     message += ": the control points span no area (bounding box ";
     message += fmt(b.hi.x() - b.lo.x());

@@ -7,6 +7,7 @@
 namespace tspline {
 
 using toolkit::InputError;      ///< invalid user input (a std::invalid_argument)
+using toolkit::InternalError;   ///< a broken invariant, a bug (a std::logic_error)
 using toolkit::Interrupted;     ///< the run was stopped on request (SIGINT)
 using toolkit::IoError;         ///< a file could not be read or written
 using toolkit::NumericalError;  ///< a numerical procedure failed

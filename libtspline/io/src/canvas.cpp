@@ -57,7 +57,7 @@ struct Canvas::Impl {
 Canvas::Canvas(ImageFormat format, std::string path, int width, int height)
     : impl_(std::make_unique<Impl>()), format_(format), path_(std::move(path)), width_(width), height_(height) {
   if (width < 16 || height < 16 || width > 16384 || height > 16384)
-    throw std::invalid_argument("image size must be between 16 and 16384 pixels per side");
+    throw toolkit::InputError("image size must be between 16 and 16384 pixels per side");
   switch (format) {
     case ImageFormat::Png: impl_->surface = cairo_image_surface_create(CAIRO_FORMAT_RGB24, width, height); break;
     case ImageFormat::Svg: impl_->surface = cairo_svg_surface_create(path_.c_str(), width, height); break;
@@ -174,7 +174,7 @@ void Canvas::draw_text(double x, double y, const std::string& text, Rgb colour, 
 }
 
 Rgb Canvas::pixel(int x, int y) const {
-  if (format_ != ImageFormat::Png) throw std::logic_error("Canvas::pixel: not a PNG canvas");
+  if (format_ != ImageFormat::Png) throw toolkit::InternalError("Canvas::pixel: not a PNG canvas");
   cairo_surface_flush(impl_->surface);
   const unsigned char* data = cairo_image_surface_get_data(impl_->surface);
   const int stride = cairo_image_surface_get_stride(impl_->surface);

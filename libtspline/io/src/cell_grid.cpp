@@ -1,12 +1,13 @@
 #include "tspline/io/cell_grid.h"
 
 #include <stdexcept>
+#include "toolkit/errors.h"
 
 namespace tspline::io {
 
 toolkit::io::VtuMesh cell_grid_vtu(const TMesh& mesh, int k,
                       const std::function<Eigen::Vector2d(int, const Eigen::Vector2d&)>& sample) {
-  if (k < 1 || k > 64) throw std::invalid_argument("samples per cell edge must be in [1, 64]");
+  if (k < 1 || k > 64) throw toolkit::InputError("samples per cell edge must be in [1, 64]");
   toolkit::io::VtuMesh out;
   // Every array at its final size at once (a sea of 9,000 patches holds all
   // its patches' parts before they are merged: growing by doubling cost a

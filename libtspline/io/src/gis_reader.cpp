@@ -158,7 +158,7 @@ DomainInput read_domain(const std::string& path, const DomainReadOptions& option
   DomainInput out;
   if (!is_gis_file(path)) {
     if (options.layer || options.feature)
-      throw InputError(path + ": --layer and --feature apply to GIS files, not to a text polygon");
+      throw InputError(path + ": `layer` and `feature` apply to GIS files, not to a text polygon");
     if (options.crs) throw InputError(path + ": a CRS applies to GIS data, not to a text polygon (planar)");
     // Rings separated by blank lines: the first is the outer boundary, the others are holes.
     std::vector<Polygon> rings = read_text_rings(path);
@@ -248,13 +248,13 @@ DomainInput read_dataset(GDALDataset& dataset, const std::string& path, const Do
   }
   read_layer(layer, false);
   if (options.feature && *options.feature >= features)
-    throw InputError(path + ": --feature " + std::to_string(*options.feature) + " out of range (layer '" +
+    throw InputError(path + ": `feature` " + std::to_string(*options.feature) + " out of range (layer '" +
                      layer->GetName() + "' has " + std::to_string(features) + " features)");
   if (polys.empty()) throw InputError(path + ": layer '" + std::string(layer->GetName()) + "' has no polygons");
   std::size_t pick = 0;
   if (options.polygon_index) {
     if (*options.polygon_index >= polys.size())
-      throw InputError(path + ": --polygon " + std::to_string(*options.polygon_index) + " out of range (" +
+      throw InputError(path + ": `polygon_index` " + std::to_string(*options.polygon_index) + " out of range (" +
                        std::to_string(polys.size()) + " polygons)");
     pick = *options.polygon_index;
   } else {
@@ -287,7 +287,7 @@ DomainInput read_dataset(GDALDataset& dataset, const std::string& path, const Do
   if (layer_srs && layer_srs->GetName() && std::strncmp(layer_srs->GetName(), "Undefined", 9) == 0) layer_srs = nullptr;
   const bool geographic = layer_srs && layer_srs->IsGeographic();
   if (options.planar || !geographic) {
-    d["units"] = options.planar ? "as in the file (--planar)"
+    d["units"] = options.planar ? "as in the file (`planar`)"
                  : layer_srs    ? std::string(layer_srs->IsProjected() ? "projected CRS, kept" : "CRS kept")
                                 : std::string("no CRS: planar, as in the file");
   } else {
@@ -296,7 +296,7 @@ DomainInput read_dataset(GDALDataset& dataset, const std::string& path, const Do
       if (!(std::abs(p.x()) <= 360.0 && std::abs(p.y()) <= 90.0))
         throw InputError(path + ": coordinates (" + std::to_string(p.x()) + ", " + std::to_string(p.y()) +
                          ") are not longitude/latitude degrees, which the layer's CRS (" +
-                         d["crs"].get<std::string>() + ") requires; use --planar to keep them as they are");
+                         d["crs"].get<std::string>() + ") requires; set `planar` to keep them as they are");
     const Eigen::Vector2d c = centroid(chosen.outer);
     OGRSpatialReference src(*layer_srs);
     src.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);

@@ -13,6 +13,7 @@
 
 #include "tspline/spline/bezier_extraction.h"
 #include "toolkit/io/atomic_file.h"
+#include "toolkit/errors.h"
 
 namespace tspline::io {
 
@@ -96,11 +97,11 @@ PatchNodes patch_nodes(const TSplineMap& map) {
 
 std::string msh_document(const std::vector<const TSplineMap*>& maps, const std::vector<Interface>& interfaces,
                          MshExportStats* stats) {
-  if (maps.empty()) throw std::invalid_argument("msh_document: no patches");
+  if (maps.empty()) throw toolkit::InputError("msh_document: no patches");
   const std::size_t P = maps.size();
   for (const Interface& f : interfaces)
     if (f.patch_a >= P || f.patch_b >= P || f.side_a < 0 || f.side_a > 3 || f.side_b < 0 || f.side_b > 3)
-      throw std::invalid_argument("msh_document: an interface names a patch or side out of range");
+      throw toolkit::InputError("msh_document: an interface names a patch or side out of range");
   std::vector<PatchNodes> patches;
   patches.reserve(P);
   for (const TSplineMap* m : maps) patches.push_back(patch_nodes(*m));

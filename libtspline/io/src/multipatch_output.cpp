@@ -16,6 +16,7 @@
 #include "tspline/io/multipatch_file.h"
 #include "tspline/io/param_output.h"
 #include "tspline/io/output_files.h"
+#include "toolkit/errors.h"
 
 namespace tspline::io {
 namespace {
@@ -139,7 +140,7 @@ void write_multipatch_outputs(const MultiPatchResult& R, const std::string& out_
            uv[v] = mesh.vertex_param(v) + Eigen::Vector2d(1.25 * static_cast<double>(p), 0.0);
          return tmesh_vtu(mesh, uv);
        }}};
-  if (piece_cells < 1) throw std::invalid_argument("write_multipatch_outputs: piece_cells must be >= 1");
+  if (piece_cells < 1) throw toolkit::InputError("write_multipatch_outputs: piece_cells must be >= 1");
   std::vector<std::size_t> piece_begin = {0};  // patches [piece_begin[i], piece_begin[i + 1]) make piece i
   for (std::size_t p = 0, cells = 0; p < n; ++p) {
     cells += R.patches[p].map->mesh().num_cells();

@@ -22,11 +22,12 @@
 #include "tspline/validity/map_certification.h"
 #include "tspline/validity/map_quality.h"
 #include "tspline/validity/map_quality_bounds.h"
+#include "toolkit/errors.h"
 
 namespace tspline::io {
 
 toolkit::io::VtuMesh surface_vtu(const TSplineMap& map, int k) {
-  if (k < 1 || k > 64) throw std::invalid_argument("samples per cell edge must be in [1, 64]");
+  if (k < 1 || k > 64) throw toolkit::InputError("samples per cell edge must be in [1, 64]");
   std::vector<double> jr, det, js;
   std::vector<Eigen::Vector2d> param;
   const std::size_t points = map.mesh().num_cells() * static_cast<std::size_t>((k + 1) * (k + 1));
@@ -87,7 +88,7 @@ toolkit::io::VtuMesh control_net_vtu(const TSplineMap& map) {
 toolkit::io::VtuMesh physical_tmesh_vtu(const TSplineMap& map, int k, const MapCertification* certificate,
                                         const CertificationOptions& options,
                                         const std::vector<CellMapQuality>* quality) {
-  if (k < 1 || k > 64) throw std::invalid_argument("samples per cell edge must be in [1, 64]");
+  if (k < 1 || k > 64) throw toolkit::InputError("samples per cell edge must be in [1, 64]");
   const TMesh& mesh = map.mesh();
   const int nc = static_cast<int>(mesh.num_cells());
   if (certificate && certificate->cell_certified.size() != mesh.num_cells()) certificate = nullptr;
@@ -170,12 +171,12 @@ toolkit::io::VtuMesh physical_tmesh_vtu(const TSplineMap& map, int k, const MapC
 }
 
 toolkit::io::VtuMesh bezier_vtu(const ParameterizationResult& r) {
-  if (!r.map) throw std::invalid_argument("bezier_vtu: the result has no map");
+  if (!r.map) throw toolkit::InputError("bezier_vtu: the result has no map");
   return bezier_vtu(*r.map, r.adaptive.certify ? &r.certification : nullptr, r.adaptive.certification);
 }
 
 toolkit::io::VtuMesh physical_tmesh_vtu(const ParameterizationResult& r, int k) {
-  if (!r.map) throw std::invalid_argument("physical_tmesh_vtu: the result has no map");
+  if (!r.map) throw toolkit::InputError("physical_tmesh_vtu: the result has no map");
   return physical_tmesh_vtu(*r.map, k, r.adaptive.certify ? &r.certification : nullptr, r.adaptive.certification,
                             &r.cell_quality);
 }

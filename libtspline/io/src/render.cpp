@@ -29,7 +29,7 @@ toolkit::io::VtuMesh read_output(const fs::path& file, const char* written_by) {
   std::error_code ec;
   if (!fs::is_regular_file(file, ec))
     throw IoError("'" + file.string() + "' not found: render draws the outputs of `" + written_by +
-                  "`; give the directory it wrote (--out)");
+                  "`; give the directory it wrote");
   return toolkit::io::read_vtu(file.string());
 }
 
@@ -148,10 +148,10 @@ fs::path solution_step(const fs::path& dir, int step) {
     }
   }
   if (best < 0) {
-    if (step >= 0) throw InputError("--step " + std::to_string(step) + ": no '" + (sub / "step_*.vtu").string() +
+    if (step >= 0) throw InputError("`step` " + std::to_string(step) + ": no '" + (sub / "step_*.vtu").string() +
                                     "' with that number");
     throw IoError("'" + sub.string() + "' has no step_NNN.vtu: the solution view draws the output of `tspline "
-                  "poisson`; give the directory it wrote (--out)");
+                  "poisson`; give the directory it wrote");
   }
   return file;
 }
@@ -211,7 +211,7 @@ RenderView parse_render_view(const std::string& name) {
   if (name == "control-net") return RenderView::ControlNet;
   if (name == "solution") return RenderView::Solution;
   if (name == "layout") return RenderView::Layout;
-  throw InputError("--view: '" + name + "' is not one of auto, tmesh, jacobian, control-net, solution, layout");
+  throw InputError("`view`: '" + name + "' is not one of auto, tmesh, jacobian, control-net, solution, layout");
 }
 
 namespace {

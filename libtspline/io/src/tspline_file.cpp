@@ -246,7 +246,7 @@ class Reader {
     }
     try {
       mesh.build_topology();
-    } catch (const std::logic_error& e) {
+    } catch (const InternalError& e) {
       fail("/tmesh/cells", std::string("the cells are not 2:1 balanced (") + e.what() + ")");
     }
     const std::string inv = mesh.check_invariants();

@@ -331,11 +331,11 @@ void PetscPoissonSolver::add_cell(std::span<const int> rows, const Eigen::Matrix
       } else if (gj >= m.row_begin && gj < m.row_end) {
         const auto lj = static_cast<HYPRE_Int>(gj - m.row_begin);
         while (pd < m.di[k + 1] && m.dj[pd] != lj) ++pd;
-        if (pd == m.di[k + 1]) throw std::logic_error("PETSc assembly: a column outside the preallocated pattern");
+        if (pd == m.di[k + 1]) throw toolkit::InternalError("PETSc assembly: a column outside the preallocated pattern");
         m.dv[pd] += v;
       } else {
         while (po < m.oi[k + 1] && m.col_map[m.oj[po]] != gj) ++po;
-        if (po == m.oi[k + 1]) throw std::logic_error("PETSc assembly: a column outside the preallocated pattern");
+        if (po == m.oi[k + 1]) throw toolkit::InternalError("PETSc assembly: a column outside the preallocated pattern");
         m.ov[po] += v;
       }
     }

@@ -15,14 +15,14 @@ BoundaryMap::BoundaryMap(Polygon ccw_polygon, Corners corners)
     : polygon_(std::move(ccw_polygon)), corners_(std::move(corners)) {
   const std::size_t n = polygon_.vertices.size();
   const auto& c = corners_.index;
-  if (n < 4) throw std::invalid_argument("BoundaryMap: polygon has fewer than 4 vertices");
+  if (n < 4) throw toolkit::InputError("BoundaryMap: polygon has fewer than 4 vertices");
   // The corners must be distinct, in range, and in CCW (cyclically increasing) order.
   int descents = 0;
   for (int k = 0; k < 4; ++k) {
-    if (c[k] >= n) throw std::invalid_argument("BoundaryMap: corner index out of range");
+    if (c[k] >= n) throw toolkit::InputError("BoundaryMap: corner index out of range");
     descents += c[(k + 1) % 4] <= c[k];
   }
-  if (descents != 1) throw std::invalid_argument("BoundaryMap: corners are not distinct and in CCW order");
+  if (descents != 1) throw toolkit::InputError("BoundaryMap: corners are not distinct and in CCW order");
 
   for (int s = 0; s < 4; ++s) {
     auto& pts = chain_points_[s];
@@ -54,7 +54,7 @@ BoundaryMap::BoundaryMap(Polygon ccw_polygon, Corners corners)
 }
 
 Eigen::Vector2d BoundaryMap::point(Side side, double t) const {
-  if (!(t >= 0.0 && t <= 1.0)) throw std::invalid_argument("BoundaryMap::point: t must be in [0,1]");
+  if (!(t >= 0.0 && t <= 1.0)) throw toolkit::InputError("BoundaryMap::point: t must be in [0,1]");
   const auto& par = chain_params(side);
   const auto& pts = chain_points(side);
   // Segment k with par[k] <= t < par[k+1] (k = last segment when t == 1).
@@ -68,14 +68,14 @@ Eigen::Vector2d BoundaryMap::point(Side side, double t) const {
 Eigen::Vector2d BoundaryMap::point_at(const Eigen::Vector2d& uv) const {
   const double u = uv.x(), v = uv.y();
   if (!(u >= 0.0 && u <= 1.0 && v >= 0.0 && v <= 1.0))
-    throw std::invalid_argument("BoundaryMap::point_at: (u, v) is outside [0,1]^2");
+    throw toolkit::InputError("BoundaryMap::point_at: (u, v) is outside [0,1]^2");
   // Order matters only at the parametric corners, where both choices agree:
   // (0,0) = Bottom t=0, (1,0) = Bottom t=1, (1,1) = Right t=1, (0,1) = Top t=1.
   if (v == 0.0) return point(Side::Bottom, u);
   if (u == 1.0) return point(Side::Right, v);
   if (v == 1.0) return point(Side::Top, 1.0 - u);
   if (u == 0.0) return point(Side::Left, 1.0 - v);
-  throw std::invalid_argument("BoundaryMap::point_at: (u, v) is not on the boundary of [0,1]^2");
+  throw toolkit::InputError("BoundaryMap::point_at: (u, v) is not on the boundary of [0,1]^2");
 }
 
 const std::vector<Eigen::Vector2d>& BoundaryMap::chain_points(Side side) const {

@@ -76,15 +76,15 @@ BoundaryRefinementReport refine_to_boundary(TMesh& mesh, const BoundaryMap& boun
     throw InputError("boundary tolerance must be a positive number");
   if (options.max_level < 1 || options.max_level > TMesh::kMaxLevel)
     throw InputError("maximum refinement level must be in [1, " + std::to_string(TMesh::kMaxLevel) + "]");
-  if (options.max_cells < 1) throw InputError("--max-cells must be >= 1");
+  if (options.max_cells < 1) throw InputError("`max_cells` must be >= 1");
   BoundaryRefinementReport report;
   std::size_t leaves = 0;
   for (const QuadNode& q : mesh.nodes()) leaves += q.is_leaf();
   auto over_budget = [&] {
     std::ostringstream s;
-    s << "the boundary needs more than " << options.max_cells << " cells (--max-cells) to meet the tolerance "
+    s << "the boundary needs more than " << options.max_cells << " cells (`max_cells`) to meet the tolerance "
       << options.tolerance_area << " (an area) at levels up to " << options.max_level
-      << ": raise --max-cells, --tol or --tol-rel, or simplify the polygon (long thin parts need the most cells)";
+      << ": raise `max_cells`, `tolerance_absolute` or `tolerance_relative`, or simplify the polygon (long thin parts need the most cells)";
     return InputError(s.str());
   };
   for (;;) {

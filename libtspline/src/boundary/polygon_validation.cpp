@@ -133,7 +133,7 @@ Polygon validate_polygon(Polygon p, std::size_t min_vertices) {
     p.file_index.resize(n);
     for (std::size_t i = 0; i < n; ++i) p.file_index[i] = i;
   } else if (p.file_index.size() != n) {
-    throw std::invalid_argument("validate_polygon: file_index has " + std::to_string(p.file_index.size()) +
+    throw toolkit::InputError("validate_polygon: file_index has " + std::to_string(p.file_index.size()) +
                                 " entries for " + std::to_string(n) + " vertices");
   }
   const auto& fi = p.file_index;
@@ -225,7 +225,7 @@ double needle_width_for_tolerance(double tolerance_area, double diagonal) {
 
 PolygonCleaning clean_polygon(Polygon p, double needle_width) {
   if (!(needle_width >= 0.0) || !std::isfinite(needle_width))
-    throw std::invalid_argument("clean_polygon: the needle width must be finite and >= 0");
+    throw toolkit::InputError("clean_polygon: the needle width must be finite and >= 0");
   const std::size_t n0 = p.vertices.size();
   if (p.file_index.empty()) {
     p.file_index.resize(n0);

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
+#include "toolkit/errors.h"
 
 namespace tspline::detail {
 
@@ -56,7 +57,7 @@ void split_row(const double* in, int deg, int stride, double* left, double* righ
 // ---------------------------------------------------------------------------
 BernsteinPoly::BernsteinPoly(int m_, int n_) : m(m_), n(n_) {
   if (m < 0 || n < 0 || m > kMaxDegree || n > kMaxDegree)
-    throw std::invalid_argument("BernsteinPoly: bidegree out of range");
+    throw toolkit::InternalError("BernsteinPoly: bidegree out of range");
 }
 
 double BernsteinPoly::min_coefficient() const { return *std::min_element(c.begin(), c.begin() + size()); }
@@ -103,7 +104,7 @@ BernsteinPoly bernstein_product(const BernsteinPoly& a, const BernsteinPoly& b) 
 }
 
 BernsteinPoly bernstein_ds(const BernsteinPoly& a) {
-  if (a.m < 1) throw std::invalid_argument("bernstein_ds: degree 0");
+  if (a.m < 1) throw toolkit::InternalError("bernstein_ds: degree 0");
   BernsteinPoly r(a.m - 1, a.n);
   for (int j = 0; j <= a.n; ++j)
     for (int i = 0; i < a.m; ++i) r.at(i, j) = a.m * (a.at(i + 1, j) - a.at(i, j));
@@ -111,7 +112,7 @@ BernsteinPoly bernstein_ds(const BernsteinPoly& a) {
 }
 
 BernsteinPoly bernstein_dt(const BernsteinPoly& a) {
-  if (a.n < 1) throw std::invalid_argument("bernstein_dt: degree 0");
+  if (a.n < 1) throw toolkit::InternalError("bernstein_dt: degree 0");
   BernsteinPoly r(a.m, a.n - 1);
   for (int j = 0; j < a.n; ++j)
     for (int i = 0; i <= a.m; ++i) r.at(i, j) = a.n * (a.at(i, j + 1) - a.at(i, j));
@@ -119,7 +120,7 @@ BernsteinPoly bernstein_dt(const BernsteinPoly& a) {
 }
 
 BernsteinPoly bernstein_axpy(const BernsteinPoly& a, double f, const BernsteinPoly& b) {
-  if (a.m != b.m || a.n != b.n) throw std::invalid_argument("bernstein_axpy: bidegrees differ");
+  if (a.m != b.m || a.n != b.n) throw toolkit::InternalError("bernstein_axpy: bidegrees differ");
   BernsteinPoly r = a;
   for (int k = 0; k < r.size(); ++k) r.c[k] += f * b.c[k];
   return r;

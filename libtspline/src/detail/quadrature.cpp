@@ -3,6 +3,7 @@
 
 #include <stdexcept>
 #include <utility>
+#include "toolkit/errors.h"
 
 namespace tspline::detail {
 
@@ -27,7 +28,7 @@ void gauss_points_01(int n, std::vector<double>& p, std::vector<double>& w) {
        {0.2386191860831969, 0.4679139345726910},
        {0.6612093864662645, 0.3607615730481386},
        {0.9324695142031521, 0.1713244923791704}}};
-  if (n < 1 || n > 6) throw std::invalid_argument("gauss_points_01: n must be in [1, 6]");
+  if (n < 1 || n > 6) throw toolkit::InputError("gauss_points_01: n must be in [1, 6]");
   p.clear(), w.clear();
   for (const auto& [x, wt] : table[n - 1]) p.push_back(0.5 * (x + 1.0)), w.push_back(0.5 * wt);
 }

@@ -396,7 +396,7 @@ AutomaticCuts automatic_cuts(const Domain& d) {
     }
   if (best.cuts.empty())
     throw InputError("no automatic decomposition into four-sided patches found for this domain with " +
-                     std::to_string(d.holes.size()) + " hole(s); give the cuts with --cuts FILE");
+                     std::to_string(d.holes.size()) + " hole(s); give the cuts by hand (`cuts`)");
   return best;
 }
 

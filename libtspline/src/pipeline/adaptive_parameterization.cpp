@@ -36,7 +36,7 @@ std::string corner_problem(const TSplineMap& map, const BoundaryMap& boundary, s
       s << "det J <= 0 at the corner (" << uv[k].x() << "," << uv[k].y()
         << ") of the square: the boundary curve turns by a reflex angle at polygon vertex "
         << boundary.polygon().file_index[boundary.corners().index[k]]
-        << " (file numbering); no interior move can fix this, choose other --corners";
+        << " (file numbering); no interior move can fix this, choose other `corners`";
       first = s.str();
     }
   }
@@ -428,7 +428,7 @@ class AdaptiveRun {
       why = "warm start: certified, whole-map J_r " + std::to_string(rec.dense_quality.min_mean_ratio) +
             " against the previous map's " + std::to_string(warm_->reference_mean_ratio);
     } else if (it >= ad_.max_adapt) {
-      why = "reached --max-adapt " + std::to_string(ad_.max_adapt);
+      why = "reached `max_adapt` " + std::to_string(ad_.max_adapt);
     } else if (certified && best_->score.certified && ad_.min_quality_gain > 0.0 && it > last_gain_it_) {
       why = "certified; refining the cells with J_r < " + std::to_string(ad_.min_jacobian) +
             " raised the whole-map min J_r by less than " +
@@ -440,7 +440,7 @@ class AdaptiveRun {
     } else {
       marked = cells_to_refine(f_.mesh, cells, cert, ad_, opt_.max_level, &rec.certification_marked_cells);
       if (marked.empty()) {
-        why = "the cells to refine are at --max-level";
+        why = "the cells to refine are at `max_level`";
       } else if (certified && static_cast<double>(marked.size()) > ad_.max_quality_fraction * f_.mesh.num_cells()) {
         // J_r < delta on a large part of a certified map: anisotropy that the
         // shape and the corner choice impose, which refinement only multiplies.
@@ -450,7 +450,7 @@ class AdaptiveRun {
         marked.clear();
       } else if (f_.mesh.num_cells() + 3 * marked.size() > ad_.max_cells) {
         why = "refining " + std::to_string(marked.size()) + " more cells would exceed the budget of " +
-              std::to_string(ad_.max_cells) + " cells (--max-cells)";
+              std::to_string(ad_.max_cells) + " cells (`max_cells`)";
         marked.clear();
       }
     }

@@ -208,7 +208,7 @@ DomainParameterization parameterize_domain(const Domain& input, const Parameteri
   // A first try cut short by its round limit is run again in full, so that
   // auto gives what layout single gives wherever it keeps one patch.
   const bool cut_short = first.max_adapt < adaptive.max_adapt &&
-                         single.stop_reason.rfind("reached --max-adapt", 0) == 0;
+                         single.stop_reason.rfind("reached `max_adapt`", 0) == 0;
   if (good) drop_layout();
   if ((good || !quad_mesher_available()) && cut_short)
     single = run_parameterization(domain.outer, options, adaptive, on_iteration);

@@ -221,7 +221,7 @@ FrontResult optimize_front(BoundaryMap boundary, const ParameterizationOptions& 
       if (!q[c].valid && r.mesh.cell_level(c) < opt.max_level) inverted.push_back(c);
     if (inverted.empty()) {
       r.repair_stop_reason = "the " + std::to_string(r.quality_optimized.inverted_cells) +
-                             " inverted cells are at --max-level " + std::to_string(opt.max_level);
+                             " inverted cells are at `max_level` " + std::to_string(opt.max_level);
       log("repair", "repair stopped: " + r.repair_stop_reason);
       break;
     }
@@ -231,10 +231,10 @@ FrontResult optimize_front(BoundaryMap boundary, const ParameterizationOptions& 
       // The domain needs a finer mesh than allowed (typically a long thin
       // part): say so and stop rather than go on with a tangled mesh.
       std::ostringstream s;
-      s << "the polygon needs more than " << opt.max_cells << " cells (--max-cells): after " << round
+      s << "the polygon needs more than " << opt.max_cells << " cells (`max_cells`): after " << round
         << " repair round(s) " << r.quality_optimized.inverted_cells << " of " << r.mesh.num_cells()
         << " T-mesh cells are still inverted, and refining them makes " << finer.num_cells()
-        << " cells; raise --max-cells, or check the polygon for long thin parts (spikes, narrow channels)";
+        << " cells; raise `max_cells`, or check the polygon for long thin parts (spikes, narrow channels)";
       throw InputError(s.str());
     }
     // The state before this round, restored if the round makes things worse.
@@ -409,8 +409,8 @@ FrontResult run_front(const Polygon& input, const ParameterizationOptions& opt) 
       s << "corner " << k << " (file vertex " << poly.file_index[i] << ") has an inner angle of "
         << corners.inner_angle_deg[k]
         << " degrees: corners must be convex vertices (inner angle below 180); "
-        << (opt.corners ? "pick another vertex, or omit --corners for the automatic choice"
-                        : "the polygon has fewer than four strictly convex vertices: give --corners");
+        << (opt.corners ? "pick another vertex, or leave `corners` unset for the automatic choice"
+                        : "the polygon has fewer than four strictly convex vertices: give `corners`");
       throw InputError(s.str());
     }
   }

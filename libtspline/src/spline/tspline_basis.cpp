@@ -6,6 +6,7 @@
 #include <cmath>
 #include <stdexcept>
 #include <string>
+#include "toolkit/errors.h"
 
 namespace tspline {
 
@@ -157,7 +158,7 @@ double cubic_bspline(const std::array<double, 5>& k, double t, double* d1, doubl
 }
 
 TSplineBasis::TSplineBasis(const TMesh& mesh) : mesh_(&mesh) {
-  if (!mesh.has_topology()) throw std::logic_error("TSplineBasis: the T-mesh has no topology");
+  if (!mesh.has_topology()) throw toolkit::InternalError("TSplineBasis: the T-mesh has no topology");
   const RayCaster rays{mesh};
   const std::size_t nv = mesh.num_vertices();
   functions_.reserve(nv + 4 * static_cast<std::size_t>(std::sqrt(static_cast<double>(nv))) + 16);
@@ -221,7 +222,7 @@ TSplineBasis::TSplineBasis(const TMesh& mesh) : mesh_(&mesh) {
 
 int TSplineBasis::locate(const Eigen::Vector2d& uv) const {
   if (!(uv.x() >= 0.0 && uv.x() <= 1.0 && uv.y() >= 0.0 && uv.y() <= 1.0))
-    throw std::out_of_range("TSplineBasis::locate: point outside [0,1]^2");
+    throw toolkit::InputError("TSplineBasis::locate: point outside [0,1]^2");
   // uv * kRoot is exact (power of two); floor picks the cell to the right/above
   // of a cell line; clamping puts xi = 1 (eta = 1) in the last cell.
   auto cell_index = [](double t) {
@@ -241,7 +242,7 @@ void TSplineBasis::evaluate(const Eigen::Vector2d& uv, BasisValues& out, int ord
 //   R_ij = (N_ij - R_i S_j - R_j S_i - R S_ij) / S
 // (differentiate N = R S twice: N_ij = R_ij S + R_i S_j + R_j S_i + R S_ij).
 void TSplineBasis::evaluate(int c, const Eigen::Vector2d& uv, BasisValues& out, int order) const {
-  if (order < 0 || order > 2) throw std::invalid_argument("TSplineBasis::evaluate: order must be 0, 1 or 2");
+  if (order < 0 || order > 2) throw toolkit::InputError("TSplineBasis::evaluate: order must be 0, 1 or 2");
   const std::vector<int>& ids = cell_functions_.at(static_cast<std::size_t>(c));
   const std::size_t n = ids.size();
   out.ids = ids;
@@ -276,7 +277,7 @@ void TSplineBasis::evaluate(int c, const Eigen::Vector2d& uv, BasisValues& out, 
       Syy += u * w2;
     }
   }
-  if (!(S > 0.0)) throw std::logic_error("TSplineBasis::evaluate: the blending functions vanish at the point");
+  if (!(S > 0.0)) throw toolkit::InternalError("TSplineBasis::evaluate: the blending functions vanish at the point");
   const double inv = 1.0 / S;
   for (std::size_t k = 0; k < n; ++k) {
     const double R = out.R[k] * inv;

@@ -2,6 +2,7 @@
 
 #include <stdexcept>
 #include <string>
+#include "toolkit/errors.h"
 
 namespace tspline {
 
@@ -10,7 +11,7 @@ TSplineMap::TSplineMap(TMesh mesh, std::vector<Eigen::Vector2d> control_points)
       basis_(std::make_unique<TSplineBasis>(*mesh_)),
       control_points_(std::move(control_points)) {
   if (control_points_.size() != basis_->size())
-    throw std::invalid_argument("TSplineMap: " + std::to_string(control_points_.size()) + " control points for " +
+    throw toolkit::InputError("TSplineMap: " + std::to_string(control_points_.size()) + " control points for " +
                                 std::to_string(basis_->size()) + " blending functions");
 }
 
@@ -21,7 +22,7 @@ TSplineMap::TSplineMap(TMesh mesh)
 
 void TSplineMap::set_control_points(std::vector<Eigen::Vector2d> control_points) {
   if (control_points.size() != basis_->size())
-    throw std::invalid_argument("TSplineMap: " + std::to_string(control_points.size()) + " control points for " +
+    throw toolkit::InputError("TSplineMap: " + std::to_string(control_points.size()) + " control points for " +
                                 std::to_string(basis_->size()) + " blending functions");
   control_points_ = std::move(control_points);
 }

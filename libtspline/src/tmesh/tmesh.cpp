@@ -28,8 +28,8 @@ TMesh::TMesh(int initial_level) {
 }
 
 int TMesh::refine(int n) {
-  if (!nodes_.at(n).is_leaf()) throw std::logic_error("TMesh::refine: node is not a leaf");
-  if (nodes_[n].level >= kMaxLevel) throw std::logic_error("TMesh::refine: maximum level reached");
+  if (!nodes_.at(n).is_leaf()) throw toolkit::InternalError("TMesh::refine: node is not a leaf");
+  if (nodes_[n].level >= kMaxLevel) throw toolkit::InternalError("TMesh::refine: maximum level reached");
   topology_valid_ = false;
   const int first = static_cast<int>(nodes_.size());
   const QuadNode parent = nodes_[n];
@@ -147,7 +147,7 @@ void TMesh::build_topology() {
       const IPoint quarter = (e % 2 == 0) ? IPoint{lo.x + h / 2, mids[e].y} : IPoint{mids[e].x, lo.y + h / 2};
       const IPoint quarter2 = (e % 2 == 0) ? IPoint{hi.x - h / 2, mids[e].y} : IPoint{mids[e].x, hi.y - h / 2};
       if (h >= 2 && (find_vertex(quarter) >= 0 || find_vertex(quarter2) >= 0))
-        throw std::logic_error("TMesh::build_topology: the tree is not 2:1 balanced");
+        throw toolkit::InternalError("TMesh::build_topology: the tree is not 2:1 balanced");
       cell_mid_[c][e] = v;
       vertex_hanging_cell_[v] = static_cast<int>(c);
     }

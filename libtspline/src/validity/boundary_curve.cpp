@@ -11,6 +11,7 @@
 #include <stdexcept>
 
 #include "tspline/spline/bezier_extraction.h"
+#include "toolkit/errors.h"
 
 namespace tspline {
 
@@ -40,7 +41,7 @@ void element_border_segments(const BezierElement& e, const std::vector<Eigen::Ve
     Piece p;
     for (int i = 0; i < 4; ++i) {
       if (std::abs(W[idx[i]] - 1.0) > 1e-9)
-        throw std::logic_error("check_boundary_curve: the map's weights are not 1 on the border");
+        throw toolkit::InternalError("check_boundary_curve: the map's weights are not 1 on the border");
       p.P[i] = X[idx[i]] / W[idx[i]];
     }
     p.uv0 = uv0, p.uv1 = uv1;
@@ -86,7 +87,7 @@ bool monotone(const Piece* a, const Piece* b, double tiny) {
 }  // namespace
 
 BoundaryCurveCheck check_boundary_curve(const TSplineMap& map, int max_depth) {
-  if (max_depth < 0 || max_depth > 20) throw std::invalid_argument("check_boundary_curve: max_depth out of range");
+  if (max_depth < 0 || max_depth > 20) throw toolkit::InputError("check_boundary_curve: max_depth out of range");
   const BezierExtraction ex(map.basis());
   std::array<std::vector<Piece>, 4> sides;
   std::array<std::vector<double>, 4> keys;

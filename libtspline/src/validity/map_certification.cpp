@@ -11,6 +11,7 @@
 
 #include "tspline/detail/element_jacobian.h"
 #include "tspline/detail/quadrature.h"
+#include "toolkit/errors.h"
 
 namespace tspline {
 
@@ -61,7 +62,7 @@ double at_gauss(const BernsteinPoly& p, const double (&bs)[d + 1], const double 
 ElementCertificate certify_element(const BezierElement& e, const std::vector<Eigen::Vector2d>& P,
                                    const CertificationOptions& opt) {
   if (opt.max_depth < 0 || opt.max_depth > 20)
-    throw std::invalid_argument("certify_element: max_depth out of range");
+    throw toolkit::InputError("certify_element: max_depth out of range");
   const ElementJacobian J = element_jacobian(e, P);
   const double area = (e.hi.x() - e.lo.x()) * (e.hi.y() - e.lo.y());
   const double tol = opt.relative_tolerance * J.scale;

@@ -9,6 +9,7 @@
 #include <limits>
 #include <stdexcept>
 #include <thread>
+#include "toolkit/errors.h"
 
 namespace tspline {
 
@@ -257,12 +258,12 @@ MapEnergy::Samples::Samples(const MapEnergy& energy) {
 
 MapEnergy::MapEnergy(const TSplineMap& map, const MapEnergyOptions& opt)
     : options_(opt), extraction_(map.basis()) {
-  if (!opt.lobatto && (opt.gauss < 1 || opt.gauss > 6)) throw std::invalid_argument("MapEnergy: gauss must be in [1, 6]");
+  if (!opt.lobatto && (opt.gauss < 1 || opt.gauss > 6)) throw toolkit::InputError("MapEnergy: gauss must be in [1, 6]");
   if (opt.lobatto && (opt.gauss < 3 || opt.gauss > 5))
-    throw std::invalid_argument("MapEnergy: Gauss-Lobatto points per direction must be in [3, 5]");
-  if (!(opt.theta >= 0.0 && opt.theta < 1.0)) throw std::invalid_argument("MapEnergy: theta must be in [0, 1)");
+    throw toolkit::InputError("MapEnergy: Gauss-Lobatto points per direction must be in [3, 5]");
+  if (!(opt.theta >= 0.0 && opt.theta < 1.0)) throw toolkit::InputError("MapEnergy: theta must be in [0, 1)");
   if (opt.max_sample_level < 0 || opt.max_sample_level > 4)
-    throw std::invalid_argument("MapEnergy: max_sample_level must be in [0, 4]");
+    throw toolkit::InputError("MapEnergy: max_sample_level must be in [0, 4]");
   if (options_.threads <= 0) options_.threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
   options_.threads = std::min(options_.threads, 16);
 
@@ -296,7 +297,7 @@ MapEnergy::MapEnergy(const TSplineMap& map, const MapEnergyOptions& opt)
   const TSplineBasis& basis = map.basis();
   variable_of_.assign(basis.size(), -1);
   if (!opt.movable.empty() && opt.movable.size() != basis.size())
-    throw std::invalid_argument("MapEnergy: movable must have one flag per basis function");
+    throw toolkit::InputError("MapEnergy: movable must have one flag per basis function");
   for (int a = 0; a < static_cast<int>(basis.size()); ++a)
     if (!touches_border(basis.function(a)) && (opt.movable.empty() || opt.movable[a])) {
       variable_of_[a] = static_cast<int>(2 * free_functions_.size());
@@ -348,7 +349,7 @@ MapEnergy::MapEnergy(const TSplineMap& map, const MapEnergyOptions& opt)
     }
   }
   if (!(area > 0.0) || !std::isfinite(area))
-    throw std::invalid_argument("MapEnergy: the map's domain has no positive area (boundary curve clockwise or degenerate)");
+    throw toolkit::InputError("MapEnergy: the map's domain has no positive area (boundary curve clockwise or degenerate)");
   L_ = std::sqrt(area);
   for (Eigen::Vector2d& p : normalized_) p /= L_;
 }
@@ -401,7 +402,7 @@ std::vector<Eigen::Vector2d> MapEnergy::control_points(const double* x) const {
 
 void MapEnergy::set_sample_level(std::size_t element, int level) {
   if (level < 0 || level > options_.max_sample_level)
-    throw std::invalid_argument("MapEnergy::set_sample_level: level out of range");
+    throw toolkit::InputError("MapEnergy::set_sample_level: level out of range");
   elements_[element].level = level;
 }
 

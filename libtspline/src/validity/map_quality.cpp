@@ -11,6 +11,7 @@
 #include <cmath>
 #include <limits>
 #include <stdexcept>
+#include "toolkit/errors.h"
 
 namespace tspline {
 
@@ -85,12 +86,12 @@ MapQualityStats map_quality(const TSplineMap& map, const BezierExtraction& extra
 }
 
 DenseMapQuality dense_map_quality(const TSplineMap& map, int k) {
-  if (k < 1) throw std::invalid_argument("dense_map_quality: k must be >= 1");
+  if (k < 1) throw toolkit::InputError("dense_map_quality: k must be >= 1");
   return dense_map_quality(BezierExtraction(map.basis()), map.control_points(), k);
 }
 
 DenseMapQuality dense_map_quality(const BezierExtraction& extraction, const std::vector<Eigen::Vector2d>& P, int k) {
-  if (k < 1) throw std::invalid_argument("dense_map_quality: k must be >= 1");
+  if (k < 1) throw toolkit::InputError("dense_map_quality: k must be >= 1");
   const std::vector<BezierElement>& es = extraction.elements();
   // The (k + 1) x (k + 1) points of every element as a tensor grid: the map's
   // Bernstein coefficients per element and sum factorization (tensor_grid.h),

@@ -13,6 +13,7 @@
 
 #include "tspline/detail/bernstein.h"
 #include "tspline/detail/element_jacobian.h"
+#include "toolkit/errors.h"
 
 namespace tspline {
 
@@ -348,11 +349,11 @@ void dense_sample(const std::array<BernsteinPoly, 3>& xyw, const SampleTable& ta
 }
 
 void check_options(const QualityBoundOptions& o) {
-  if (o.max_depth < 0 || o.max_depth > 20) throw std::invalid_argument("quality bounds: max_depth out of range");
-  if (o.max_patches < 1) throw std::invalid_argument("quality bounds: max_patches must be >= 1");
+  if (o.max_depth < 0 || o.max_depth > 20) throw toolkit::InputError("quality bounds: max_depth out of range");
+  if (o.max_patches < 1) throw toolkit::InputError("quality bounds: max_patches must be >= 1");
   if (!(o.relative_gap >= 0.0) || !(o.absolute_gap >= 0.0))
-    throw std::invalid_argument("quality bounds: the gaps must be >= 0");
-  if (o.samples_per_edge < 0) throw std::invalid_argument("quality bounds: samples_per_edge must be >= 0");
+    throw toolkit::InputError("quality bounds: the gaps must be >= 0");
+  if (o.samples_per_edge < 0) throw toolkit::InputError("quality bounds: samples_per_edge must be >= 0");
 }
 
 ElementQualityBound bound_element(const BezierElement& e, const std::vector<Eigen::Vector2d>& P,

@@ -15,6 +15,7 @@
 #include <limits>
 #include <optional>
 #include <stdexcept>
+#include "toolkit/errors.h"
 
 namespace tspline {
 
@@ -196,15 +197,15 @@ MapUntanglingOptions local_repair_options(const TSplineMap& map, const MapEnergy
 
 MapUntanglingReport untangle_map(TSplineMap& map, const MapUntanglingOptions& opt) {
   if (opt.max_stages < 1 || opt.max_iterations_per_stage < 1 || opt.max_iterations < 1)
-    throw std::invalid_argument("untangle_map: stage and iteration limits must be >= 1");
+    throw toolkit::InputError("untangle_map: stage and iteration limits must be >= 1");
   if (!(opt.eps_floor > 0.0) || !(opt.energy_tolerance > 0.0))
-    throw std::invalid_argument("untangle_map: eps_floor and energy_tolerance must be > 0");
+    throw toolkit::InputError("untangle_map: eps_floor and energy_tolerance must be > 0");
   if (opt.max_newton_iterations_per_stage < 1 || !(opt.newton_stage_tolerance >= 0.0))
-    throw std::invalid_argument("untangle_map: max_newton_iterations_per_stage must be >= 1 and newton_stage_tolerance >= 0");
+    throw toolkit::InputError("untangle_map: max_newton_iterations_per_stage must be >= 1 and newton_stage_tolerance >= 0");
   if (!(opt.min_decrease > 0.0 && opt.min_decrease < 1.0) || !(opt.newton_min_decrease > 0.0 && opt.newton_min_decrease < 1.0))
-    throw std::invalid_argument("untangle_map: min_decrease and newton_min_decrease must be in (0, 1)");
+    throw toolkit::InputError("untangle_map: min_decrease and newton_min_decrease must be in (0, 1)");
   if (opt.max_cg_iterations < 1 || opt.newton_cholesky_below < 0)
-    throw std::invalid_argument("untangle_map: max_cg_iterations must be >= 1 and newton_cholesky_below >= 0");
+    throw toolkit::InputError("untangle_map: max_cg_iterations must be >= 1 and newton_cholesky_below >= 0");
   const auto t0 = std::chrono::steady_clock::now();
   MapEnergy energy(map, opt.energy);
   MapUntanglingReport rep;

@@ -20,7 +20,7 @@ enum class Side { Bottom = 0, Right = 1, Top = 2, Left = 3 };
 /// chord length onto its side of the unit square.
 class BoundaryMap {
  public:
-  /// \throw std::invalid_argument unless the corners are distinct, in range and in
+  /// \throw InputError unless the corners are distinct, in range and in
   /// CCW order; NumericalError if an edge is too short for a strictly increasing
   /// chord parameter (length below double resolution relative to its chain).
   BoundaryMap(Polygon ccw_polygon, Corners corners);
@@ -30,11 +30,11 @@ class BoundaryMap {
 
   /// Point of the polygon at chord parameter t in [0,1] on `side` (t=0 at the
   /// chain's first corner). Exact at the chain's vertices. O(log n).
-  /// \throw std::invalid_argument if t is not in [0,1].
+  /// \throw InputError if t is not in [0,1].
   Eigen::Vector2d point(Side side, double t) const;
 
   /// Physical point for a parametric point on the boundary of [0,1]^2
-  /// (one coordinate must be 0 or 1). \throw std::invalid_argument otherwise.
+  /// (one coordinate must be 0 or 1). \throw InputError otherwise.
   Eigen::Vector2d point_at(const Eigen::Vector2d& uv) const;
 
   /// Chain of `side`: polygon vertices from its first corner to its last corner

@@ -82,7 +82,7 @@ struct PolygonCleaning {
 /// closing seam (vertex 0) too; each removed tip changes the area by at most
 /// needle_width x (the longer edge) / 2. A note per vertex in the file's
 /// numbering. True crossings are left for validate_polygon to reject.
-/// Non-finite coordinates are left as well. \throw std::invalid_argument if
+/// Non-finite coordinates are left as well. \throw InputError if
 /// needle_width is negative or not finite.
 PolygonCleaning clean_polygon(Polygon p, double needle_width = 0.0);
 

@@ -7,7 +7,7 @@
 namespace tspline::detail {
 
 /// Gauss-Legendre points on [0,1] (n = 1..6) and their weights (exact for
-/// polynomials of degree 2n - 1). \throw std::invalid_argument if n is outside [1, 6].
+/// polynomials of degree 2n - 1). \throw InputError if n is outside [1, 6].
 void gauss_points_01(int n, std::vector<double>& points, std::vector<double>& weights);
 
 }  // namespace tspline::detail

@@ -23,7 +23,7 @@ class TSplineMap {
  public:
   /// Takes the T-mesh (topology must be built) and one control point per
   /// blending function of TSplineBasis(mesh), in its order.
-  /// \throw std::invalid_argument if the number of control points is wrong.
+  /// \throw InputError if the number of control points is wrong.
   TSplineMap(TMesh mesh, std::vector<Eigen::Vector2d> control_points);
   /// All control points at the origin (to be set with set_control_points()).
   explicit TSplineMap(TMesh mesh);
@@ -35,7 +35,7 @@ class TSplineMap {
   const TMesh& mesh() const { return *mesh_; }
   const TSplineBasis& basis() const { return *basis_; }
   const std::vector<Eigen::Vector2d>& control_points() const { return control_points_; }
-  /// \throw std::invalid_argument if the count differs from basis().size().
+  /// \throw InputError if the count differs from basis().size().
   void set_control_points(std::vector<Eigen::Vector2d> control_points);
 
   Eigen::Vector2d point(const Eigen::Vector2d& uv) const;

@@ -60,7 +60,7 @@ class TMesh {
   static IPoint node_max(const QuadNode& q) { return {(q.i + 1) * node_size(q), (q.j + 1) * node_size(q)}; }
 
   /// Splits a leaf into four. Returns the index of its first child.
-  /// \throw std::logic_error if n is not a leaf or is at kMaxLevel.
+  /// \throw InternalError if n is not a leaf or is at kMaxLevel.
   int refine(int n);
   /// Refines until no two edge-adjacent leaves differ by more than one level
   /// (2:1 balance: at most one hanging vertex per cell edge). Returns the number of splits.
@@ -74,7 +74,7 @@ class TMesh {
 
   // ---------------------------------------------------------------- topology
   /// Numbers cells (leaves, in depth-first = Morton order) and vertices.
-  /// \pre the tree is balanced (checked: throws std::logic_error otherwise).
+  /// \pre the tree is balanced (checked: throws InternalError otherwise).
   void build_topology();
   bool has_topology() const { return topology_valid_; }
 
@@ -136,7 +136,7 @@ class TMesh {
 /// the boundary-curve and adaptive rounds of the map, the Poisson estimator):
 /// a copy of `mesh` with the given cells (numbering of `mesh`) split into four,
 /// re-balanced 2:1 and its topology rebuilt. Repeated cells are split once.
-/// \pre mesh has its topology; \throw std::logic_error for a cell at kMaxLevel
+/// \pre mesh has its topology; \throw InternalError for a cell at kMaxLevel
 /// (callers filter by their own maximum level first).
 TMesh refine_cells(const TMesh& mesh, const std::vector<int>& cells);
 

@@ -107,7 +107,7 @@ struct SampleStats {
 
 class MapEnergy {
  public:
-  /// \throw std::invalid_argument for options out of range or a map whose
+  /// \throw InputError for options out of range or a map whose
   /// domain has no positive area.
   MapEnergy(const TSplineMap& map, const MapEnergyOptions& options = {});
 

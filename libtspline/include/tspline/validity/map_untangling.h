@@ -147,7 +147,7 @@ struct MapUntanglingReport {
 };
 
 /// Moves the interior control points of `map` in place.
-/// \throw std::invalid_argument for options out of range.
+/// \throw InputError for options out of range.
 MapUntanglingReport untangle_map(TSplineMap& map, const MapUntanglingOptions& options = {});
 
 }  // namespace tspline

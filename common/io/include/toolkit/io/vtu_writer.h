@@ -38,7 +38,7 @@ struct VtuMesh {
   std::vector<std::array<int, 3>> higher_order_degrees;
 };
 
-/// Writes `mesh` to `path` atomically. \throw IoError; std::invalid_argument if
+/// Writes `mesh` to `path` atomically. \throw IoError; InputError if
 /// an array has the wrong length or a cell index is out of range.
 void write_vtu(const std::string& path, const VtuMesh& mesh);
 /// The same, releasing each of `mesh`'s arrays as soon as VTK has its copy

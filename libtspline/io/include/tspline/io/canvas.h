@@ -31,7 +31,7 @@ enum class TextAlign { Left, Centre, Right };
 class Canvas {
  public:
   /// A white page of width x height pixels (points for SVG and PDF) that
-  /// finish() writes to `path` in `format`. \throw std::invalid_argument
+  /// finish() writes to `path` in `format`. \throw InputError
   /// unless 16 <= width, height <= 16384; IoError if Cairo cannot create it.
   Canvas(ImageFormat format, std::string path, int width, int height);
   ~Canvas();

@@ -12,7 +12,7 @@ namespace tspline::io {
 /// row by row) and k x k VTK_QUAD cells per T-mesh cell, with cell data `cell`
 /// (T-mesh cell id) and `level`. `sample(c, uv)` returns the physical point for
 /// the grid point uv of cell c; callers record their own point data in it, in
-/// call order. \throw std::invalid_argument unless 1 <= k <= 64.
+/// call order. \throw InputError unless 1 <= k <= 64.
 toolkit::io::VtuMesh cell_grid_vtu(const TMesh& mesh, int k,
                       const std::function<Eigen::Vector2d(int, const Eigen::Vector2d&)>& sample);
 

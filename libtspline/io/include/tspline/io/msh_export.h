@@ -56,7 +56,7 @@ MshExportStats write_msh_file(const std::string& path, const TSplineMap& map);
 /// shared interface knots of `tspline param` that is every node of the cut), so
 /// that the mesh is conforming across cuts. A node belongs to the entity of the
 /// first patch that has it. One patch and no interfaces: msh_document(map).
-/// \throw std::invalid_argument for an empty map list or an interface naming a
+/// \throw InputError for an empty map list or an interface naming a
 /// patch or side out of range.
 std::string msh_document(const std::vector<const TSplineMap*>& maps, const std::vector<Interface>& interfaces,
                          MshExportStats* stats = nullptr);

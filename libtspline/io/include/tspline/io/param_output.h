@@ -40,7 +40,7 @@ toolkit::io::VtuMesh control_net_vtu(const TSplineMap& map);
 /// quadrature points, from `quality`; NaN without). Point data: parametric (xi,
 /// eta), vertex (the T-mesh vertex, -1 for samples inside an edge), hanging,
 /// boundary (on the parametric square's border).
-/// \throw std::invalid_argument unless 1 <= k <= 64.
+/// \throw InputError unless 1 <= k <= 64.
 toolkit::io::VtuMesh physical_tmesh_vtu(const TSplineMap& map, int k, const MapCertification* certificate,
                                         const CertificationOptions& options,
                                         const std::vector<CellMapQuality>* quality);
