@@ -399,7 +399,7 @@ void bind_maps(py::module_& m) {
       .def("save_vtk_bezier", &save_vtk_bezier, py::arg("path"),
            "save_vtk_bezier(path): the map exactly as rational bicubic Bezier cells for ParaView (a .vtu "
            "file, "
-           "as `tspline export --vtk-bezier`; README, 'The exact map in ParaView').")
+           "as `tspline export --vtk-bezier`; docs/paraview.md).")
       .def("render", &render, py::arg("path"), py::arg("view") = "jacobian",
            py::arg("size") = std::pair<int, int>{1200, 900}, py::arg("samples") = 4,
            "render(path, view='jacobian', size=(1200, 900), samples=4) -> dict {min, max}: a picture (PNG, "

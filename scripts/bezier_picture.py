@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""The README's picture of surface_bezier.vtu as ParaView draws it, made with
+"""The picture of surface_bezier.vtu as ParaView draws it (docs/paraview.md), made with
 VTK's own rendering (offscreen; without a display run it under xvfb-run, as
 scripts/make_pictures.sh does):
 

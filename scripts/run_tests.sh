@@ -4,7 +4,8 @@
 # UndefinedBehaviorSanitizer (-O1 -g1). Between the two, installs the Release build into
 # build/install and builds and runs tests/downstream against the installed
 # CMake package (and imports the installed Python module). The Python tests
-# (pytest, tests/python) run after the Release suites, not under the sanitizers.
+# (pytest, tests/python) run after the Release suites, not under the sanitizers,
+# and then every command of README.md (scripts/run_readme_commands.sh).
 # Before the sanitizer suites, the libFuzzer targets (scripts/run_fuzz.sh: clang,
 # ASan, 20 s each), so that the run still ends with doctest's summaries (the sanitized
 # suites run in groups, one per core at a time: scripts/run_test_chunks.sh).
@@ -20,6 +21,8 @@ BUILD_DIR=build BUILD_TYPE=Release bash scripts/build.sh -DPython3_EXECUTABLE="$
 ./build/tests/unit_tests
 echo "== Python module (pytest; build/python)"
 PYTHONPATH="$PWD/build/python" "$PYTHON" -m pytest -p no:cacheprovider tests/python
+echo "== README commands (every command of README.md, against the Release build)"
+BUILD_DIR=build PYTHON="$PYTHON" bash scripts/run_readme_commands.sh
 echo "== Installed package: cmake --install, then a downstream project with find_package(TSpline)"
 rm -rf build/install build/downstream
 cmake --install build --prefix "$PWD/build/install" > build/install.log

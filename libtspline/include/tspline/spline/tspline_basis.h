@@ -1,8 +1,8 @@
 #pragma once
 // Cubic T-spline blending functions on a balanced quadtree T-mesh
 // (Brovka, López, Escobar, Cascón, Montenegro, "A new method for T-spline parameterization
-// of complex 2D geometries", Engineering with Computers 2014, Sect. 5.2, Eq. 6; README.md,
-// "The T-spline, its untangling and its quality"; file format: docs/tspline_format.md).
+// of complex 2D geometries", Engineering with Computers 2014, Sect. 5.2, Eq. 6;
+// docs/method.md, "The T-spline, its untangling and its quality"; file format: docs/tspline_format.md).
 //
 // Every T-mesh vertex is an anchor. Its local knot vectors (5 knots per
 // direction, the anchor's coordinate in the middle) come from casting rays from

@@ -79,7 +79,7 @@ struct MapUntanglingOptions {
   /// L-BFGS by default: on this project's 2-core machine (ATLAS BLAS) the
   /// Cholesky of the bicubic 2-component Hessian costs 60 ms at 2.7e3 and
   /// 1.6 s at 3.3e4 unknowns, more than the L-BFGS iterations it saves
-  /// (bench/README.md, issue 23).
+  /// (bench/README.md, "Projected Newton vs L-BFGS for the untangling of the map").
   MapOptimizer optimizer = MapOptimizer::LBFGS;
   int max_iterations_per_stage = 20;  ///< L-BFGS iterations per stage
   /// Newton iterations per stage at most; a stage also ends when an

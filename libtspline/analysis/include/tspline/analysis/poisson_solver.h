@@ -2,8 +2,8 @@
 // Isogeometric Poisson solver (the residual estimator is poisson_estimator.h,
 // the adaptive loop poisson_adaptive.h, all three together poisson.h)
 // (Brovka, López, Escobar, Cascón, Montenegro, "A new method for T-spline parameterization
-// of complex 2D geometries", Engineering with Computers 2014, Sect. 7.2; README.md,
-// "tspline poisson").
+// of complex 2D geometries", Engineering with Computers 2014, Sect. 7.2;
+// docs/poisson.md).
 //
 //   -Laplace(u) = f in Omega = S([0,1]^2),   u = g on the boundary of Omega.
 //
