@@ -129,16 +129,3 @@ int run(int argc, char** argv) {
   // A valid map has det J > 0 at every Gauss point; "good" also has J_r >= delta.
   return result.good() ? 0 : 1;
 }
-
-// Library errors are exceptions with a message that names the problem:
-// tspline::InputError (bad input or options), tspline::IoError (files),
-// tspline::NumericalError (e.g. a singular system); libmeshopt throws the same
-// InputError (toolkit/errors.h, one header for all libraries).
-int main(int argc, char** argv) {
-  try {
-    return run(argc, argv);
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "error: %s\n", e.what());
-    return 2;
-  }
-}

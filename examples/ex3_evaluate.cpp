@@ -56,16 +56,3 @@ int run(int argc, char** argv) {
   // Inside the domain the map must be valid: det J > 0.
   return d.J.determinant() > 0.0 && worst < 1e-2 * diameter ? 0 : 1;
 }
-
-// Library errors are exceptions with a message that names the problem:
-// tspline::InputError (bad input or options), tspline::IoError (files),
-// tspline::NumericalError (e.g. a singular system); libmeshopt throws the same
-// InputError (toolkit/errors.h, one header for all libraries).
-int main(int argc, char** argv) {
-  try {
-    return run(argc, argv);
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "error: %s\n", e.what());
-    return 2;
-  }
-}

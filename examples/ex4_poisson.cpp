@@ -55,16 +55,3 @@ int run(int argc, char** argv) {
   std::printf("H1 error reduced by %.1fx\n", steps.front().errors.h1 / steps.back().errors.h1);
   return ok ? 0 : 1;
 }
-
-// Library errors are exceptions with a message that names the problem:
-// tspline::InputError (bad input or options), tspline::IoError (files),
-// tspline::NumericalError (e.g. a singular system); libmeshopt throws the same
-// InputError (toolkit/errors.h, one header for all libraries).
-int main(int argc, char** argv) {
-  try {
-    return run(argc, argv);
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "error: %s\n", e.what());
-    return 2;
-  }
-}

@@ -96,12 +96,3 @@ int run(int argc, char** argv) {
               (out / "first.png").string().c_str(), (out / "last.png").string().c_str());
   return ok ? 0 : 1;
 }
-
-int main(int argc, char** argv) {
-  try {
-    return run(argc, argv);
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "error: %s\n", e.what());
-    return 2;
-  }
-}
