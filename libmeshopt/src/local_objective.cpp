@@ -33,29 +33,30 @@ inline double sigma_of(const Eigen::Vector2d& x, const Eigen::Vector2d& pa, cons
   return (ax * by - ay * bx) * (winv(0, 0) * winv(1, 1) - winv(0, 1) * winv(1, 0));
 }
 
+/// S = A W^{-1} for the triangle (x, a, b).
+inline Eigen::Matrix2d s_of(const Eigen::Vector2d& x, const Eigen::Vector2d& pa, const Eigen::Vector2d& pb,
+                            const Eigen::Matrix2d& winv) {
+  Eigen::Matrix2d a;
+  a << pa.x() - x.x(), pb.x() - x.x(), pa.y() - x.y(), pb.y() - x.y();
+  return a * winv;
+}
+
 inline double frob2_of(const Eigen::Vector2d& x, const Eigen::Vector2d& pa, const Eigen::Vector2d& pb,
                        const Eigen::Matrix2d& winv) {
-  const double ax = pa.x() - x.x(), ay = pa.y() - x.y();
-  const double bx = pb.x() - x.x(), by = pb.y() - x.y();
-  const double s00 = ax * winv(0, 0) + bx * winv(1, 0), s01 = ax * winv(0, 1) + bx * winv(1, 1);
-  const double s10 = ay * winv(0, 0) + by * winv(1, 0), s11 = ay * winv(0, 1) + by * winv(1, 1);
-  return s00 * s00 + s01 * s01 + s10 * s10 + s11 * s11;
+  return s_of(x, pa, pb, winv).squaredNorm();
 }
 
 inline TriangleTerms terms_of(const Eigen::Vector2d& x, const Eigen::Vector2d& pa, const Eigen::Vector2d& pb,
                               const Eigen::Matrix2d& winv) {
-  const double ax = pa.x() - x.x(), ay = pa.y() - x.y();
-  const double bx = pb.x() - x.x(), by = pb.y() - x.y();
-  const double s00 = ax * winv(0, 0) + bx * winv(1, 0), s01 = ax * winv(0, 1) + bx * winv(1, 1);
-  const double s10 = ay * winv(0, 0) + by * winv(1, 0), s11 = ay * winv(0, 1) + by * winv(1, 1);
-  const double c0 = winv(0, 0) + winv(1, 0), c1 = winv(0, 1) + winv(1, 1);
+  const Eigen::Matrix2d S = s_of(x, pa, pb, winv);
+  const Eigen::Vector2d c(winv(0, 0) + winv(1, 0), winv(0, 1) + winv(1, 1));  // c = W^{-T} (1, 1)^T
   const double detw = winv(0, 0) * winv(1, 1) - winv(0, 1) * winv(1, 0);
   TriangleTerms t;
-  t.sigma = (ax * by - ay * bx) * detw;
-  t.f = s00 * s00 + s01 * s01 + s10 * s10 + s11 * s11;
+  t.sigma = sigma_of(x, pa, pb, winv);
+  t.f = S.squaredNorm();
   t.grad_sigma = Eigen::Vector2d(detw * (pa.y() - pb.y()), detw * (pb.x() - pa.x()));
-  t.grad_f = Eigen::Vector2d(-2.0 * (s00 * c0 + s01 * c1), -2.0 * (s10 * c0 + s11 * c1));
-  t.c2 = c0 * c0 + c1 * c1;
+  t.grad_f = -2.0 * S * c;
+  t.c2 = c.squaredNorm();
   return t;
 }
 

@@ -77,26 +77,28 @@ Session::Session(bool verbose) {
 
 Session::~Session() { gmsh::finalize(); }
 
-void open_model(const std::string& path) {
-  require_readable(path, "model");
+namespace {
+
+// Loads the file `path` (a `what`) into the session with `load` (gmsh::open or gmsh::merge).
+void load_file(const std::string& path, const char* what, void (*load)(const std::string&)) {
+  require_readable(path, what);
   try {
-    gmsh::open(path);
+    load(path);
   } catch (...) {
-    throw InputError(cat("cannot load the model '", path, "': ", gmsh_error()));
+    throw InputError(cat("cannot load the ", what, " '", path, "': ", gmsh_error()));
   }
+}
+
+}  // namespace
+
+void open_model(const std::string& path) {
+  load_file(path, "model", gmsh::open);
   gmsh::vectorpair faces;
   gmsh::model::getEntities(faces, 2);
   if (faces.empty()) throw InputError(cat("the model '", path, "' has no surfaces"));
 }
 
-void merge_mesh(const std::string& path) {
-  require_readable(path, "mesh");
-  try {
-    gmsh::merge(path);
-  } catch (...) {
-    throw InputError(cat("cannot load the mesh '", path, "': ", gmsh_error()));
-  }
-}
+void merge_mesh(const std::string& path) { load_file(path, "mesh", gmsh::merge); }
 
 void generate_surface_mesh() {
   try {

@@ -36,9 +36,7 @@ std::size_t reoptimize_inner_nodes(PatchLayout& layout, const Domain& moved, int
   std::vector<RingCurve> curves;
   for (const Polygon* r : rings_of(moved)) curves.emplace_back(r->vertices);
   const RingGeometry geometry = RingGeometry::of_rings(curves);
-  Eigen::Vector2d lo = moved.outer.vertices.front(), hi = lo;
-  for (const auto& v : moved.outer.vertices) lo = lo.cwiseMin(v), hi = hi.cwiseMax(v);
-  const double tol = 1e-9 * (hi - lo).norm();
+  const double tol = 1e-9 * bounding_box_diagonal(moved.outer);
   // Nodes: the patch corners, one per position.
   LayoutMesh m;
   std::map<std::pair<double, double>, int> id;
@@ -226,11 +224,7 @@ MultiPatchResult reparameterize_layout(const PreviousLayout& old, const Domain& 
                        "); map the moved domain from scratch, or move it in smaller steps");
     }
   }
-  {
-    Eigen::Vector2d lo = moved.outer.vertices.front(), hi = lo;
-    for (const auto& v : moved.outer.vertices) lo = lo.cwiseMin(v), hi = hi.cwiseMax(v);
-    R.diameter = (hi - lo).norm();
-  }
+  R.diameter = bounding_box_diagonal(moved.outer);
   R.domain_area = domain_area(R.domain);
   report_step(options.progress, "patches",
               "warm start: " + std::to_string(P) + " patches of the previous layout moved with the domain");
@@ -238,14 +232,9 @@ MultiPatchResult reparameterize_layout(const PreviousLayout& old, const Domain& 
   // The patches, each from its previous map, on `threads` threads.
   std::mutex progress_mutex;
   ParameterizationOptions shared = options;
-  if (options.progress)
-    shared.progress = [cb = options.progress, &progress_mutex](const ProgressEvent& e) {
-      std::lock_guard<std::mutex> lock(progress_mutex);
-      cb(e);
-    };
+  shared.progress = locked_progress(options.progress, progress_mutex);
   std::vector<std::optional<ParameterizationResult>> runs(P);
-  const unsigned threads =
-      multi.threads > 0 ? static_cast<unsigned>(multi.threads) : std::max(1u, std::thread::hardware_concurrency());
+  const unsigned threads = patch_threads(multi.threads);
   for_each_patch(P, threads, [&](std::size_t p) {
     if (on_patch) {
       std::lock_guard<std::mutex> lock(progress_mutex);

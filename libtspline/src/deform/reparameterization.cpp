@@ -101,9 +101,7 @@ ParameterizationResult reparameterize(const TSplineMap& old_map, const Polygon& 
                                                           : warm.map.point(front.mesh.vertex_param(v));
   front.coons = front.optimized;
   front.quality_coons = front.quality_optimized = mesh_quality(front.mesh, front.optimized);
-  Eigen::Vector2d lo = moved.vertices.front(), hi = lo;
-  for (const Eigen::Vector2d& v : moved.vertices) lo = lo.cwiseMin(v), hi = hi.cwiseMax(v);
-  const double diag = (hi - lo).norm();
+  const double diag = bounding_box_diagonal(moved);
   front.tolerance_is_relative = !options.tolerance_absolute.has_value();
   front.tolerance_area =
       options.tolerance_absolute ? *options.tolerance_absolute : options.tolerance_relative * diag * diag;

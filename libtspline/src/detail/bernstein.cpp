@@ -12,11 +12,14 @@ namespace {
 
 constexpr int kMax = BernsteinPoly::kMaxDegree;
 
-// binom(n, k) for n <= 2 kMax (exact in double).
-double binom(int n, int k) {
+static_assert(2 * kMax <= kMaxBinomial, "products of Bernstein polynomials need C(2 kMax, k)");
+
+}  // namespace
+
+double binomial(int n, int k) {
   static const auto table = [] {
-    std::array<std::array<double, 2 * kMax + 1>, 2 * kMax + 1> t{};
-    for (int i = 0; i <= 2 * kMax; ++i) {
+    std::array<std::array<double, kMaxBinomial + 1>, kMaxBinomial + 1> t{};
+    for (int i = 0; i <= kMaxBinomial; ++i) {  // Pascal's triangle
       t[i][0] = t[i][i] = 1.0;
       for (int j = 1; j < i; ++j) t[i][j] = t[i - 1][j - 1] + t[i - 1][j];
     }
@@ -25,8 +28,6 @@ double binom(int n, int k) {
   return table[n][k];
 }
 
-}  // namespace
-
 // Bernstein basis values B_i^deg(s), i = 0..deg.
 void bernstein_values(int deg, double s, double* out) {
   // Powers by repeated multiplication (no pow calls): s^i and r^(deg-i).
@@ -34,7 +35,7 @@ void bernstein_values(int deg, double s, double* out) {
   double sp[kMax + 1], rp[kMax + 1];
   sp[0] = rp[0] = 1.0;
   for (int i = 1; i <= deg; ++i) sp[i] = sp[i - 1] * s, rp[i] = rp[i - 1] * r;
-  for (int i = 0; i <= deg; ++i) out[i] = binom(deg, i) * sp[i] * rp[deg - i];
+  for (int i = 0; i <= deg; ++i) out[i] = binomial(deg, i) * sp[i] * rp[deg - i];
 }
 
 namespace {
@@ -81,16 +82,16 @@ double BernsteinPoly::operator()(double s, double t) const {
   return v;
 }
 
-// With scaled coefficients a_ij binom(m1,i) binom(n1,j) the product is a plain
+// With scaled coefficients a_ij binomial(m1,i) binomial(n1,j) the product is a plain
 // 2-D convolution (the power-basis identity B_i^m1 B_k^m2 =
-// binom(m1,i) binom(m2,k) / binom(m1+m2,i+k) B_{i+k}^{m1+m2}).
+// binomial(m1,i) binomial(m2,k) / binomial(m1+m2,i+k) B_{i+k}^{m1+m2}).
 BernsteinPoly bernstein_product(const BernsteinPoly& a, const BernsteinPoly& b) {
   BernsteinPoly r(a.m + b.m, a.n + b.n);
   double sa[(kMax + 1) * (kMax + 1)], sb[(kMax + 1) * (kMax + 1)];
   for (int j = 0; j <= a.n; ++j)
-    for (int i = 0; i <= a.m; ++i) sa[i + (a.m + 1) * j] = a.at(i, j) * binom(a.m, i) * binom(a.n, j);
+    for (int i = 0; i <= a.m; ++i) sa[i + (a.m + 1) * j] = a.at(i, j) * binomial(a.m, i) * binomial(a.n, j);
   for (int j = 0; j <= b.n; ++j)
-    for (int i = 0; i <= b.m; ++i) sb[i + (b.m + 1) * j] = b.at(i, j) * binom(b.m, i) * binom(b.n, j);
+    for (int i = 0; i <= b.m; ++i) sb[i + (b.m + 1) * j] = b.at(i, j) * binomial(b.m, i) * binomial(b.n, j);
   for (int j1 = 0; j1 <= a.n; ++j1)
     for (int i1 = 0; i1 <= a.m; ++i1) {
       const double x = sa[i1 + (a.m + 1) * j1];
@@ -99,7 +100,7 @@ BernsteinPoly bernstein_product(const BernsteinPoly& a, const BernsteinPoly& b) 
         for (int i2 = 0; i2 <= b.m; ++i2) r.at(i1 + i2, j1 + j2) += x * sb[i2 + (b.m + 1) * j2];
     }
   for (int j = 0; j <= r.n; ++j)
-    for (int i = 0; i <= r.m; ++i) r.at(i, j) /= binom(r.m, i) * binom(r.n, j);
+    for (int i = 0; i <= r.m; ++i) r.at(i, j) /= binomial(r.m, i) * binomial(r.n, j);
   return r;
 }
 

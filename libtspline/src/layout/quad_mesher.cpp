@@ -163,16 +163,21 @@ PlanarQuadMesh quad_mesh_here(const std::vector<std::vector<Eigen::Vector2d>>& r
   return out;
 }
 
-// Whole writes and reads on a pipe.
-bool write_all(int fd, const void* data, std::size_t n) {
-  const char* p = static_cast<const char*>(data);
+// Whole writes and reads on a pipe: `io` (::read or ::write) until n bytes
+// have gone, again after a signal; false at the end of the pipe or an error.
+template <class Byte, class Io>
+bool transfer_all(int fd, Byte* p, std::size_t n, Io io) {
   while (n > 0) {
-    const ssize_t k = ::write(fd, p, n);
+    const ssize_t k = io(fd, p, n);
     if (k < 0 && errno == EINTR) continue;
     if (k <= 0) return false;
     p += k, n -= static_cast<std::size_t>(k);
   }
   return true;
+}
+
+bool write_all(int fd, const void* data, std::size_t n) {
+  return transfer_all(fd, static_cast<const char*>(data), n, ::write);
 }
 
 template <class T>
@@ -181,16 +186,7 @@ bool write_vector(int fd, const std::vector<T>& v) {
   return write_all(fd, &n, sizeof n) && write_all(fd, v.data(), n * sizeof(T));
 }
 
-bool read_all(int fd, void* data, std::size_t n) {
-  char* p = static_cast<char*>(data);
-  while (n > 0) {
-    const ssize_t k = ::read(fd, p, n);
-    if (k < 0 && errno == EINTR) continue;
-    if (k <= 0) return false;
-    p += k, n -= static_cast<std::size_t>(k);
-  }
-  return true;
-}
+bool read_all(int fd, void* data, std::size_t n) { return transfer_all(fd, static_cast<char*>(data), n, ::read); }
 
 template <class T>
 bool read_vector(int fd, std::vector<T>& v) {

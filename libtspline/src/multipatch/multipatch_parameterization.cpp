@@ -15,6 +15,7 @@
 #include "tspline/multipatch/automatic_cuts.h"
 #include "tspline/spline/bezier_extraction.h"
 #include "tspline/boundary/border_knots.h"
+#include "tspline/boundary/polygon_validation.h"
 #include "tspline/errors.h"
 #include "tspline/validity/map_certification.h"
 #include "tspline/validity/map_quality.h"
@@ -81,33 +82,38 @@ bool MultiPatchResult::valid() const {
   return std::all_of(patches.begin(), patches.end(), [](const ParameterizationResult& r) { return r.valid(); });
 }
 
+namespace {
+
+/// The least of value(r) over the patches' results (+infinity for none).
+template <class Value>
+double min_over_patches(const std::vector<ParameterizationResult>& patches, Value value) {
+  double m = std::numeric_limits<double>::infinity();
+  for (const ParameterizationResult& r : patches) m = std::min(m, value(r));
+  return m;
+}
+
+}  // namespace
+
 bool MultiPatchResult::certified_valid() const {
   return std::all_of(patches.begin(), patches.end(),
                      [](const ParameterizationResult& r) { return r.certified_valid(); });
 }
 
 double MultiPatchResult::min_relative_det_bound() const {
-  double m = std::numeric_limits<double>::infinity();
-  for (const auto& r : patches) m = std::min(m, r.certification.min_relative_lower_bound);
-  return m;
+  return min_over_patches(patches,
+                          [](const ParameterizationResult& r) { return r.certification.min_relative_lower_bound; });
 }
 
 double MultiPatchResult::min_mean_ratio_dense() const {
-  double m = std::numeric_limits<double>::infinity();
-  for (const auto& r : patches) m = std::min(m, r.dense_quality.min_mean_ratio);
-  return m;
+  return min_over_patches(patches, [](const ParameterizationResult& r) { return r.dense_quality.min_mean_ratio; });
 }
 
 double MultiPatchResult::min_scaled_jacobian_dense() const {
-  double m = std::numeric_limits<double>::infinity();
-  for (const auto& r : patches) m = std::min(m, r.dense_quality.min_scaled);
-  return m;
+  return min_over_patches(patches, [](const ParameterizationResult& r) { return r.dense_quality.min_scaled; });
 }
 
 double MultiPatchResult::min_mean_ratio_gauss() const {
-  double m = std::numeric_limits<double>::infinity();
-  for (const auto& r : patches) m = std::min(m, r.quality.min_mean_ratio);
-  return m;
+  return min_over_patches(patches, [](const ParameterizationResult& r) { return r.quality.min_mean_ratio; });
 }
 
 namespace {
@@ -213,11 +219,7 @@ MultiPatchResult run_multipatch_parameterization(const Domain& domain, PatchLayo
   R.domain = domain;
   R.layout = std::move(layout);
   R.cuts_explanation = explanation;
-  {
-    Eigen::Vector2d lo = R.domain.outer.vertices.front(), hi = lo;
-    for (const auto& v : R.domain.outer.vertices) lo = lo.cwiseMin(v), hi = hi.cwiseMax(v);
-    R.diameter = (hi - lo).norm();
-  }
+  R.diameter = bounding_box_diagonal(R.domain.outer);
   R.domain_area = domain_area(R.domain);
   const std::size_t P = R.layout.patches.size();
   log("patches: " + std::to_string(P) + " four-sided patches, " + std::to_string(R.layout.cuts.size()) + " cuts (" +
@@ -225,13 +227,8 @@ MultiPatchResult run_multipatch_parameterization(const Domain& domain, PatchLayo
   // Progress events of concurrent patches go through one lock.
   std::mutex progress_mutex;
   ParameterizationOptions shared = options;
-  if (options.progress)
-    shared.progress = [cb = options.progress, &progress_mutex](const ProgressEvent& e) {
-      std::lock_guard<std::mutex> lock(progress_mutex);
-      cb(e);
-    };
-  const unsigned threads =
-      multi.threads > 0 ? static_cast<unsigned>(multi.threads) : std::max(1u, std::thread::hardware_concurrency());
+  shared.progress = locked_progress(options.progress, progress_mutex);
+  const unsigned threads = patch_threads(multi.threads);
 
   std::vector<BorderParams> required(P);
   std::vector<char> stale(P, 1);
@@ -316,6 +313,18 @@ void for_each_patch(std::size_t n, unsigned threads, const std::function<void(st
     for (std::thread& t : pool) t.join();
   }
   if (error) std::rethrow_exception(error);
+}
+
+unsigned patch_threads(int requested) {
+  return requested > 0 ? static_cast<unsigned>(requested) : std::max(1u, std::thread::hardware_concurrency());
+}
+
+ProgressCallback locked_progress(const ProgressCallback& progress, std::mutex& lock) {
+  if (!progress) return {};
+  return [progress, &lock](const ProgressEvent& e) {
+    std::lock_guard<std::mutex> hold(lock);
+    progress(e);
+  };
 }
 
 ProgressCallback patch_progress(const ProgressCallback& progress, std::size_t p) {

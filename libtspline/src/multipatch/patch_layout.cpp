@@ -26,11 +26,7 @@ using CSegment = K::Segment_2;
 const Polygon& ring(const Domain& d, std::size_t r) { return r == 0 ? d.outer : d.holes[r - 1]; }
 std::size_t ring_count(const Domain& d) { return d.holes.size() + 1; }
 
-double diameter(const Domain& d) {
-  Eigen::Vector2d lo = d.outer.vertices.front(), hi = lo;
-  for (const auto& v : d.outer.vertices) lo = lo.cwiseMin(v), hi = hi.cwiseMax(v);
-  return (hi - lo).norm();
-}
+double diameter(const Domain& d) { return bounding_box_diagonal(d.outer); }
 
 double snap_tolerance(const Domain& d) { return 1e-9 * diameter(d); }
 

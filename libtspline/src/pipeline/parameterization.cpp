@@ -86,11 +86,6 @@ void refine_below(TMesh& mesh, int level) {
   }
 }
 
-double bbox_diagonal(const Polygon& p) {
-  Eigen::Vector2d lo = p.vertices.front(), hi = p.vertices.front();
-  for (const auto& v : p.vertices) lo = lo.cwiseMin(v), hi = hi.cwiseMax(v);
-  return (hi - lo).norm();
-}
 
 // Runs body(0), ..., body(n - 1) on up to hardware_concurrency threads; the
 // first exception thrown by a body is rethrown here once the running bodies
@@ -131,7 +126,7 @@ FrontResult optimize_front(BoundaryMap boundary, const ParameterizationOptions& 
   StageClock clock(r.times);
 
   r.tolerance_is_relative = !opt.tolerance_absolute.has_value();
-  const double diag = bbox_diagonal(r.boundary.polygon());
+  const double diag = bounding_box_diagonal(r.boundary.polygon());
   r.tolerance_area = opt.tolerance_absolute ? *opt.tolerance_absolute : opt.tolerance_relative * diag * diag;
 
   meshopt::SmoothingOptions sopt = opt.smoothing;
@@ -319,7 +314,7 @@ FrontResult run_front(const Polygon& input, const ParameterizationOptions& opt) 
       // than the default 1e-5 diag^2): for the default options that is the run
       // itself; for fine user settings it keeps the trials cheap.
       topt.initial_level = std::min(opt.initial_level, 5);
-      const double d = bbox_diagonal(poly);
+      const double d = bounding_box_diagonal(poly);
       const double tol = opt.tolerance_absolute ? *opt.tolerance_absolute : opt.tolerance_relative * d * d;
       topt.tolerance_absolute = std::max(tol, 1e-5 * d * d);
       trial_is_run = topt.initial_level == opt.initial_level && *topt.tolerance_absolute == tol;

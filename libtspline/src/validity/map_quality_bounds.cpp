@@ -20,6 +20,8 @@ namespace tspline {
 namespace {
 
 using detail::BernsteinPoly;
+using detail::binomial;
+using detail::kMaxBinomial;
 using detail::bernstein_axpy;
 using detail::bernstein_ds;
 using detail::bernstein_dt;
@@ -55,17 +57,7 @@ struct Poly12 {
   int size() const { return (m + 1) * (n + 1); }
 };
 
-double binom24(int n, int k) {
-  static const auto table = [] {
-    std::array<std::array<double, 2 * kQ + 1>, 2 * kQ + 1> t{};
-    for (int i = 0; i <= 2 * kQ; ++i) {
-      t[i][0] = t[i][i] = 1.0;
-      for (int j = 1; j < i; ++j) t[i][j] = t[i - 1][j - 1] + t[i - 1][j];
-    }
-    return t;
-  }();
-  return table[n][k];
-}
+static_assert(2 * kQ <= kMaxBinomial, "products of degree-kQ polynomials need C(2 kQ, k)");
 
 Poly12 to_poly12(const BernsteinPoly& p) {
   Poly12 r(p.m, p.n);
@@ -79,9 +71,9 @@ Poly12 product12(const Poly12& a, const Poly12& b) {
   // Scaled coefficients a_ij binom(m, i) binom(n, j): the product is a plain convolution.
   std::array<double, (kQ + 1) * (kQ + 1)> sa{}, sb{};
   for (int j = 0; j <= a.n; ++j)
-    for (int i = 0; i <= a.m; ++i) sa[i + (a.m + 1) * j] = a.at(i, j) * binom24(a.m, i) * binom24(a.n, j);
+    for (int i = 0; i <= a.m; ++i) sa[i + (a.m + 1) * j] = a.at(i, j) * binomial(a.m, i) * binomial(a.n, j);
   for (int j = 0; j <= b.n; ++j)
-    for (int i = 0; i <= b.m; ++i) sb[i + (b.m + 1) * j] = b.at(i, j) * binom24(b.m, i) * binom24(b.n, j);
+    for (int i = 0; i <= b.m; ++i) sb[i + (b.m + 1) * j] = b.at(i, j) * binomial(b.m, i) * binomial(b.n, j);
   const int rs = r.m + 1, bs = b.m + 1;
   for (int j1 = 0; j1 <= a.n; ++j1)
     for (int i1 = 0; i1 <= a.m; ++i1) {
@@ -94,7 +86,7 @@ Poly12 product12(const Poly12& a, const Poly12& b) {
       }
     }
   for (int j = 0; j <= r.n; ++j)
-    for (int i = 0; i <= r.m; ++i) r.at(i, j) /= binom24(r.m, i) * binom24(r.n, j);
+    for (int i = 0; i <= r.m; ++i) r.at(i, j) /= binomial(r.m, i) * binomial(r.n, j);
   return r;
 }
 

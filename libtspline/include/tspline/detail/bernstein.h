@@ -41,4 +41,9 @@ std::array<BernsteinPoly, 4> bernstein_subdivide(const BernsteinPoly& p);
 /// The Bernstein basis values B_i^deg(s), i = 0..deg (deg <= BernsteinPoly::kMaxDegree), into out[0..deg].
 void bernstein_values(int deg, double s, double* out);
 
+/// The binomial coefficient C(n, k), 0 <= k <= n <= kMaxBinomial, from a table
+/// (every such C(n, k) is below 2^53, so exact in double).
+inline constexpr int kMaxBinomial = 24;
+double binomial(int n, int k);
+
 }  // namespace tspline::detail

@@ -12,6 +12,7 @@
 // two images of an interface agree to round-off.
 #include <Eigen/Core>
 #include <functional>
+#include <mutex>
 #include <optional>
 #include <string>
 #include <vector>
@@ -77,6 +78,12 @@ using PatchCallback = std::function<void(std::size_t patch, int round)>;
 /// (each patch run uses the process's pool inside), each taking the next i;
 /// after the first exception no task starts, and it is rethrown here.
 void for_each_patch(std::size_t n, unsigned threads, const std::function<void(std::size_t)>& task);
+
+/// The threads for the patches: `requested` if > 0, else the hardware's.
+unsigned patch_threads(int requested);
+
+/// `progress` called under `lock` (progress events of concurrent patches), empty if progress is.
+ProgressCallback locked_progress(const ProgressCallback& progress, std::mutex& lock);
 
 /// The progress callback of patch p: `progress` with "patch p: " before each text (empty if progress is).
 ProgressCallback patch_progress(const ProgressCallback& progress, std::size_t p);
