@@ -39,6 +39,7 @@
 #include "petsc_session.h"
 #include "tspline/petsc_solver.h"
 #include "tspline/analysis/poisson.h"
+#include "toolkit/timing.h"
 
 namespace tspline_app {
 
@@ -48,9 +49,7 @@ namespace fs = std::filesystem;
 using nlohmann::json;
 using Clock = std::chrono::steady_clock;
 
-double seconds_since(Clock::time_point t0) {
-  return std::chrono::duration<double>(Clock::now() - t0).count();
-}
+using toolkit::seconds_since;
 
 /// A number for messages (10 significant digits).
 std::string fmt(double v) {

@@ -19,12 +19,13 @@
 #include "toolkit/errors.h"
 #include "toolkit/io/atomic_file.h"
 #include "toolkit/io/vtu_writer.h"
+#include "toolkit/timing.h"
 
 namespace meshopt_app {
 namespace {
 
-using Clock = std::chrono::steady_clock;
-double since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+using toolkit::Clock;
+constexpr auto since = toolkit::seconds_since;
 
 constexpr double kDegree = std::numbers::pi / 180.0;
 

@@ -15,6 +15,7 @@
 #include "toolkit/errors.h"
 #include "toolkit/io/atomic_file.h"
 #include "toolkit/io/vtu_writer.h"
+#include "toolkit/timing.h"
 
 namespace meshopt_app {
 namespace {
@@ -85,7 +86,7 @@ nlohmann::json smooth_model(const SmoothArgs& a, const SweepProgress& on_sweep) 
   const ElementQualities before = meshopt::surface_mesh_quality(g.mesh, measure, opt.size);
   const auto t0 = std::chrono::steady_clock::now();
   const meshopt::SurfaceSmoothingReport rep = meshopt::smooth_surface(g.mesh, opt);
-  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  const double seconds = toolkit::seconds_since(t0);
   const ElementQualities after = meshopt::surface_mesh_quality(g.mesh, measure, opt.size);
 
   meshopt::gmsh_io::write_mesh(a.out, g);

@@ -13,6 +13,7 @@
 #include "tspline/io/output_files.h"
 #include "tspline/io/param_output.h"
 #include "tspline/io/polygon_reader.h"
+#include "toolkit/timing.h"
 
 namespace tspline_app {
 namespace {
@@ -208,7 +209,7 @@ ParamRun run_param(tspline::io::DomainInput domain, std::string source, const Pa
       hooks.on_patch);
   }
   if (run.result.patches) run.iterations.clear();  // adapt.pvd is written for a single patch only
-  run.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  run.seconds = toolkit::seconds_since(started);
   run.report = run.result.patches ? multipatch_report(run) : single_report(run);
   return run;
 }

@@ -9,12 +9,12 @@
 
 #include "tspline/io/polygon_reader.h"
 #include "tspline/pipeline/parameterization.h"
+#include "toolkit/timing.h"
 
 namespace bench {
 
-inline double since(std::chrono::steady_clock::time_point t) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
-}
+using since_t = double (*)(toolkit::Clock::time_point);
+inline constexpr since_t since = toolkit::seconds_since;
 
 /// The front half for POLYGON INIT_LEVEL [TOL_REL = 1e-6]; empty (after a usage
 /// line on stderr) if the arguments are missing.

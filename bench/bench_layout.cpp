@@ -9,6 +9,7 @@
 #include "tspline/errors.h"
 #include "tspline/io/gis_reader.h"
 #include "tspline/layout/quad_layout.h"
+#include "toolkit/timing.h"
 
 int main(int argc, char** argv) {
   std::cout << std::setprecision(4);
@@ -18,7 +19,7 @@ int main(int argc, char** argv) {
       const tspline::Domain d = tspline::validate_domain({in.outer, in.holes});
       const auto t0 = std::chrono::steady_clock::now();
       const tspline::QuadLayout L = tspline::build_quad_layout(d);
-      const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+      const double s = toolkit::seconds_since(t0);
       std::cout << argv[i] << ": holes " << d.holes.size() << ", " << L.explanation() << ", repairs "
                 << L.stats.repair_rounds << ", " << s << " s" << std::endl;
       // Patch corners of (nearly) 180 degrees or more: no map can be valid there.

@@ -22,12 +22,11 @@
 #include "tspline/deform/reparameterization.h"
 #include "tspline/pipeline/domain_parameterization.h"
 #include "tspline/io/polygon_reader.h"
+#include "toolkit/timing.h"
 
 namespace {
 
-double seconds_since(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-}
+using toolkit::seconds_since;
 
 bool same_tmesh(const tspline::TMesh& a, const tspline::TMesh& b) {
   if (a.num_cells() != b.num_cells()) return false;

@@ -36,13 +36,12 @@
 #include "tspline/petsc_solver.h"
 #include "tspline/analysis/poisson.h"
 #include "tspline/io/multipatch_file.h"
+#include "toolkit/timing.h"
 
 namespace {
 
 using Clock = std::chrono::steady_clock;
-double seconds_since(Clock::time_point t0) {
-  return std::chrono::duration<double>(Clock::now() - t0).count();
-}
+using toolkit::seconds_since;
 
 /// The identity on [0,1]^2 as a T-spline map on a uniform T-mesh (Greville control points).
 tspline::TSplineMap identity_map(int level) {

@@ -32,6 +32,7 @@
 #include "meshopt/gmsh/gmsh_remesh_model.h"
 #include "meshopt/remesh.h"
 #include "meshopt/remesh_statistics.h"
+#include "toolkit/timing.h"
 
 namespace {
 
@@ -136,7 +137,7 @@ int main(int argc, char** argv) {
   opt.max_deviation = cap;
   const auto t0 = std::chrono::steady_clock::now();
   meshopt::remesh(m, g, opt);
-  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  const double seconds = toolkit::seconds_since(t0);
   const double target = max_deviation(m, g);
   std::printf("remesh: L %g s %g D %g triangles %zu deviation %.4g seconds %.1f\n", length, s, cap, m.live_triangles(),
               target, seconds);

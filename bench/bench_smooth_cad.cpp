@@ -18,6 +18,7 @@
 #include "cad_fixtures.h"
 #include "meshopt/gmsh/gmsh_mesh.h"
 #include "meshopt/surface_smoother.h"
+#include "toolkit/timing.h"
 
 
 int main(int argc, char** argv) {
@@ -48,7 +49,7 @@ int main(int argc, char** argv) {
   meshopt::SurfaceSmoothingOptions opt;
   const auto t0 = std::chrono::steady_clock::now();
   const meshopt::SurfaceSmoothingReport rep = meshopt::smooth_surface(g.mesh, opt);
-  const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  const double s = toolkit::seconds_since(t0);
   const meshopt::ElementQualities after = meshopt::surface_mesh_quality(g.mesh, meshopt::SurfaceMeasure::shape);
   std::printf("%9zu %10zu %8zu %6d %11zu %8.3f %12.0f %8zu %6.3f\n", g.mesh.elements.size(), free_nodes,
               rep.tangled_before, rep.sweeps, rep.node_visits, s, static_cast<double>(rep.node_visits) / s,

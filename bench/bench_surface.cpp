@@ -13,6 +13,7 @@
 #include <random>
 
 #include "meshopt/surface_smoother.h"
+#include "toolkit/timing.h"
 
 namespace {
 
@@ -83,7 +84,7 @@ int main(int argc, char** argv) {
   const auto before = meshopt::surface_mesh_quality(m, meshopt::SurfaceMeasure::shape);
   const auto t0 = std::chrono::steady_clock::now();
   const auto rep = meshopt::smooth_surface(m, opt);
-  const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  const double s = toolkit::seconds_since(t0);
   const auto after = meshopt::surface_mesh_quality(m, meshopt::SurfaceMeasure::shape);
   std::printf("%8zu %9zu %8zu %6d %12.4f %14.0f %8zu %6.3f\n", m.x.size(), m.elements.size(), before.tangled,
               rep.sweeps, s / rep.sweeps, static_cast<double>(rep.node_visits) / s, after.tangled, after.min);

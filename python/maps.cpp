@@ -76,9 +76,16 @@ Map map_of_run(std::shared_ptr<const tspline_app::ParamRun> run) {
   return m;
 }
 
-Map parameterize(const py::object& domain, const py::kwargs& kwargs) {
+namespace {
+
+// One run of `tspline param` from Python: the keywords read through the
+// option table, the domain converted, the run without the GIL (other Python
+// threads go on; Ctrl-C still stops it), from `previous` if given.
+Map run_from_python(const py::object& domain, const py::kwargs& kwargs,
+                    std::optional<tspline_app::PreviousMap> previous) {
   std::optional<std::string> crs;
   tspline_app::ParamSettings settings = settings_from_keywords(kwargs, &crs);
+  if (previous && !settings.from_file.empty()) throw tspline::InputError("deform: 'from' is this map");
   settings.domain.crs = crs;
   const auto started = std::chrono::steady_clock::now();
   DomainArgument in = domain_from_python(domain, settings.domain);
@@ -88,7 +95,7 @@ Map parameterize(const py::object& domain, const py::kwargs& kwargs) {
   {
     py::gil_scoped_release release;
     run = std::make_shared<tspline_app::ParamRun>(
-        tspline_app::run_param(std::move(in.domain), in.source, settings, hooks, started));
+        tspline_app::run_param(std::move(in.domain), in.source, settings, hooks, started, std::move(previous)));
   }
   return map_of_run(std::move(run));
 }
@@ -107,23 +114,14 @@ tspline_app::PreviousMap previous_of(const Map& m) {
   return prev;
 }
 
+}  // namespace
+
+Map parameterize(const py::object& domain, const py::kwargs& kwargs) {
+  return run_from_python(domain, kwargs, std::nullopt);
+}
+
 Map deform(const Map& m, const py::object& domain, const py::kwargs& kwargs) {
-  std::optional<std::string> crs;
-  tspline_app::ParamSettings settings = settings_from_keywords(kwargs, &crs);
-  if (!settings.from_file.empty()) throw tspline::InputError("deform: 'from' is this map");
-  settings.domain.crs = crs;
-  const auto started = std::chrono::steady_clock::now();
-  DomainArgument in = domain_from_python(domain, settings.domain);
-  tspline_app::ParamHooks hooks;
-  hooks.progress = interruptible();
-  std::shared_ptr<tspline_app::ParamRun> run;
-  {
-    py::gil_scoped_release release;
-    run = std::make_shared<tspline_app::ParamRun>(tspline_app::run_param(
-        std::move(in.domain), in.source, settings, hooks, started,
-        previous_of(m)));
-  }
-  return map_of_run(std::move(run));
+  return run_from_python(domain, kwargs, previous_of(m));
 }
 
 Map load(const py::object& path_obj) {

@@ -9,15 +9,14 @@
 
 #include "remesher.h"
 #include "toolkit/errors.h"
+#include "toolkit/timing.h"
 
 namespace meshopt {
 namespace {
 
 using detail::Remesher;
 
-double seconds_since(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-}
+using toolkit::seconds_since;
 
 void validate(const RemeshOptions& o) {
   auto bad = [](const std::string& what) { throw toolkit::InputError("meshopt::remesh: " + what); };

@@ -19,6 +19,7 @@
 #include "meshopt/flip_energy.h"
 #include "meshopt/gmsh/gmsh_mesh.h"
 #include "meshopt/remesh_statistics.h"
+#include "toolkit/union_find.h"
 
 namespace meshopt::gmsh_io {
 namespace {
@@ -82,10 +83,6 @@ Eigen::Vector2d uv_of_boundary_point(const GmshFace& face, int dim, int tag, dou
   return closest_point(2, face.tag(), x).second;
 }
 
-int find_root(std::vector<int>& parent, int i) {
-  while (parent[i] != i) i = parent[i] = parent[parent[i]];
-  return i;
-}
 
 /// +1 if Gmsh's triangles of `face` turn counter-clockwise about phi_u x phi_v, -1 if clockwise.
 int face_orientation(const GmshFace& face) {
@@ -169,8 +166,7 @@ CadFeatures detect_features(double feature_angle) {
   // Dihedral angle across each curve: the largest angle between the oriented face
   // normals at points along it. Features: sharp curves, curves of one face side
   // (boundaries), non-manifold curves.
-  std::vector<int> parent(face_tags.size());
-  std::iota(parent.begin(), parent.end(), 0);
+  toolkit::UnionFind smoothly_joined(face_tags.size());
   auto index_of = [&](int tag) {
     return static_cast<int>(std::lower_bound(face_tags.begin(), face_tags.end(), tag) - face_tags.begin());
   };
@@ -208,7 +204,7 @@ CadFeatures detect_features(double feature_angle) {
     if (fs.size() != 2 || dihedral > feature_angle) {
       f.feature_curves.push_back(curve);
     } else if (fs[0] != fs[1]) {
-      parent[find_root(parent, index_of(fs[0]))] = find_root(parent, index_of(fs[1]));
+      smoothly_joined.unite(static_cast<std::size_t>(index_of(fs[0])), static_cast<std::size_t>(index_of(fs[1])));
     }
   }
   std::sort(f.feature_curves.begin(), f.feature_curves.end());
@@ -222,7 +218,7 @@ CadFeatures detect_features(double feature_angle) {
   }
   std::map<int, int> patch_of_root;
   for (std::size_t i = 0; i < face_tags.size(); ++i) {
-    const int root = find_root(parent, static_cast<int>(i));
+    const int root = static_cast<int>(smoothly_joined.find(i));
     const auto [it, inserted] = patch_of_root.emplace(root, static_cast<int>(f.patch_faces.size()));
     if (inserted) f.patch_faces.emplace_back();
     f.patch_faces[it->second].push_back(face_tags[i]);

@@ -1,4 +1,5 @@
 // The glued analysis space of a map of 1..n patches (see analysis_space.h).
+#include "toolkit/union_find.h"
 #include "tspline/analysis/analysis_space.h"
 
 #include <algorithm>
@@ -20,15 +21,7 @@ namespace {
 // Index range of a level-l function along a side: [0, 2^l + 2].
 std::int64_t last_index(int level) { return (std::int64_t{1} << level) + 2; }
 
-struct UnionFind {
-  std::vector<int> parent;
-  explicit UnionFind(std::size_t n) : parent(n) { std::iota(parent.begin(), parent.end(), 0); }
-  int find(int x) {
-    while (parent[x] != x) x = parent[x] = parent[parent[x]];
-    return x;
-  }
-  void unite(int a, int b) { parent[find(a)] = find(b); }
-};
+using toolkit::UnionFind;
 
 }  // namespace
 
@@ -149,7 +142,7 @@ std::vector<std::vector<std::size_t>> patch_neighbours(std::size_t P, const std:
     corners.unite(static_cast<int>(4 * f.patch_a + f.side_a), static_cast<int>(4 * f.patch_b + (f.side_b + 1) % 4));
     corners.unite(static_cast<int>(4 * f.patch_a + (f.side_a + 1) % 4), static_cast<int>(4 * f.patch_b + f.side_b));
   }
-  std::map<int, std::vector<std::size_t>> at_node;
+  std::map<std::size_t, std::vector<std::size_t>> at_node;
   for (std::size_t p = 0; p < P; ++p)
     for (int k = 0; k < 4; ++k) at_node[corners.find(static_cast<int>(4 * p + k))].push_back(p);
   std::vector<std::vector<std::size_t>> out(P);
@@ -249,7 +242,7 @@ AnalysisSpace::AnalysisSpace(AnalysisGeometry geometry, std::vector<TMesh> meshe
   for (std::size_t p = 0; p < P; ++p) {
     dofs_[p].resize(offset[p + 1] - offset[p]);
     for (std::size_t a = 0; a < dofs_[p].size(); ++a) {
-      const int r = uf.find(static_cast<int>(offset[p] + a));
+      const std::size_t r = uf.find(offset[p] + a);
       if (root_id[r] < 0) root_id[r] = n++;
       dofs_[p][a] = root_id[r];
     }

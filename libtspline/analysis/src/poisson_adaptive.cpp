@@ -6,13 +6,14 @@
 #include <cmath>
 
 #include "tspline/errors.h"
+#include "toolkit/timing.h"
 
 namespace tspline {
 
 namespace {
 
-using Clock = std::chrono::steady_clock;
-double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+using toolkit::Clock;
+using toolkit::seconds_since;
 
 }  // namespace
 

@@ -22,13 +22,14 @@
 #include "cell_tabulation.h"
 
 #include <Eigen/CholmodSupport>
+#include "toolkit/timing.h"
 
 namespace tspline {
 
 namespace {
 
-using Clock = std::chrono::steady_clock;
-double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+using toolkit::Clock;
+using toolkit::seconds_since;
 
 std::string at(double x, double y) {
   std::ostringstream s;

@@ -20,6 +20,7 @@
 
 #include "tspline/errors.h"
 #include "tspline/io/polygon_reader.h"
+#include "tspline/boundary/plane.h"
 
 namespace tspline::io {
 namespace {
@@ -90,15 +91,7 @@ void collect(const OGRGeometry* g, std::size_t feature, std::vector<RawPolygon>&
   }
 }
 
-double signed_area(const Ring& r) {
-  double a = 0.0;
-  for (std::size_t i = 0; i < r.size(); ++i) {
-    const Eigen::Vector2d& p = r[i];
-    const Eigen::Vector2d& q = r[(i + 1) % r.size()];
-    a += p.x() * q.y() - q.x() * p.y();
-  }
-  return 0.5 * a;
-}
+using tspline::signed_area;  // of a Ring
 
 /// Area centroid of a ring (its vertex mean if degenerate).
 Eigen::Vector2d centroid(const Ring& r) {

@@ -14,6 +14,7 @@
 #include "tspline/spline/bezier_extraction.h"
 #include "toolkit/io/atomic_file.h"
 #include "toolkit/errors.h"
+#include "toolkit/union_find.h"
 
 namespace tspline::io {
 
@@ -109,12 +110,7 @@ std::string msh_document(const std::vector<const TSplineMap*>& maps, const std::
   // interface are one node (also where several patches meet at a point).
   std::vector<std::size_t> offset(P + 1, 0);
   for (std::size_t p = 0; p < P; ++p) offset[p + 1] = offset[p] + patches[p].keys.size();
-  std::vector<std::size_t> parent(offset[P]);
-  for (std::size_t i = 0; i < parent.size(); ++i) parent[i] = i;
-  auto find = [&](std::size_t i) {
-    while (parent[i] != i) i = parent[i] = parent[parent[i]];
-    return i;
-  };
+  toolkit::UnionFind same_node(offset[P]);  // the root is the first occurrence
   for (const Interface& f : interfaces) {
     const PatchNodes& a = patches[f.patch_a];
     const PatchNodes& b = patches[f.patch_b];
@@ -123,26 +119,25 @@ std::string msh_document(const std::vector<const TSplineMap*>& maps, const std::
       if (t < 0) continue;
       const auto it = b.index.find(side_key(f.side_b, kSideKeys - t));
       if (it == b.index.end()) continue;
-      const std::size_t x = find(offset[f.patch_a] + i), y = find(offset[f.patch_b] + it->second);
-      if (x != y) parent[std::max(x, y)] = std::min(x, y);  // the root is the first occurrence
+      same_node.unite(offset[f.patch_a] + i, offset[f.patch_b] + it->second);
     }
   }
   // Node tags in order of first occurrence (patch by patch), each node on the
   // entity of its first patch.
-  std::vector<std::size_t> tag(parent.size(), 0);
+  std::vector<std::size_t> tag(same_node.size(), 0);
   std::vector<std::vector<std::size_t>> block_tags(P);
   std::vector<std::vector<Eigen::Vector2d>> block_points(P);
   std::size_t n = 0;
   for (std::size_t p = 0; p < P; ++p)
     for (std::size_t i = 0; i < patches[p].keys.size(); ++i) {
-      const std::size_t g = offset[p] + i, r = find(g);
+      const std::size_t g = offset[p] + i, r = same_node.find(g);
       if (r != g) continue;
       tag[g] = ++n;
       const Key& k = patches[p].keys[i];
       block_tags[p].push_back(n);
       block_points[p].push_back(maps[p]->point({key_coordinate(k.first), key_coordinate(k.second)}));
     }
-  for (std::size_t g = 0; g < parent.size(); ++g) tag[g] = tag[find(g)];
+  for (std::size_t g = 0; g < same_node.size(); ++g) tag[g] = tag[same_node.find(g)];
   std::size_t m = 0;
   for (const PatchNodes& q : patches) m += q.elements.size();
 

@@ -14,6 +14,7 @@
 #include "tspline/io/convergence_plot.h"
 #include "tspline/io/multipatch_output.h"
 #include "tspline/io/output_files.h"
+#include "toolkit/timing.h"
 
 namespace tspline::io {
 
@@ -148,7 +149,7 @@ json PoissonOutputWriter::add_step(const PoissonStep& st, const PoissonSolution&
   }
   steps_.push_back(st);
   peak_total_.push_back(std::accumulate(peak_mib.begin(), peak_mib.end(), 0.0));
-  rec["output_seconds"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  rec["output_seconds"] = toolkit::seconds_since(t0);
   report_["steps"].push_back(rec);
   write_tables(false);
   return rec;

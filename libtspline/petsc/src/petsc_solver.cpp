@@ -18,13 +18,14 @@
 #include <string>
 
 #include "tspline/errors.h"
+#include "toolkit/timing.h"
 
 namespace tspline::petsc {
 
 namespace {
 
-using Clock = std::chrono::steady_clock;
-double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+using toolkit::Clock;
+using toolkit::seconds_since;
 
 /// Turns a PETSc error code into a NumericalError with PETSc's message.
 void check(PetscErrorCode ierr, const char* what) {

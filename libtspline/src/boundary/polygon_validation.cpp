@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "tspline/errors.h"
+#include "tspline/boundary/plane.h"
 
 namespace tspline {
 namespace {
@@ -113,19 +114,7 @@ void check_polygon_scale(const Polygon& p) {
   }
 }
 
-double signed_area(const Polygon& p) {
-  const std::size_t n = p.vertices.size();
-  if (n < 3) return 0.0;
-  // Shoelace formula relative to the first vertex (reduces cancellation for
-  // polygons far from the origin, e.g. projected coastline coordinates).
-  const Eigen::Vector2d o = p.vertices[0];
-  double twice = 0.0;
-  for (std::size_t i = 1; i + 1 < n; ++i) {
-    const Eigen::Vector2d a = p.vertices[i] - o, b = p.vertices[i + 1] - o;
-    twice += a.x() * b.y() - a.y() * b.x();
-  }
-  return 0.5 * twice;
-}
+double signed_area(const Polygon& p) { return signed_area(p.vertices); }
 
 Polygon validate_polygon(Polygon p, std::size_t min_vertices) {
   const std::size_t n = p.vertices.size();

@@ -14,6 +14,7 @@
 #include "tspline/spline/bezier_extraction.h"
 #include "tspline/tmesh/mesh_quality.h"
 #include "tspline/validity/map_quality.h"
+#include "toolkit/timing.h"
 
 namespace tspline {
 
@@ -105,7 +106,7 @@ ParameterizationResult reparameterize(const TSplineMap& old_map, const Polygon& 
   front.tolerance_is_relative = !options.tolerance_absolute.has_value();
   front.tolerance_area =
       options.tolerance_absolute ? *options.tolerance_absolute : options.tolerance_relative * diag * diag;
-  const double warm_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  const double warm_seconds = toolkit::seconds_since(t0);
   front.times.push_back({"warm_start", warm_seconds});
   {
     std::string text = "warm start: " + std::to_string(moved.vertices.size()) +

@@ -4,11 +4,11 @@
 #include <cmath>
 #include <limits>
 #include <numbers>
+#include "tspline/boundary/plane.h"
 
 namespace tspline {
 namespace {
 
-double cross(const Eigen::Vector2d& a, const Eigen::Vector2d& b) { return a.x() * b.y() - a.y() * b.x(); }
 
 // x^p, by multiplication for the powers used (std::pow was a seventh of the layout's time).
 double power(double x, double p) {

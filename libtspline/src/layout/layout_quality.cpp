@@ -3,11 +3,11 @@
 #include <algorithm>
 #include <cmath>
 #include <numbers>
+#include "tspline/boundary/plane.h"
 
 namespace tspline {
 namespace {
 
-double cross(const Eigen::Vector2d& a, const Eigen::Vector2d& b) { return a.x() * b.y() - a.y() * b.x(); }
 
 // Arc length from a to b going in direction dir on a ring of length L, in [0, L).
 double arc_between(double a, double b, double dir, double L) {

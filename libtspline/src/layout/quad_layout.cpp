@@ -17,11 +17,12 @@
 #include "tspline/layout/layout_topology.h"
 #include "tspline/layout/quad_mesher.h"
 #include "tspline/layout/ring_geometry.h"
+#include "toolkit/timing.h"
+#include "tspline/boundary/plane.h"
 
 namespace tspline {
 namespace {
 
-double cross(const Eigen::Vector2d& a, const Eigen::Vector2d& b) { return a.x() * b.y() - a.y() * b.x(); }
 
 // The piece (index into nodes) of ring arc length s.
 std::size_t piece_of(const std::vector<double>& nodes, double s) {
@@ -364,7 +365,7 @@ QuadLayout build_quad_layout(const Domain& d, const QuadLayoutOptions& o) {
     if (debugging())
       std::fprintf(stderr, "layout round %d: mesh %zu quads at %.2f s, optimized in %.2f s\n", round, m.quads.size(),
                    std::chrono::duration<double>(t_opt - t0).count(),
-                   std::chrono::duration<double>(std::chrono::steady_clock::now() - t_opt).count());
+                   toolkit::seconds_since(t_opt));
 
     // Checks on the true geometry: inner nodes inside, cuts off the rings. The
     // nodes involved in a violation go back where the mesher put them (with the
@@ -497,7 +498,7 @@ QuadLayout build_quad_layout(const Domain& d, const QuadLayoutOptions& o) {
     const LayoutCornerQuality w = worst_layout_quality(m, t, quality);
     st.corner_mean_ratio = w.mean_ratio;
     st.corner_scaled_jacobian = w.scaled_jacobian;
-    st.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    st.seconds = toolkit::seconds_since(t0);
     return out;
   }
 }

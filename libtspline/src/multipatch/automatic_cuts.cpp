@@ -9,13 +9,14 @@
 #include <sstream>
 
 #include "tspline/errors.h"
+#include "toolkit/union_find.h"
+#include "tspline/boundary/plane.h"
 
 namespace tspline {
 namespace {
 
 constexpr double kPi = std::numbers::pi;
 
-double cross(const Eigen::Vector2d& a, const Eigen::Vector2d& b) { return a.x() * b.y() - a.y() * b.x(); }
 
 // Angle from direction b counter-clockwise to direction a, in [0, 2 pi).
 double ccw_angle(const Eigen::Vector2d& b, const Eigen::Vector2d& a) {
@@ -301,13 +302,9 @@ std::optional<std::vector<Cut>> variant(const Context& cx, const std::vector<std
     }
   }
   // Join every hole to the outer ring (union-find over rings).
-  std::vector<std::size_t> parent(rings);
-  std::iota(parent.begin(), parent.end(), 0);
-  auto find = [&](std::size_t x) {
-    while (parent[x] != x) x = parent[x] = parent[parent[x]];
-    return x;
-  };
-  for (const Candidate& c : chosen) parent[find(c.ring_p)] = find(c.ring_q);
+  toolkit::UnionFind joined(rings);
+  auto find = [&](std::size_t x) { return joined.find(x); };
+  for (const Candidate& c : chosen) joined.unite(c.ring_p, c.ring_q);
   for (bool again = true; again;) {
     again = false;
     const Candidate* best = nullptr;
@@ -318,7 +315,7 @@ std::optional<std::vector<Cut>> variant(const Context& cx, const std::vector<std
           best = &c;
     if (best) {
       accept(*best);
-      parent[find(best->ring_p)] = find(best->ring_q);
+      joined.unite(best->ring_p, best->ring_q);
       again = true;
     }
   }

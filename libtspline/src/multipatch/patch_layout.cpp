@@ -15,6 +15,7 @@
 
 #include "tspline/errors.h"
 #include "tspline/boundary/polygon_validation.h"
+#include "tspline/boundary/plane.h"
 
 namespace tspline {
 namespace {
@@ -206,7 +207,6 @@ std::vector<std::pair<LayoutFace, std::vector<int>>> faces_with_ids(const Domain
   return out;
 }
 
-double cross(const Eigen::Vector2d& a, const Eigen::Vector2d& b) { return a.x() * b.y() - a.y() * b.x(); }
 
 // Interior angle (radians) of a CCW polygon at vertex i.
 double inner_angle(const std::vector<Eigen::Vector2d>& p, std::size_t i) {

@@ -12,14 +12,13 @@
 #include "tspline/spline/bezier_extraction.h"
 #include "tspline/validity/boundary_curve.h"
 #include "tspline/tmesh/mesh_quality.h"
+#include "toolkit/timing.h"
 
 namespace tspline {
 
 namespace {
 
-double seconds_since(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-}
+using toolkit::seconds_since;
 
 // Step 2: det J at the corners of the square is the cross product of the two
 // boundary tangents, decided by the border control points alone.

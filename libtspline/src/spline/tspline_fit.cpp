@@ -8,6 +8,7 @@
 #include "meshopt/node_smoother.h"
 #include "meshopt/triangle_measure.h"
 #include "tspline/errors.h"
+#include "toolkit/timing.h"
 
 namespace tspline {
 
@@ -172,7 +173,7 @@ void solve_interpolation(TSplineMap& map, const InterpolationData& data, FitRepo
     report->nonzeros = static_cast<std::size_t>(A.nonZeros());
     report->max_residual = res;
     report->relative_residual = rel;
-    report->solve_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    report->solve_seconds = toolkit::seconds_since(t0);
   }
 }
 

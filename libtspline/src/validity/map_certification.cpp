@@ -12,6 +12,7 @@
 #include "tspline/detail/element_jacobian.h"
 #include "tspline/detail/quadrature.h"
 #include "toolkit/errors.h"
+#include "toolkit/timing.h"
 
 namespace tspline {
 
@@ -220,7 +221,7 @@ MapCertification certify_map(const BezierExtraction& extraction, std::size_t num
       r.failures.push_back(std::move(f));
     }
   }
-  r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  r.seconds = toolkit::seconds_since(t0);
   return r;
 }
 

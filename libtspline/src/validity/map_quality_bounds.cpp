@@ -14,6 +14,7 @@
 #include "tspline/detail/bernstein.h"
 #include "tspline/detail/element_jacobian.h"
 #include "toolkit/errors.h"
+#include "toolkit/timing.h"
 
 namespace tspline {
 
@@ -543,7 +544,7 @@ MapQualityBounds certified_map_quality(const BezierExtraction& extraction, const
     if (!b.converged) ++m.elements_not_converged;
   }
   if (opt.per_element) m.per_element = std::move(per);
-  m.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  m.seconds = toolkit::seconds_since(t0);
   return m;
 }
 

@@ -16,6 +16,7 @@
 #include <optional>
 #include <stdexcept>
 #include "toolkit/errors.h"
+#include "toolkit/timing.h"
 
 namespace tspline {
 
@@ -130,7 +131,7 @@ class NewtonStage {
       cg_solver_.compute(H_);
       d = cg_solver_.solve(-g);
       rep.cg_iterations += static_cast<int>(cg_solver_.iterations());
-      rep.solve_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t2).count();
+      rep.solve_seconds += toolkit::seconds_since(t2);
       return d.allFinite() && g.dot(d) < 0.0;
     }
     if (!analyzed_) {
@@ -157,7 +158,7 @@ class NewtonStage {
       }
       shift = shift == 0.0 ? 1e-8 * mean_diag : 10.0 * shift;
     }
-    rep.solve_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t2).count();
+    rep.solve_seconds += toolkit::seconds_since(t2);
     return ok;
   }
 
@@ -234,7 +235,7 @@ MapUntanglingReport untangle_map(TSplineMap& map, const MapUntanglingOptions& op
     rep.after = rep.before;
     rep.stop_reason = "no interior control points";
     rep.samples = energy.num_samples();
-    rep.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    rep.seconds = toolkit::seconds_since(t0);
     return rep;
   }
 
@@ -399,7 +400,7 @@ MapUntanglingReport untangle_map(TSplineMap& map, const MapUntanglingOptions& op
   map.set_control_points(energy.control_points(x.data()));
   rep.after = energy.stats(x.data());
   rep.samples = energy.num_samples();
-  rep.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  rep.seconds = toolkit::seconds_since(t0);
   return rep;
 }
 
