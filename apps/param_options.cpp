@@ -239,12 +239,9 @@ std::vector<ParamOption> make_table() {
       "polygon "
       "that needs more stops with a message",
       [](ParamSettings& s, const std::string& v) {
-        s.adaptive.max_cells = parse_count(v);
-        s.opt.max_cells = s.adaptive.max_cells;  // one budget for the front half and the adaptive loop
+        s.opt.max_cells = parse_count(v);  // one budget for the front half and the adaptive loop
       },
-      [](const ParamSettings& s) {
-        return json{{"adaptive", s.adaptive.max_cells}, {"front", s.opt.max_cells}};
-      }));
+      [](const ParamSettings& s) { return json(s.opt.max_cells); }));
   t.push_back(option(
       "no-control-point-optimization", OptionKind::Flag,
       "Keep the interpolating map of the T-mesh (by default all interior control points are untangled and "

@@ -94,7 +94,7 @@ TEST_SUITE("cli") {
     };
     CHECK(contains(option_line(param_help, "--min-jacobian"), eq(str(adaptive.min_jacobian))));
     CHECK(contains(option_line(param_help, "--max-adapt"), eq(str(adaptive.max_adapt))));
-    CHECK(contains(option_line(param_help, "--max-cells"), eq(str(adaptive.max_cells))));
+    CHECK(contains(option_line(param_help, "--max-cells"), eq(str(front.max_cells))));
     CHECK(contains(option_line(param_help, "--init-level"), eq(str(front.initial_level))));
     CHECK(contains(option_line(param_help, "--tol-rel"), eq(str(front.tolerance_relative))));
     CHECK(contains(option_line(param_help, "--omega"), eq(str(front.smoothing.over_relaxation))));

@@ -251,7 +251,7 @@ nlohmann::json options_json(const ParameterizationOptions& o, const AdaptiveOpti
           {"stall_rounds", a.stall_rounds},
           {"min_quality_gain", a.min_quality_gain},
           {"max_quality_fraction", a.max_quality_fraction},
-          {"max_cells", a.max_cells},
+          {"max_cells", o.max_cells},
           {"map_untangling", a.optimize_control_points},
           {"untangling",
            {{"max_stages", u.max_stages},
@@ -429,7 +429,7 @@ nlohmann::json param_report(const ParameterizationResult& r, const std::string& 
     }
   rep["adaptive"] = {{"max_rounds", ad.max_adapt},
                      {"stall_rounds", ad.stall_rounds},
-                     {"max_cells", ad.max_cells},
+                     {"max_cells", r.options.max_cells},
                      {"map_untangling", ad.optimize_control_points},
                      {"iterations", its},
                      {"kept_iteration", r.kept_iteration},

@@ -275,7 +275,7 @@ class AdaptiveRun {
     }
     if (ad_.optimize_control_points) {
       const auto t1 = std::chrono::steady_clock::now();
-      const MapUntanglingReport u = untangle_map(map, untangling_options());
+      const MapUntanglingReport u = untangle_map(map, untangling_options(), ad_.certification);
       cert = u.certification;
       rec.untangling = u;
       rec.untangling.certification.failures.clear();
@@ -346,7 +346,7 @@ class AdaptiveRun {
     uo.max_quality_stages = ad_.polish_stages;
     uo.quality_power = ad_.polish_power;
     TSplineMap map = b.map;
-    const MapUntanglingReport u = untangle_map(map, uo);
+    const MapUntanglingReport u = untangle_map(map, uo, ad_.certification);
     t_untangle_ += seconds_since(t1);
     if (ad_.certify && !u.certified) return;
     const auto t2 = std::chrono::steady_clock::now();
@@ -372,7 +372,6 @@ class AdaptiveRun {
 
   MapUntanglingOptions untangling_options() const {
     MapUntanglingOptions uo = ad_.untangling;
-    uo.certification = ad_.certification;
     // A warm start from a polished map (whole-map J_r below polish_below) is
     // near the minimum of the polish energy: optimize that energy, not the
     // default one (whose minimum has the lower min J_r) followed by the polish.
@@ -447,9 +446,9 @@ class AdaptiveRun {
               " of " + std::to_string(f_.mesh.num_cells()) +
               " cells, a distortion that the shape and the corners impose (refinement does not remove it)";
         marked.clear();
-      } else if (f_.mesh.num_cells() + 3 * marked.size() > ad_.max_cells) {
+      } else if (f_.mesh.num_cells() + 3 * marked.size() > opt_.max_cells) {
         why = "refining " + std::to_string(marked.size()) + " more cells would exceed the budget of " +
-              std::to_string(ad_.max_cells) + " cells (`max_cells`)";
+              std::to_string(opt_.max_cells) + " cells (`max_cells`)";
         marked.clear();
       }
     }

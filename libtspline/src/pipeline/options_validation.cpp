@@ -44,7 +44,6 @@ void validate_options(const AdaptiveOptions& ad) {
   if (!(ad.min_jacobian > 0.0 && ad.min_jacobian <= 1.0))
     fail("`min_jacobian` must be in (0, 1], got " + str(ad.min_jacobian));
   if (ad.max_adapt < 0) fail("`max_adapt` must be >= 0, got " + std::to_string(ad.max_adapt));
-  if (ad.max_cells < 1) fail("`max_cells` must be >= 1, got " + std::to_string(ad.max_cells));
   if (ad.polish_stages < 0 || !(ad.polish_power >= 1.0) || !std::isfinite(ad.polish_below))
     fail("`polish_stages` must be >= 0, `polish_power` >= 1 and `polish_below` finite");
   if (ad.gauss < 1 || ad.gauss > 6) fail("`gauss` (Gauss points per direction) must be in [1, 6], got " +

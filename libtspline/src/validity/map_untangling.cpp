@@ -196,7 +196,8 @@ MapUntanglingOptions local_repair_options(const TSplineMap& map, const MapEnergy
 
 }  // namespace
 
-MapUntanglingReport untangle_map(TSplineMap& map, const MapUntanglingOptions& opt) {
+MapUntanglingReport untangle_map(TSplineMap& map, const MapUntanglingOptions& opt,
+                                 const CertificationOptions& certification) {
   if (opt.max_stages < 1 || opt.max_iterations_per_stage < 1 || opt.max_iterations < 1)
     throw toolkit::InputError("untangle_map: stage and iteration limits must be >= 1");
   if (!(opt.eps_floor > 0.0) || !(opt.energy_tolerance > 0.0))
@@ -225,7 +226,7 @@ MapUntanglingReport untangle_map(TSplineMap& map, const MapUntanglingOptions& op
   if (!opt.energy.movable.empty())
     for (std::size_t k = 0; k < energy.num_elements(); ++k) local_elements.push_back(energy.element_active(k));
   auto certify = [&](const Eigen::VectorXd& v) {
-    return certify_map(energy.extraction(), num_cells, energy.control_points(v.data()), opt.certification,
+    return certify_map(energy.extraction(), num_cells, energy.control_points(v.data()), certification,
                        local_elements.empty() ? nullptr : &local_elements);
   };
   // A map without free points is what it is.
@@ -335,7 +336,7 @@ MapUntanglingReport untangle_map(TSplineMap& map, const MapUntanglingOptions& op
           ++rep.local_repairs;
           TSplineMap local = map;
           local.set_control_points(energy.control_points(x.data()));
-          const MapUntanglingReport lr = untangle_map(local, local_repair_options(map, energy, cert, opt));
+          const MapUntanglingReport lr = untangle_map(local, local_repair_options(map, energy, cert, opt), certification);
           rep.local_repair_iterations += lr.iterations;
           rep.local_repair_seconds += lr.seconds;
           rep.iterations += lr.iterations;

@@ -50,8 +50,7 @@ struct AdaptiveOptions {
   /// 0.2 after certification; three more rounds reached 59,506 cells for a
   /// minimum of 0.024 -> 0.032).
   double max_quality_fraction = 0.25;
-  /// Never refine beyond this many cells.
-  std::size_t max_cells = 200000;
+  // The cell budget is ParameterizationOptions::max_cells (one for the front half and this loop).
   /// Untangle and smooth the interior control points of every map globally
   /// (map_untangling.h). false: keep the interpolating map of the T-mesh.
   bool optimize_control_points = true;
@@ -71,6 +70,7 @@ struct AdaptiveOptions {
   /// Certify det J > 0 on every Bezier element after each fit; refine the cells
   /// that are not certified, and stop only once the map is certified.
   bool certify = true;
+  /// How det J > 0 is certified, by this loop and by the untangling it runs (one owner).
   CertificationOptions certification;
 };
 

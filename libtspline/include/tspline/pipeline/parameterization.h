@@ -25,7 +25,7 @@ struct ParameterizationOptions {
   std::optional<std::array<long long, 4>> corners;
   /// Automatic corners: how many of the best choices to try (the whole front
   /// half, initial level capped at 5) before keeping one by best_corner_trial
-  /// (a trial over --max-cells ranks last). 1: no trials.
+  /// (a trial over max_cells ranks last). 1: no trials.
   int corner_trials = 4;
   /// Boundary tolerance epsilon (an AREA, Sect. 3). If unset, epsilon =
   /// tolerance_relative * (bounding-box diagonal)^2.
@@ -35,8 +35,8 @@ struct ParameterizationOptions {
   int initial_level = 3;
   /// No cell is refined beyond this level.
   int max_level = 22;
-  /// The T-mesh never has more cells than this (`--max-cells`, the same budget
-  /// as AdaptiveOptions::max_cells): boundary refinement that needs more throws
+  /// The T-mesh never has more cells than this, in the front half and in the
+  /// adaptive loop (one budget): boundary refinement that needs more throws
   /// InputError; repair rounds that would exceed it stop (repair_stop_reason).
   std::size_t max_cells = 200000;
   /// If inverted cells remain after optimization, refine them, re-balance,

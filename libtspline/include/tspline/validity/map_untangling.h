@@ -110,7 +110,6 @@ struct MapUntanglingOptions {
   /// (Garanzha et al. use 1/10; 1/4 needed 33 instead of 54 stages on Bali,
   /// 20 L-BFGS iterations per stage, and reached the same certified map).
   double min_decrease = 0.25;
-  CertificationOptions certification;
   /// When every sample is positive but some elements are not certified (folds
   /// hidden between their samples): first untangle the control points of
   /// those elements and of one ring of elements around them alone, with the
@@ -146,8 +145,10 @@ struct MapUntanglingReport {
   double seconds = 0.0;
 };
 
-/// Moves the interior control points of `map` in place.
+/// Moves the interior control points of `map` in place; `certification` says
+/// how det J > 0 is certified on the elements (the stopping test).
 /// \throw InputError for options out of range.
-MapUntanglingReport untangle_map(TSplineMap& map, const MapUntanglingOptions& options = {});
+MapUntanglingReport untangle_map(TSplineMap& map, const MapUntanglingOptions& options = {},
+                                 const CertificationOptions& certification = {});
 
 }  // namespace tspline
