@@ -265,8 +265,11 @@ TEST_SUITE("poisson") {
     // knot lines cross its cells; the first refinement is pre-asymptotic (the
     // square's corners sit on smooth points of the circle, where the map is
     // nearly singular: J_r ~ 1e-4 at the corner itself; measured L2/H1 rates
-    // 1.78/1.09, then 4.93/3.70, then 4.4/3.3). Documented tolerance: every
-    // rate at least 1.5 / 1.0, the last at least 3.6 / 2.6.
+    // 1.78/1.09, then 4.93/3.70, then 4.4/3.3). Documented tolerance: the
+    // first rate at least 1.5 / 1.0, every later one at least 3.6 / 2.6: the
+    // asymptotic rates of a basis that reproduces cubics are 4 / 3, and one that
+    // loses the cubics (the normalized T-spline basis on these T-meshes) drops
+    // to 3 / 2 at most, below the floor.
     const auto& map = disk_map();
     REQUIRE(map.mesh().num_hanging_vertices() > 0);
     tspline::AdaptiveSolveOptions o;
@@ -276,12 +279,14 @@ TEST_SUITE("poisson") {
     const auto steps = tspline::solve_adaptive(map, sinsin(), o).steps;
     REQUIRE(steps.size() == 4);
     const auto rates = uniform_rates(steps, "disk default");
-    for (const Rates& r : rates) {
-      CHECK(r.l2_cells >= 1.5);
-      CHECK(r.h1_cells >= 1.0);
+    REQUIRE(rates.size() == 3);
+    CHECK(rates.front().l2_cells >= 1.5);
+    CHECK(rates.front().h1_cells >= 1.0);
+    for (std::size_t k = 1; k < rates.size(); ++k) {
+      CAPTURE(k);
+      CHECK(rates[k].l2_cells >= 3.6);
+      CHECK(rates[k].h1_cells >= 2.6);
     }
-    CHECK(rates.back().l2_cells >= 3.6);
-    CHECK(rates.back().h1_cells >= 2.6);
   }
 
   TEST_CASE("refinement patch: a marked cell and the leaves at most as fine that touch it") {

@@ -2,6 +2,7 @@
 // colours, antialiasing, fonts, SVG and PDF) and `tspline render` on the
 // outputs of param and poisson (image size, colour variety, drawn fraction;
 // bad input), and the convergence plot of `tspline poisson`.
+#include <cmath>
 #include <doctest/doctest.h>
 
 #include <vtkImageData.h>
@@ -29,10 +30,21 @@ namespace {
 fs::path scratch(const std::string& name) { return test_support::scratch_dir("render", name); }
 std::string q(const fs::path& p) { return test_support::quoted(p); }
 
+struct Rgb8 {
+  int r = 0, g = 0, b = 0;
+  bool white() const { return r == 255 && g == 255 && b == 255; }
+  bool dark() const { return r < 90 && g < 90 && b < 90; }
+  bool operator==(const Rgb8&) const = default;
+};
+
 struct PngStats {
   int width = 0, height = 0;
   std::size_t colours = 0;      ///< distinct RGB values
   double drawn_fraction = 0.0;  ///< pixels that are not white
+  std::vector<Rgb8> pixels;     ///< row by row from the top
+  Rgb8 at(double x, double y) const {  ///< the pixel at (x, y) from the top left
+    return pixels[static_cast<std::size_t>(std::lround(y)) * width + static_cast<std::size_t>(std::lround(x))];
+  }
 };
 
 PngStats png_stats(const fs::path& file) {
@@ -51,11 +63,15 @@ PngStats png_stats(const fs::path& file) {
   REQUIRE(px->GetNumberOfComponents() == 3);
   std::set<int> colours;
   std::size_t drawn = 0;
+  s.pixels.resize(px->GetNumberOfTuples());
   for (vtkIdType i = 0; i < px->GetNumberOfTuples(); ++i) {
     const int r = static_cast<int>(px->GetComponent(i, 0)), g = static_cast<int>(px->GetComponent(i, 1)),
               b = static_cast<int>(px->GetComponent(i, 2));
     colours.insert((r << 16) | (g << 8) | b);
     if (r != 255 || g != 255 || b != 255) ++drawn;
+    // VTK's rows go up from the bottom.
+    const vtkIdType row = i / s.width, column = i % s.width;
+    s.pixels[static_cast<std::size_t>((s.height - 1 - row) * s.width + column)] = {r, g, b};
   }
   s.colours = colours.size();
   s.drawn_fraction = static_cast<double>(drawn) / static_cast<double>(px->GetNumberOfTuples());
@@ -176,6 +192,21 @@ TEST_SUITE("render") {
       CHECK(st.colours >= c.min_colours);
       CHECK(st.drawn_fraction >= c.min_drawn);
       CHECK(st.drawn_fraction <= c.max_drawn);
+      // The flower's centre is the centre of the drawing area (the margins of
+      // 30 pixels, less the colour bar's 190 on the right where there is one):
+      // drawn; the corners of the image are not.
+      const bool bar = c.view != "tmesh" && c.view != "control-net";
+      if (c.view != "control-net") CHECK_FALSE(st.at((30 + 600 - 30 - (bar ? 190 : 0)) / 2.0, 200).white());
+      CHECK(st.at(5, 5).white());
+      CHECK(st.at(594, 394).white());
+      if (c.view == "jacobian") {
+        // The colour bar (x from 600 - 190 + 40 = 450 to 476, y from 50 to
+        // 350): viridis, yellow at J_r = 1 on top, dark violet at 0 below.
+        const Rgb8 top = st.at(463, 55), bottom = st.at(463, 345);
+        INFO("top " << top.r << "," << top.g << "," << top.b << "; bottom " << bottom.r << "," << bottom.g << "," << bottom.b);
+        CHECK((top.r > 200 && top.g > 200 && top.b < 80));
+        CHECK((bottom.r < 100 && bottom.g < 30 && bottom.b > 60));
+      }
     }
     // The layout view: one colour per patch (the palette has 10), outlines and corners.
     {
@@ -191,6 +222,28 @@ TEST_SUITE("render") {
       const PngStats st = png_stats(png);
       CHECK(st.colours >= 8 + 2);  // eight patch colours, black outlines, red corners (and antialiasing)
       CHECK(st.drawn_fraction >= 0.5);
+      // Where the geometry is: the plate [0, 4]^2 fills the 540 x 540 pixels
+      // inside the margins (x = 30 + 135 X, y = 570 - 135 Y); its hole (radius
+      // 1 about (2, 2)) and the margins are white; the cuts run along x = 2 and
+      // y = 2 and the diagonals, so each octant of the plate, sampled near the
+      // plate's sides, is a patch of its own colour.
+      auto pixel = [&](double X, double Y) { return st.at(30 + 135 * X, 570 - 135 * Y); };
+      CHECK(pixel(2, 2).white());
+      CHECK(pixel(2.5, 2).white());
+      CHECK(pixel(1.3, 2.2).white());
+      CHECK(pixel(-0.1, 2).white());
+      CHECK(pixel(2, 4.1).white());
+      std::vector<Rgb8> octants;
+      for (const auto& [X, Y] : std::vector<std::pair<double, double>>{
+               {1, 0.3}, {3, 0.3}, {3.7, 1}, {3.7, 3}, {3, 3.7}, {1, 3.7}, {0.3, 3}, {0.3, 1}}) {
+        const Rgb8 c = pixel(X, Y);
+        INFO("at (" << X << ", " << Y << "): " << c.r << "," << c.g << "," << c.b);
+        CHECK_FALSE(c.white());
+        CHECK_FALSE(c.dark());
+        for (const Rgb8& o : octants) CHECK_FALSE(o == c);
+        octants.push_back(c);
+      }
+      CHECK(pixel(2, 0.3).dark());  // the cut along x = 2
       // A single patch is one colour.
       const auto one = run_app("render " + q(d / "param") + " --png " + q(d / "one.png") + " --view layout", d);
       CHECK(one.exit_code == 0);

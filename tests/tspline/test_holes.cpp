@@ -433,7 +433,23 @@ TEST_SUITE("holes") {
     CHECK(R.certified_valid());
     CHECK(std::abs(R.map_area - R.domain_area) < 1e-3 * R.domain_area);
     CHECK(R.max_gap() <= 1e-12 * R.diameter);
-    for (const tspline::Patch& p : R.layout.patches) CHECK(p.corners.size() == 4);
+    // The layout partitions the domain: each patch's four corners are distinct
+    // vertices of its polygon in counter-clockwise order (one descent in the
+    // cyclic sequence of their indices), its polygon is counter-clockwise, and
+    // the patches' areas add up to the domain's.
+    double area = 0.0;
+    for (const tspline::Patch& p : R.layout.patches) {
+      int descents = 0;
+      for (int k = 0; k < 4; ++k) {
+        CHECK(p.corners[k] < p.polygon.vertices.size());
+        CHECK(p.corners[(k + 1) % 4] != p.corners[k]);
+        descents += p.corners[(k + 1) % 4] < p.corners[k];
+      }
+      CHECK(descents == 1);
+      CHECK(tspline::signed_area(p.polygon) > 0.0);
+      area += tspline::signed_area(p.polygon);
+    }
+    CHECK(area == doctest::Approx(tspline::domain_area(d)).epsilon(1e-12));
   }
 
   TEST_CASE("GeoJSON polygon with an interior ring: the hole is read and projected with the outer ring") {
