@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "tspline/errors.h"
+#include "tspline/io/gis_reader.h"
 #include "tspline/io/polygon_reader.h"
 #include "tspline/boundary/polygon_validation.h"
 
@@ -50,14 +51,16 @@ TEST_SUITE("boundary_io") {
     CHECK(signed_area(validate_polygon(p)) == doctest::Approx(1.0));
   }
 
-  TEST_CASE("GeoJSON Polygon, Feature and FeatureCollection give the same vertices as the text") {
+  TEST_CASE("GeoJSON Polygon, Feature and FeatureCollection (through GDAL) give the same vertices as the text") {
     const Polygon txt = read("disk");
     const std::string ring = geojson_ring(txt.vertices);
     const std::string poly = R"({"type":"Polygon","coordinates":[)" + ring + "]}";
     const std::string feat = R"({"type":"Feature","properties":{},"geometry":)" + poly + "}";
     const std::string coll = R"({"type":"FeatureCollection","features":[)" + feat + "]}";
+    io::DomainReadOptions planar;
+    planar.planar = true;
     for (const std::string& s : {poly, feat, coll}) {
-      const Polygon g = io::parse_polygon(s, "mem.geojson");
+      const Polygon g = io::read_geojson_domain(s, planar, "mem.geojson").outer;
       REQUIRE(g.vertices.size() == txt.vertices.size());  // closing vertex dropped
       for (std::size_t i = 0; i < g.vertices.size(); ++i) {
         CHECK(g.vertices[i].x() == doctest::Approx(txt.vertices[i].x()).epsilon(1e-12));
@@ -65,25 +68,28 @@ TEST_SUITE("boundary_io") {
         CHECK(g.file_index[i] == i);
       }
     }
+    // The text reader refuses GeoJSON, saying where it goes.
+    CHECK(contains(message_of<InputError>([&] { io::parse_polygon(poly, "mem.geojson"); }),
+                   "mem.geojson: GeoJSON, not a text polygon: read it with read_domain"));
   }
 
-  TEST_CASE("GeoJSON MultiPolygon: largest by default, or chosen by index; holes noted") {
+  TEST_CASE("GeoJSON MultiPolygon: largest by default, or chosen by index; its holes kept") {
     const std::string small = geojson_ring({V2(5, 5), V2(6, 5), V2(6, 6), V2(5, 6)});
     const std::string big = geojson_ring({V2(0, 0), V2(3, 0), V2(3, 3), V2(0, 3)});
     const std::string hole = geojson_ring({V2(1, 1), V2(1, 2), V2(2, 2), V2(2, 1)});
     const std::string mp =
         R"({"type":"MultiPolygon","coordinates":[[)" + small + "],[" + big + "," + hole + "]]}";
-    std::string warn;
-    const Polygon largest = io::parse_polygon(mp, "m.json", {}, &warn);
-    CHECK(largest.vertices[1] == V2(3, 0));
-    CHECK(contains(warn, "largest area"));
-    CHECK(contains(warn, "1 hole(s) ignored"));
-    io::PolygonReadOptions opt;
+    io::DomainReadOptions opt;
+    opt.planar = true;
+    const io::DomainInput largest = io::read_geojson_domain(mp, opt, "m.json");
+    CHECK(largest.outer.vertices[1] == V2(3, 0));
+    REQUIRE(largest.holes.size() == 1);
+    CHECK(std::abs(signed_area(largest.holes[0])) == doctest::Approx(1.0));
     opt.polygon_index = 0;
-    CHECK(io::parse_polygon(mp, "m.json", opt).vertices[0] == V2(5, 5));
+    CHECK(io::read_geojson_domain(mp, opt, "m.json").outer.vertices[0] == V2(5, 5));
     opt.polygon_index = 2;
-    CHECK(contains(message_of<InputError>([&] { io::parse_polygon(mp, "m.json", opt); }),
-                   "polygon index 2 is out of range"));
+    CHECK(contains(message_of<InputError>([&] { io::read_geojson_domain(mp, opt, "m.json"); }),
+                   "`polygon_index` 2 out of range (2 polygons)"));
   }
 
   // ---- bad input, one case each ------------------------------------------------
@@ -118,13 +124,10 @@ TEST_SUITE("boundary_io") {
           "b.txt:1: expected two numbers 'x y', got '0 0 0'");
   }
 
-  TEST_CASE("error: invalid JSON") {
-    CHECK(contains(message_of<InputError>([] { io::parse_polygon("{\"type\": ", "j.json"); }),
-                   "j.json: invalid JSON"));
-    CHECK(contains(message_of<InputError>([] {
-                     io::parse_polygon(R"({"type":"Polygon","coordinates":[[[0,0],[1]]]})", "j.json");
-                   }),
-                   "/coordinates/0/1: expected a position"));
+  TEST_CASE("error: invalid GeoJSON") {
+    CHECK_THROWS_AS(io::read_geojson_domain("{\"type\": ", {}, "j.json"), InputError);
+    CHECK_THROWS_AS(io::read_geojson_domain(R"({"type":"Polygon","coordinates":[[[0,0],[1]]]})", {}, "j.json"),
+                    InputError);
   }
 
   TEST_CASE("error: unreadable path") {

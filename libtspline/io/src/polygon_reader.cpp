@@ -1,4 +1,4 @@
-// Polygon input: plain "x y" text files and GeoJSON.
+// Polygon input: plain "x y" text files (GeoJSON and GIS files: gis_reader, through GDAL).
 #include "tspline/io/polygon_reader.h"
 
 #include <cerrno>
@@ -7,7 +7,6 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
-#include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
 #include <string_view>
@@ -18,7 +17,6 @@
 namespace tspline::io {
 namespace {
 
-using json = nlohmann::json;
 using Ring = std::vector<Eigen::Vector2d>;
 
 std::string_view trim(std::string_view s) {
@@ -98,114 +96,6 @@ Polygon parse_text(const std::string& content, const std::string& source) {
   return finish(parse_text_vertices(content, source), source);
 }
 
-// ---- GeoJSON ---------------------------------------------------------------
-
-struct Found {
-  std::string path;  // JSON pointer of the polygon's "coordinates" array
-  const json* coords;
-};
-
-double ring_area(const Ring& r) {
-  double a = 0;
-  for (std::size_t i = 0; i + 1 < r.size(); ++i)
-    a += (r[i] - r[0]).x() * (r[i + 1] - r[0]).y() - (r[i] - r[0]).y() * (r[i + 1] - r[0]).x();
-  return std::abs(0.5 * a);
-}
-
-Ring parse_ring(const json& ring, const std::string& path, const std::string& source) {
-  if (!ring.is_array()) throw InputError(source + ": " + path + ": expected an array of positions");
-  Ring out;
-  for (std::size_t i = 0; i < ring.size(); ++i) {
-    const json& pos = ring[i];
-    const std::string here = source + ": " + path + "/" + std::to_string(i) + ": ";
-    if (!pos.is_array() || pos.size() < 2 || !pos[0].is_number() || !pos[1].is_number())
-      throw InputError(here + "expected a position [x, y], got " + pos.dump());
-    const double x = pos[0].get<double>(), y = pos[1].get<double>();
-    if (!std::isfinite(x) || !std::isfinite(y)) throw InputError(here + "coordinate is not finite");
-    out.emplace_back(x, y);
-  }
-  return out;
-}
-
-// Collects the Polygon coordinate arrays of a GeoJSON object in file order.
-void collect(const json& obj, const std::string& path, const std::string& source, std::vector<Found>& out) {
-  const std::string at = path.empty() ? "/" : path;
-  if (!obj.is_object() || !obj.contains("type") || !obj["type"].is_string())
-    throw InputError(source + ": " + at + ": expected a GeoJSON object with a \"type\"");
-  const std::string type = obj["type"].get<std::string>();
-  auto member = [&](const char* name) -> const json& {
-    if (!obj.contains(name)) throw InputError(source + ": " + at + ": " + type + " without \"" + name + "\"");
-    return obj[name];
-  };
-  auto array_member = [&](const char* name) -> const json& {
-    const json& m = member(name);
-    if (!m.is_array()) throw InputError(source + ": " + path + "/" + name + ": expected an array");
-    return m;
-  };
-  if (type == "Polygon") {
-    array_member("coordinates");
-    out.push_back({path + "/coordinates", &obj["coordinates"]});
-  } else if (type == "MultiPolygon") {
-    const json& polys = array_member("coordinates");
-    for (std::size_t i = 0; i < polys.size(); ++i)
-      out.push_back({path + "/coordinates/" + std::to_string(i), &polys[i]});
-  } else if (type == "Feature") {
-    const json& g = member("geometry");
-    if (!g.is_null()) collect(g, path + "/geometry", source, out);
-  } else if (type == "FeatureCollection") {
-    const json& fs = array_member("features");
-    for (std::size_t i = 0; i < fs.size(); ++i)
-      collect(fs[i], path + "/features/" + std::to_string(i), source, out);
-  } else if (type == "GeometryCollection") {
-    const json& gs = array_member("geometries");
-    for (std::size_t i = 0; i < gs.size(); ++i)
-      collect(gs[i], path + "/geometries/" + std::to_string(i), source, out);
-  }
-  // Other geometry types (Point, LineString, ...) hold no polygon: skipped.
-}
-
-Polygon parse_geojson(const std::string& content, const std::string& source, const PolygonReadOptions& opt,
-                      std::string* warnings) {
-  json doc;
-  try {
-    doc = json::parse(content);
-  } catch (const json::parse_error& e) {
-    throw InputError(source + ": invalid JSON: " + e.what());
-  } catch (const json::exception& e) {  // e.g. a number too large for a double (out_of_range.406)
-    throw InputError(source + ": invalid JSON: " + e.what());
-  }
-  std::vector<Found> found;
-  collect(doc, "", source, found);
-  if (found.empty()) throw InputError(source + ": no Polygon or MultiPolygon in the GeoJSON");
-  auto outer = [&](const Found& f) {
-    if (!f.coords->is_array() || f.coords->empty())
-      throw InputError(source + ": " + f.path + ": expected an array of rings");
-    return parse_ring((*f.coords)[0], f.path + "/0", source);
-  };
-  std::size_t chosen = 0;
-  std::string note;
-  if (opt.polygon_index) {
-    if (*opt.polygon_index >= found.size())
-      throw InputError(source + ": polygon index " + std::to_string(*opt.polygon_index) +
-                       " is out of range (" + std::to_string(found.size()) + " polygon(s) in the file)");
-    chosen = *opt.polygon_index;
-  } else if (found.size() > 1) {
-    double best = -1;
-    for (std::size_t i = 0; i < found.size(); ++i) {
-      const double a = ring_area(outer(found[i]));
-      if (a > best) best = a, chosen = i;
-    }
-    note = source + ": " + std::to_string(found.size()) + " polygons; using polygon " +
-           std::to_string(chosen) + " (largest area)\n";
-  }
-  const Found& f = found[chosen];
-  Ring ring = outer(f);
-  if (f.coords->size() > 1)
-    note += source + ": " + f.path + ": " + std::to_string(f.coords->size() - 1) + " hole(s) ignored\n";
-  if (warnings) *warnings += note;
-  return finish(std::move(ring), source);
-}
-
 }  // namespace
 
 std::vector<Polygon> parse_text_rings(const std::string& content, const std::string& source_name) {
@@ -222,13 +112,13 @@ std::vector<Polygon> parse_text_rings(const std::string& content, const std::str
   return rings;
 }
 
-Polygon parse_polygon(const std::string& content, const std::string& source_name,
-                      const PolygonReadOptions& options, std::string* warnings) {
+Polygon parse_polygon(const std::string& content, const std::string& source_name) {
   std::size_t first = content.find_first_not_of(" \t\r\n\f\v");
   if (first != std::string::npos && content.compare(first, 3, "\xEF\xBB\xBF") == 0)
     first = content.find_first_not_of(" \t\r\n\f\v", first + 3);
   if (first != std::string::npos && content[first] == '{')
-    return parse_geojson(content, source_name, options, warnings);
+    throw InputError(source_name + ": GeoJSON, not a text polygon: read it with read_domain (a .geojson or .json "
+                     "file) or read_geojson_domain (GDAL), which keep its holes and project longitude/latitude");
   return parse_text(content, source_name);
 }
 
@@ -252,8 +142,8 @@ std::string read_whole_file(const std::string& path) {
 
 }  // namespace
 
-Polygon read_polygon(const std::string& path, const PolygonReadOptions& options, std::string* warnings) {
-  return parse_polygon(read_whole_file(path), path, options, warnings);
+Polygon read_polygon(const std::string& path) {
+  return parse_polygon(read_whole_file(path), path);
 }
 
 std::vector<Polygon> read_text_rings(const std::string& path) { return parse_text_rings(read_whole_file(path), path); }

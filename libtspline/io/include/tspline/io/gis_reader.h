@@ -56,7 +56,7 @@ DomainInput read_domain(const std::string& path, const DomainReadOptions& option
 /// longitude/latitude (RFC 7946) projected to metres unless `planar` or
 /// `crs` says otherwise. `name` stands for the input in messages and in the
 /// description ("format": "GeoJSON").
-/// 	hrow InputError as read_domain, and for text GDAL cannot read as GeoJSON.
+/// \throw InputError as read_domain, and for text GDAL cannot read as GeoJSON.
 DomainInput read_geojson_domain(const std::string& geojson, const DomainReadOptions& options = {},
                                 const std::string& name = "GeoJSON");
 
