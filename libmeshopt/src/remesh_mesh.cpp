@@ -6,11 +6,6 @@
 
 namespace meshopt {
 
-std::uint64_t RemeshMesh::key(int a, int b) {
-  if (a > b) std::swap(a, b);
-  return (static_cast<std::uint64_t>(static_cast<std::uint32_t>(a)) << 32) | static_cast<std::uint32_t>(b);
-}
-
 int RemeshMesh::add_vertex(const RemeshVertex& v) {
   vertices.push_back(v);
   incident_.emplace_back();
@@ -111,9 +106,9 @@ void RemeshMesh::compact() {
       for (int& v : n.v) v = new_index[v];
       tris.push_back(n);
     }
-  std::unordered_map<std::uint64_t, int> features;
+  std::unordered_map<EdgeKey, int, EdgeKeyHash> features;
   for (const auto& [k, curve] : feature_edges) {
-    const int a = new_index[static_cast<int>(k >> 32)], b = new_index[static_cast<int>(k & 0xffffffffu)];
+    const int a = new_index[k.a], b = new_index[k.b];
     if (a >= 0 && b >= 0) features[key(a, b)] = curve;
   }
   vertices = std::move(kept);
@@ -124,7 +119,7 @@ void RemeshMesh::compact() {
 
 std::map<int, long> RemeshMesh::euler_characteristics() const {
   std::map<int, std::set<int>> verts;
-  std::map<int, std::set<std::uint64_t>> edges_of;
+  std::map<int, std::set<EdgeKey>> edges_of;
   std::map<int, long> faces;
   for (const RemeshTriangle& t : triangles) {
     if (!t.alive) continue;
@@ -141,7 +136,7 @@ std::map<int, long> RemeshMesh::euler_characteristics() const {
 }
 
 std::size_t RemeshMesh::non_manifold_edges() const {
-  std::unordered_map<std::uint64_t, std::array<int, 2>> uses;  // key -> (count, net direction)
+  std::unordered_map<EdgeKey, std::array<int, 2>, EdgeKeyHash> uses;  // key -> (count, net direction)
   for (const RemeshTriangle& t : triangles) {
     if (!t.alive) continue;
     for (int i = 0; i < 3; ++i) {

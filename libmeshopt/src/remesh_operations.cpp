@@ -321,7 +321,7 @@ void Remesher::improve_all_by_flips() {
   if (all_touched_) {
     stack = m_.edges();
   } else {
-    std::vector<std::uint64_t> keys;
+    std::vector<EdgeKey> keys;
     for (int v : touched_)
       for (int t : m_.triangles_of(v)) {
         const auto& c = m_.triangles[t].v;
@@ -329,8 +329,8 @@ void Remesher::improve_all_by_flips() {
       }
     std::sort(keys.begin(), keys.end());
     keys.erase(std::unique(keys.begin(), keys.end()), keys.end());
-    // Larger vertex first, as m_.edges() lists them: the stack pops the last.
-    for (std::uint64_t k : keys) stack.push_back({static_cast<int>(k >> 32), static_cast<int>(k & 0xffffffffu)});
+    // In increasing order of (a, b), as m_.edges() lists them: the stack pops the last.
+    for (const EdgeKey& k : keys) stack.push_back({k.a, k.b});
   }
   for (int v : touched_) is_touched_[v] = 0;
   touched_.clear();
@@ -340,7 +340,7 @@ void Remesher::improve_all_by_flips() {
 
 void Remesher::improve_by_flips(std::vector<Edge> stack) {
   std::vector<Edge> retry;  // the paper's S1
-  std::unordered_set<std::uint64_t> in_retry;
+  std::unordered_set<EdgeKey, EdgeKeyHash> in_retry;
   for (int pass = 0; pass < o_.max_flip_passes && !stack.empty(); ++pass) {
     bool flipped = false;
     while (!stack.empty()) {

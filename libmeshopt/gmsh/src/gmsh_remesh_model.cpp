@@ -533,8 +533,8 @@ void write_remesh_mesh(const std::string& path, const RemeshMesh& m, const std::
     for (int v : m.triangles[t].v) tri_by_face[faces[t]].push_back(static_cast<std::size_t>(v) + 1);
   }
   for (const auto& [k, curve] : m.feature_edges) {
-    line_by_curve[curve].push_back((k >> 32) + 1);
-    line_by_curve[curve].push_back((k & 0xffffffffu) + 1);
+    line_by_curve[curve].push_back(static_cast<std::size_t>(k.a) + 1);
+    line_by_curve[curve].push_back(static_cast<std::size_t>(k.b) + 1);
   }
   try {
     for (const auto& [ent, nodes] : by_entity)

@@ -4,7 +4,10 @@
 // (mesh edges on feature curves) and the vertex-triangle incidence that the
 // local operations keep up to date.
 #include <Eigen/Core>
+#include <algorithm>
 #include <array>
+#include <compare>
+#include <functional>
 #include <cstdint>
 #include <map>
 #include <unordered_map>
@@ -14,6 +17,21 @@
 #include "meshopt/remesh_geometry.h"
 
 namespace meshopt {
+
+/// An undirected mesh edge, its ends in increasing order: the key of per-edge data.
+struct EdgeKey {
+  int a = 0, b = 0;  ///< a <= b
+  EdgeKey() = default;
+  EdgeKey(int u, int v) : a(std::min(u, v)), b(std::max(u, v)) {}
+  auto operator<=>(const EdgeKey&) const = default;
+};
+
+struct EdgeKeyHash {
+  std::size_t operator()(const EdgeKey& e) const noexcept {
+    return std::hash<std::uint64_t>{}((static_cast<std::uint64_t>(static_cast<std::uint32_t>(e.a)) << 32) |
+                                      static_cast<std::uint32_t>(e.b));
+  }
+};
 
 struct RemeshVertex {
   Eigen::Vector3d x = Eigen::Vector3d::Zero();
@@ -41,9 +59,9 @@ class RemeshMesh {
   std::vector<RemeshVertex> vertices;
   std::vector<RemeshTriangle> triangles;
   /// Feature edges: key(a, b) -> the feature curve they lie on.
-  std::unordered_map<std::uint64_t, int> feature_edges;
+  std::unordered_map<EdgeKey, int, EdgeKeyHash> feature_edges;
 
-  static std::uint64_t key(int a, int b);
+  static EdgeKey key(int a, int b) { return {a, b}; }
   int add_vertex(const RemeshVertex& v);
   int add_triangle(const RemeshTriangle& t);
   void kill_triangle(int t);

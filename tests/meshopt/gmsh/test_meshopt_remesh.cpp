@@ -81,7 +81,7 @@ void remesh_model(const std::function<void()>& make, double h, const RemeshOptio
   std::map<int, int> degree;
   std::size_t bad_edges = 0;
   for (const auto& [k, curve] : m.feature_edges) {
-    const int a = static_cast<int>(k >> 32), b = static_cast<int>(k & 0xffffffffu);
+    const int a = k.a, b = k.b;
     for (int v : {a, b}) {
       ++degree[v];
       const RemeshVertex& vv = m.vertices[v];
