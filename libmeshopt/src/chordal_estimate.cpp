@@ -14,11 +14,6 @@ double chord_curvature_term(const Eigen::Vector3d& xa, const Eigen::Vector3d& na
   return second * 2.0 / (1.0 + cos_half);
 }
 
-double edge_deviation_estimate(const Eigen::Vector3d& xa, const Eigen::Vector3d& na, const Eigen::Vector3d& xb,
-                               const Eigen::Vector3d& nb) {
-  return std::abs(chord_curvature_term(xa, na, xb, nb)) / 8.0;
-}
-
 double triangle_deviation_estimate(const std::array<Eigen::Vector3d, 3>& x, const std::array<Eigen::Vector3d, 3>& n) {
   double sum = 0.0;
   for (int k = 0; k < 3; ++k) sum += chord_curvature_term(x[k], n[k], x[(k + 1) % 3], n[(k + 1) % 3]);

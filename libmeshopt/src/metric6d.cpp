@@ -25,10 +25,6 @@ double angle6d(const Point6d& a, const Point6d& b, const Point6d& c) {
   return std::acos(std::clamp(ca.dot(cb) / (la * lb), -1.0, 1.0));
 }
 
-std::array<double, 3> triangle_angles6d(const Point6d& p0, const Point6d& p1, const Point6d& p2) {
-  return {angle6d(p1, p2, p0), angle6d(p2, p0, p1), angle6d(p0, p1, p2)};
-}
-
 double min_angle6d(const Point6d& p0, const Point6d& p1, const Point6d& p2) {
   // acos is decreasing: the smallest angle has the largest cosine (one acos, not three).
   const Point6d e01 = p1 - p0, e12 = p2 - p1, e20 = p0 - p2;

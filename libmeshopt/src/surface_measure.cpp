@@ -129,8 +129,4 @@ DistortionInX restricted_distortion(SurfaceMeasure measure, const Eigen::Vector3
   return out;
 }
 
-Eigen::Matrix2d equilateral_ideal_inverse(double h) {
-  return ideal_inverse(Eigen::Vector2d::Zero(), Eigen::Vector2d(h, 0.0), Eigen::Vector2d(0.5 * h, 0.5 * std::sqrt(3.0) * h));
-}
-
 }  // namespace meshopt

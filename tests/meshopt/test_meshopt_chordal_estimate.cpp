@@ -7,6 +7,9 @@
 #include <cmath>
 
 #include "meshopt/chordal_estimate.h"
+#include "meshopt_formulas.h"
+
+using meshopt_test::edge_deviation_estimate;
 
 TEST_SUITE_BEGIN("meshopt_chordal_estimate");
 

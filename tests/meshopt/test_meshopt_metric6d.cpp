@@ -11,6 +11,9 @@
 #include "meshopt/metric6d.h"
 #include "meshopt/remesh_mesh.h"
 #include "meshopt/remesh_statistics.h"
+#include "meshopt_formulas.h"
+
+using meshopt_test::triangle_angles6d;
 
 TEST_SUITE_BEGIN("meshopt_metric6d");
 

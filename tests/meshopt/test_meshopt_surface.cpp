@@ -18,6 +18,9 @@
 #include "meshopt/triangle_measure.h"
 #include "surface_test_support.h"
 #include "test_support.h"
+#include "meshopt_formulas.h"
+
+using meshopt_test::equilateral_ideal_inverse;
 
 TEST_SUITE_BEGIN("meshopt_surface");
 

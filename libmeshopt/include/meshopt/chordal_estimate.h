@@ -24,10 +24,6 @@ namespace meshopt {
 double chord_curvature_term(const Eigen::Vector3d& xa, const Eigen::Vector3d& na, const Eigen::Vector3d& xb,
                             const Eigen::Vector3d& nb);
 
-/// Distance of the chord's midpoint from the surface: |II(e, e)| / 8.
-double edge_deviation_estimate(const Eigen::Vector3d& xa, const Eigen::Vector3d& na, const Eigen::Vector3d& xb,
-                               const Eigen::Vector3d& nb);
-
 /// Distance of the triangle's centroid from the surface: |sum_k II(e_k, e_k)| / 18.
 double triangle_deviation_estimate(const std::array<Eigen::Vector3d, 3>& x, const std::array<Eigen::Vector3d, 3>& n);
 

@@ -22,9 +22,6 @@ double length6d(const Eigen::Vector3d& xa, const Eigen::Vector3d& na, const Eige
 /// (The paper prints the denominator without its square roots.) 0 if A or B equals C.
 double angle6d(const Point6d& a, const Point6d& b, const Point6d& c);
 
-/// The three angles of triangle (p0, p1, p2) in R^6, angle i at vertex i.
-std::array<double, 3> triangle_angles6d(const Point6d& p0, const Point6d& p1, const Point6d& p2);
-
 /// The smallest 6D angle of a triangle: the paper's triangle quality (Sect. 3.1;
 /// pi/3 for a triangle equilateral in R^6).
 double min_angle6d(const Point6d& p0, const Point6d& p1, const Point6d& p2);

@@ -85,8 +85,4 @@ DistortionInX restricted_distortion(SurfaceMeasure measure, const Eigen::Vector3
                                     const Eigen::Vector3d& x2, const Eigen::Matrix2d& ideal_inv,
                                     const Eigen::Vector3d& n, double delta);
 
-/// The ideal W^{-1} of an equilateral triangle (edge h; first edge along e1):
-/// the shape ideal of Sect. 4.3.
-Eigen::Matrix2d equilateral_ideal_inverse(double h);
-
 }  // namespace meshopt
