@@ -15,6 +15,7 @@
 #include "tspline/tmesh/coons.h"
 #include "tspline/boundary/corners.h"
 #include "tspline/errors.h"
+#include "tspline/boundary/plane.h"
 #include "tspline/boundary/polygon_validation.h"
 #include "tspline/tmesh/smoothing_problem.h"
 #include "tspline/tmesh/tmesh_transfer.h"
@@ -276,154 +277,182 @@ std::size_t best_corner_trial(const std::vector<CornerTrial>& trials) {
   return best;
 }
 
-FrontResult run_front(const Polygon& input, const ParameterizationOptions& opt) {
-  auto log = [&](const char* stage, const std::string& s) { report_step(opt.progress, stage, s); };
-  validate_options(opt);
+namespace {
 
-  std::vector<StageTime> times;
-  StageClock clock(times);
-  // Needles narrower than the boundary tolerance's width (epsilon / diagonal) go.
+// The input ring with needles narrower than the boundary tolerance's width
+// (epsilon / diagonal) removed, validated; what was removed, for the report.
+struct CleanBoundary {
+  Polygon polygon;
+  std::vector<std::size_t> removed_vertices;
+  std::vector<std::string> notes;
+};
+
+CleanBoundary clean_boundary(const Polygon& input, const ParameterizationOptions& opt) {
   const double needle_width = needle_width_for_ring(input, opt.tolerance_absolute, opt.tolerance_relative);
   PolygonCleaning cleaning = clean_polygon(input, needle_width);
   if (!cleaning.notes.empty())
     report_step(opt.progress, "cleaning", "note: " + cleaning_summary("the boundary", cleaning), -1,
                 ProgressEvent::Kind::Note);
-  const std::vector<std::size_t> removed_vertices = cleaning.removed_file_indices;
-  const std::vector<std::string> cleaning_notes = cleaning.notes;
-  Polygon poly = validate_cleaned_polygon(std::move(cleaning), needle_width);
-  clock.stop("boundary");
+  CleanBoundary out;
+  out.removed_vertices = cleaning.removed_file_indices;
+  out.notes = cleaning.notes;
+  out.polygon = validate_cleaned_polygon(std::move(cleaning), needle_width);
+  return out;
+}
+
+// The automatic corner choice tried on the T-mesh: the best few candidates'
+// front halves run concurrently and the one with the fewest inverted cells,
+// then the highest min + mean triangle quality, is kept.
+struct CornerTrials {
   Corners corners;
   std::vector<CornerTrial> trials;
-  bool trial_is_run = false;             // the corner trials ran at the run's own resolution
-  std::optional<FrontResult> kept_trial;  // then the kept choice's result, not computed again
-  std::vector<ProgressEvent> kept_events;
-  if (opt.corners) {
-    corners = corners_from_file_indices(poly, *opt.corners);
-  } else {
-    std::vector<Corners> cands = corner_candidates(poly, static_cast<std::size_t>(std::max(1, opt.corner_trials)));
-    corners = cands.front();
-    if (cands.size() > 1) {
-      // Try the best few automatic choices (with the initial level capped at 5,
-      // which is the full problem for the default options) and keep the one with
-      // the fewest inverted cells, then the highest min + mean triangle quality
-      // (the minimum guards validity margins, the mean the overall distortion).
-      ParameterizationOptions topt = opt;
-      topt.smoothing.progress = nullptr;
-      topt.corner_trials = 1;
-      // Trials at most at the default resolution (level <= 5, tolerance no finer
-      // than the default 1e-5 diag^2): for the default options that is the run
-      // itself; for fine user settings it keeps the trials cheap.
-      topt.initial_level = std::min(opt.initial_level, 5);
-      const double d = bounding_box_diagonal(poly);
-      const double tol = opt.tolerance_absolute ? *opt.tolerance_absolute : opt.tolerance_relative * d * d;
-      topt.tolerance_absolute = std::max(tol, 1e-5 * d * d);
-      trial_is_run = topt.initial_level == opt.initial_level && *topt.tolerance_absolute == tol;
-      // The trials are independent front halves: they run concurrently, each
-      // collecting its log lines (replayed for the kept one if it is the run).
-      // Each finished trial is reported at once (from its worker thread, one
-      // event at a time); the sweeps of concurrent trials are not.
-      std::vector<std::optional<FrontResult>> results(cands.size());
-      std::vector<std::vector<ProgressEvent>> events(cands.size());
-      std::mutex report_mutex;
-      std::size_t finished = 0;
-      // A trial that needs more than --max-cells with its corners (an
-      // InputError; the options were validated above) ranks last.
-      std::vector<std::exception_ptr> over_budget(cands.size());
-      for_each_concurrently(cands.size(), [&](std::size_t k) {
-        ParameterizationOptions o = topt;
-        o.progress = nullptr;
-        if (opt.progress)
-          o.progress = [&events, &report_mutex, &opt, k](const ProgressEvent& e) {
-            if (e.kind == ProgressEvent::Kind::Step || e.kind == ProgressEvent::Kind::Note) {
-              events[k].push_back(e);
-              return;
-            }
-            // Sweeps and stages of concurrent trials are not shown, but the
-            // caller hears that the run is alive and may stop it (Ctrl-C).
-            ProgressEvent beat;
-            beat.kind = ProgressEvent::Kind::Heartbeat;
-            beat.stage = "corners";
-            beat.text = "corner trial " + std::to_string(k + 1) + " working";
-            const std::lock_guard<std::mutex> lock(report_mutex);
-            opt.progress(beat);
-          };
-        try {
-          results[k].emplace(optimize_front(BoundaryMap(poly, cands[k]), o));
-        } catch (const InputError& e) {
-          over_budget[k] = std::current_exception();
-          if (!opt.progress) return;
-          const std::lock_guard<std::mutex> lock(report_mutex);
-          report_step(opt.progress, "corners",
-                      "corners: trial " + std::to_string(++finished) + " of " + std::to_string(cands.size()) +
-                          " failed (choice " + std::to_string(k + 1) + "): " + e.what());
-          return;
-        }
-        if (!opt.progress) return;
-        const FrontResult& t = *results[k];
-        std::ostringstream s;
-        const std::lock_guard<std::mutex> lock(report_mutex);
-        s << "corners: trial " << ++finished << " of " << cands.size() << " done (choice " << k + 1 << "): "
-          << t.quality_optimized.inverted_cells << " inverted cells, min/mean quality "
-          << t.quality_optimized.min_quality << " / " << t.quality_optimized.mean_quality;
-        report_step(opt.progress, "corners", s.str());
-      });
-      for (std::size_t k = 0; k < cands.size(); ++k) {
-        constexpr double kWorst = -std::numeric_limits<double>::infinity();
-        if (!results[k]) {
-          trials.push_back({cands[k].index, std::numeric_limits<std::size_t>::max(), kWorst, kWorst});
-          continue;
-        }
-        const FrontResult& t = *results[k];
-        trials.push_back({cands[k].index, t.quality_optimized.inverted_cells, t.quality_optimized.min_quality,
+  std::optional<FrontResult> kept;  // the kept choice's front half, if the trials ran at the run's resolution
+  std::vector<ProgressEvent> kept_events;  // its progress, replayed if it is the run's
+};
+
+// The front half of one trial, its steps and notes collected in `events`;
+// sweeps of concurrent trials become heartbeats (the caller may stop the run).
+FrontResult run_corner_trial(const Polygon& poly, const Corners& corners, ParameterizationOptions o,
+                             const ProgressCallback& progress, std::size_t k, std::vector<ProgressEvent>& events,
+                             std::mutex& report_mutex) {
+  o.progress = nullptr;
+  if (progress)
+    o.progress = [&events, &report_mutex, &progress, k](const ProgressEvent& e) {
+      if (e.kind == ProgressEvent::Kind::Step || e.kind == ProgressEvent::Kind::Note) {
+        events.push_back(e);
+        return;
+      }
+      ProgressEvent beat;
+      beat.kind = ProgressEvent::Kind::Heartbeat;
+      beat.stage = "corners";
+      beat.text = "corner trial " + std::to_string(k + 1) + " working";
+      const std::lock_guard<std::mutex> lock(report_mutex);
+      progress(beat);
+    };
+  return optimize_front(BoundaryMap(poly, corners), o);
+}
+
+CornerTrials try_corners(const Polygon& poly, std::vector<Corners> cands, const ParameterizationOptions& opt) {
+  // Trials at most at the default resolution (level <= 5, tolerance no finer
+  // than the default 1e-5 diag^2): for the default options that is the run
+  // itself; for fine user settings it keeps the trials cheap.
+  ParameterizationOptions topt = opt;
+  topt.smoothing.progress = nullptr;
+  topt.corner_trials = 1;
+  topt.initial_level = std::min(opt.initial_level, 5);
+  const double d = bounding_box_diagonal(poly);
+  const double tol = opt.tolerance_absolute ? *opt.tolerance_absolute : opt.tolerance_relative * d * d;
+  topt.tolerance_absolute = std::max(tol, 1e-5 * d * d);
+  const bool trial_is_run = topt.initial_level == opt.initial_level && *topt.tolerance_absolute == tol;
+  std::vector<std::optional<FrontResult>> results(cands.size());
+  std::vector<std::vector<ProgressEvent>> events(cands.size());
+  std::mutex report_mutex;
+  std::size_t finished = 0;
+  // A trial that needs more than max_cells with its corners (an InputError;
+  // the options were validated) ranks last.
+  std::vector<std::exception_ptr> over_budget(cands.size());
+  auto report = [&](const std::string& text) {  // under report_mutex
+    report_step(opt.progress, "corners",
+                "corners: trial " + std::to_string(++finished) + " of " + std::to_string(cands.size()) + text);
+  };
+  for_each_concurrently(cands.size(), [&](std::size_t k) {
+    try {
+      results[k].emplace(run_corner_trial(poly, cands[k], topt, opt.progress, k, events[k], report_mutex));
+    } catch (const InputError& e) {
+      over_budget[k] = std::current_exception();
+      const std::lock_guard<std::mutex> lock(report_mutex);
+      if (opt.progress) report(" failed (choice " + std::to_string(k + 1) + "): " + e.what());
+      return;
+    }
+    const FrontResult& t = *results[k];
+    std::ostringstream s;
+    s << " done (choice " << k + 1 << "): " << t.quality_optimized.inverted_cells
+      << " inverted cells, min/mean quality " << t.quality_optimized.min_quality << " / "
+      << t.quality_optimized.mean_quality;
+    const std::lock_guard<std::mutex> lock(report_mutex);
+    if (opt.progress) report(s.str());
+  });
+  CornerTrials out;
+  for (std::size_t k = 0; k < cands.size(); ++k) {
+    constexpr double kWorst = -std::numeric_limits<double>::infinity();
+    if (!results[k]) {
+      out.trials.push_back({cands[k].index, std::numeric_limits<std::size_t>::max(), kWorst, kWorst});
+      continue;
+    }
+    const FrontResult& t = *results[k];
+    out.trials.push_back({cands[k].index, t.quality_optimized.inverted_cells, t.quality_optimized.min_quality,
                           t.quality_optimized.mean_quality});
-      }
-      const std::size_t best = best_corner_trial(trials);
-      if (!results[best]) std::rethrow_exception(over_budget[best]);  // every trial needed more cells
-      clock.stop("corner_trials");
-      if (trial_is_run) {
-        kept_trial = std::move(results[best]);
-        kept_trial->tolerance_is_relative = !opt.tolerance_absolute.has_value();
-        kept_events = std::move(events[best]);
-      }
-      corners = cands[best];
-      corners.explanation += " Of the " + std::to_string(cands.size()) +
+  }
+  const std::size_t best = best_corner_trial(out.trials);
+  if (!results[best]) std::rethrow_exception(over_budget[best]);  // every trial needed more cells
+  if (trial_is_run) {
+    out.kept = std::move(results[best]);
+    out.kept->tolerance_is_relative = !opt.tolerance_absolute.has_value();
+    out.kept_events = std::move(events[best]);
+  }
+  out.corners = std::move(cands[best]);
+  out.corners.explanation += " Of the " + std::to_string(cands.size()) +
                              " best automatic choices, tried on the T-mesh, this one gave the fewest inverted "
                              "cells and the best min + mean triangle quality (choice " + std::to_string(best + 1) + ").";
-      log("corners", "corners: tried " + std::to_string(cands.size()) + " automatic choices, kept choice " +
-          std::to_string(best + 1));
-    }
-  }
-  // A corner where the polygon is straight or reflex makes the corner cell
-  // degenerate or folded whatever the interior does: reject it.
+  report_step(opt.progress, "corners",
+              "corners: tried " + std::to_string(cands.size()) + " automatic choices, kept choice " +
+                  std::to_string(best + 1));
+  return out;
+}
+
+// A corner where the polygon is straight or reflex makes the corner cell
+// degenerate or folded whatever the interior does: an input error.
+void require_convex_corners(const Polygon& poly, const Corners& corners, bool given) {
   for (int k = 0; k < 4; ++k) {
     const std::size_t n = poly.vertices.size(), i = corners.index[k];
     const Eigen::Vector2d a = poly.vertices[(i + n - 1) % n], b = poly.vertices[i], c = poly.vertices[(i + 1) % n];
-    const Eigen::Vector2d u = b - a, w = c - b;
-    if (!(u.x() * w.y() - u.y() * w.x() > 0.0)) {
-      std::ostringstream s;
-      s << "corner " << k << " (file vertex " << poly.file_index[i] << ") has an inner angle of "
-        << corners.inner_angle_deg[k]
-        << " degrees: corners must be convex vertices (inner angle below 180); "
-        << (opt.corners ? "pick another vertex, or leave `corners` unset for the automatic choice"
-                        : "the polygon has fewer than four strictly convex vertices: give `corners`");
-      throw InputError(s.str());
+    if (cross(b - a, c - b) > 0.0) continue;
+    std::ostringstream s;
+    s << "corner " << k << " (file vertex " << poly.file_index[i] << ") has an inner angle of "
+      << corners.inner_angle_deg[k] << " degrees: corners must be convex vertices (inner angle below 180); "
+      << (given ? "pick another vertex, or leave `corners` unset for the automatic choice"
+                : "the polygon has fewer than four strictly convex vertices: give `corners`");
+    throw InputError(s.str());
+  }
+}
+
+}  // namespace
+
+FrontResult run_front(const Polygon& input, const ParameterizationOptions& opt) {
+  validate_options(opt);
+  std::vector<StageTime> times;
+  StageClock clock(times);
+  CleanBoundary boundary = clean_boundary(input, opt);
+  Polygon& poly = boundary.polygon;
+  clock.stop("boundary");
+  CornerTrials chosen;
+  if (opt.corners) {
+    chosen.corners = corners_from_file_indices(poly, *opt.corners);
+  } else {
+    std::vector<Corners> cands = corner_candidates(poly, static_cast<std::size_t>(std::max(1, opt.corner_trials)));
+    if (cands.size() > 1) {
+      chosen = try_corners(poly, std::move(cands), opt);
+      clock.stop("corner_trials");
+    } else {
+      chosen.corners = cands.front();
     }
   }
+  const Corners& corners = chosen.corners;
+  require_convex_corners(poly, corners, opt.corners.has_value());
   {
     std::ostringstream s;
     s << "boundary: " << poly.vertices.size() << " vertices, corners (file indices) "
       << poly.file_index[corners.index[0]] << "," << poly.file_index[corners.index[1]] << ","
       << poly.file_index[corners.index[2]] << "," << poly.file_index[corners.index[3]]
       << (opt.corners ? " (given)" : " (automatic)");
-    log("boundary", s.str());
+    report_step(opt.progress, "boundary", s.str());
   }
   clock.stop("boundary");
-  FrontResult r = kept_trial ? std::move(*kept_trial)
-                             : optimize_front(BoundaryMap(std::move(poly), std::move(corners)), opt);
-  if (kept_trial) {
+  FrontResult r = chosen.kept ? std::move(*chosen.kept) : optimize_front(BoundaryMap(std::move(poly), corners), opt);
+  if (chosen.kept) {
     r.boundary = BoundaryMap(r.boundary.polygon(), corners);  // the same corners, with their explanation
     if (opt.progress)
-      for (const ProgressEvent& e : kept_events) opt.progress(e);
+      for (const ProgressEvent& e : chosen.kept_events) opt.progress(e);
     // The kept trial's stages were part of the trials' wall time.
     double kept = 0.0;
     for (const StageTime& t : r.times) kept += t.seconds;
@@ -431,9 +460,9 @@ FrontResult run_front(const Polygon& input, const ParameterizationOptions& opt) 
       if (t.stage == "corner_trials") t.seconds = std::max(0.0, t.seconds - kept);
   }
   times.insert(times.end(), r.times.begin(), r.times.end());
-  r.removed_vertices = removed_vertices;
-  r.cleaning_notes = cleaning_notes;
-  r.corner_trials = std::move(trials);
+  r.removed_vertices = std::move(boundary.removed_vertices);
+  r.cleaning_notes = std::move(boundary.notes);
+  r.corner_trials = std::move(chosen.trials);
   r.times = std::move(times);
   return r;
 }
