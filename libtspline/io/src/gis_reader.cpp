@@ -202,75 +202,133 @@ DomainInput read_geojson_domain(const std::string& geojson, const DomainReadOpti
 
 namespace {
 
-DomainInput read_dataset(GDALDataset& dataset, const std::string& path, const DomainReadOptions& options) {
-  DomainInput out;
-  GDALDataset* ds = &dataset;
-  // The layer.
-  OGRLayer* layer = nullptr;
-  if (options.layer) {
-    const std::string& name = *options.layer;
-    layer = ds->GetLayerByName(name.c_str());
-    if (!layer && !name.empty() && std::all_of(name.begin(), name.end(), [](char c) { return c >= '0' && c <= '9'; })) {
-      const long index = std::stol(name);
-      if (index < ds->GetLayerCount()) layer = ds->GetLayer(static_cast<int>(index));
-    }
-    if (!layer) {
-      std::string names;
-      for (int i = 0; i < ds->GetLayerCount(); ++i) names += std::string(i ? ", " : "") + ds->GetLayer(i)->GetName();
-      throw InputError(path + ": no layer '" + name + "' (layers: " + names + ")");
-    }
+// The layer named (or numbered) `name`. \throw InputError listing the layers.
+OGRLayer* named_layer(GDALDataset& ds, const std::string& path, const std::string& name) {
+  OGRLayer* layer = ds.GetLayerByName(name.c_str());
+  if (!layer && !name.empty() && std::all_of(name.begin(), name.end(), [](char c) { return c >= '0' && c <= '9'; })) {
+    const long index = std::stol(name);
+    if (index < ds.GetLayerCount()) layer = ds.GetLayer(static_cast<int>(index));
   }
-  std::vector<RawPolygon> polys;
+  if (layer) return layer;
+  std::string names;
+  for (int i = 0; i < ds.GetLayerCount(); ++i) names += std::string(i ? ", " : "") + ds.GetLayer(i)->GetName();
+  throw InputError(path + ": no layer '" + name + "' (layers: " + names + ")");
+}
+
+// The polygons of the chosen layer (the named one, or the first with polygons)
+// and feature (all, or the one asked for).
+struct LayerPolygons {
+  OGRLayer* layer = nullptr;
+  std::vector<RawPolygon> polygons;
+};
+
+LayerPolygons layer_polygons(GDALDataset& ds, const std::string& path, const DomainReadOptions& options) {
+  LayerPolygons out;
   std::size_t features = 0;
   auto read_layer = [&](OGRLayer* l, bool all_features) {
-    polys.clear();
+    out.polygons.clear();
     features = 0;
     l->ResetReading();
     for (const auto& f : *l) {
       if (all_features || !options.feature || *options.feature == features)
-        collect(f->GetGeometryRef(), features, polys);
+        collect(f->GetGeometryRef(), features, out.polygons);
       ++features;
     }
   };
-  if (!layer) {  // the first layer with polygons
-    for (int i = 0; i < ds->GetLayerCount() && !layer; ++i) {
-      read_layer(ds->GetLayer(i), true);
-      if (!polys.empty()) layer = ds->GetLayer(i);
-    }
-    if (!layer) throw InputError(path + ": no layer with polygons");
+  if (options.layer) out.layer = named_layer(ds, path, *options.layer);
+  for (int i = 0; i < ds.GetLayerCount() && !out.layer; ++i) {  // the first layer with polygons
+    read_layer(ds.GetLayer(i), true);
+    if (!out.polygons.empty()) out.layer = ds.GetLayer(i);
   }
-  read_layer(layer, false);
+  if (!out.layer) throw InputError(path + ": no layer with polygons");
+  read_layer(out.layer, false);
   if (options.feature && *options.feature >= features)
     throw InputError(path + ": `feature` " + std::to_string(*options.feature) + " out of range (layer '" +
-                     layer->GetName() + "' has " + std::to_string(features) + " features)");
-  if (polys.empty()) throw InputError(path + ": layer '" + std::string(layer->GetName()) + "' has no polygons");
-  std::size_t pick = 0;
+                     out.layer->GetName() + "' has " + std::to_string(features) + " features)");
+  if (out.polygons.empty())
+    throw InputError(path + ": layer '" + std::string(out.layer->GetName()) + "' has no polygons");
+  return out;
+}
+
+// The polygon asked for by index, or the one of largest area.
+std::size_t pick_polygon(const std::vector<RawPolygon>& polys, const std::string& path,
+                         const DomainReadOptions& options) {
   if (options.polygon_index) {
     if (*options.polygon_index >= polys.size())
       throw InputError(path + ": `polygon_index` " + std::to_string(*options.polygon_index) + " out of range (" +
                        std::to_string(polys.size()) + " polygons)");
-    pick = *options.polygon_index;
-  } else {
-    for (std::size_t i = 1; i < polys.size(); ++i)
-      if (std::abs(signed_area(polys[i].outer)) > std::abs(signed_area(polys[pick].outer))) pick = i;
+    return *options.polygon_index;
   }
-  RawPolygon chosen = std::move(polys[pick]);
-  if (chosen.outer.empty()) throw InputError(path + ": the chosen polygon has an empty outer ring");
+  std::size_t pick = 0;
+  for (std::size_t i = 1; i < polys.size(); ++i)
+    if (std::abs(signed_area(polys[i].outer)) > std::abs(signed_area(polys[pick].outer))) pick = i;
+  return pick;
+}
 
-  nlohmann::json d = {{"format", ds->GetDriver() ? ds->GetDriver()->GetDescription() : "unknown"},
-                      {"layer", layer->GetName()},
+// Longitude/latitude in `srs` projected to metres by the Lambert azimuthal
+// equal-area projection at the outer ring's centroid (areas kept); what was
+// done goes to the description `d`.
+void project_to_metres(RawPolygon& chosen, const OGRSpatialReference& srs, const std::string& path,
+                       nlohmann::json& d) {
+  for (const auto& p : chosen.outer)
+    if (!(std::abs(p.x()) <= 360.0 && std::abs(p.y()) <= 90.0))
+      throw InputError(path + ": coordinates (" + std::to_string(p.x()) + ", " + std::to_string(p.y()) +
+                       ") are not longitude/latitude degrees, which the layer's CRS (" +
+                       d["crs"].get<std::string>() + ") requires; set `planar` to keep them as they are");
+  const Eigen::Vector2d c = centroid(chosen.outer);
+  OGRSpatialReference src(srs);
+  src.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
+  OGRSpatialReference dst;
+  dst.CopyGeogCSFrom(&src);
+  dst.SetProjCS("Lambert azimuthal equal-area at the domain's centroid");
+  dst.SetLAEA(c.y(), c.x(), 0.0, 0.0);
+  dst.SetLinearUnits(SRS_UL_METER, 1.0);
+  dst.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
+  std::unique_ptr<OGRCoordinateTransformation> ct(OGRCreateCoordinateTransformation(&src, &dst));
+  if (!ct) throw InputError(path + ": cannot project the layer's CRS with PROJ" + QuietGdal::last());
+  auto project = [&](Ring& r) {
+    std::vector<double> x(r.size()), y(r.size());
+    for (std::size_t i = 0; i < r.size(); ++i) x[i] = r[i].x(), y[i] = r[i].y();
+    std::vector<int> ok(r.size(), 0);
+    if (!r.empty() && !ct->Transform(r.size(), x.data(), y.data(), nullptr, ok.data()))
+      throw InputError(path + ": PROJ could not project the coordinates" + QuietGdal::last());
+    for (std::size_t i = 0; i < r.size(); ++i) {
+      if (!ok[i] || !std::isfinite(x[i]) || !std::isfinite(y[i]))
+        throw InputError(path + ": PROJ could not project vertex " + std::to_string(i));
+      r[i] = {x[i], y[i]};
+    }
+  };
+  project(chosen.outer);
+  for (auto& h : chosen.holes) project(h);
+  char* proj4 = nullptr;
+  dst.exportToProj4(&proj4);
+  d["projection"] = {{"name", "Lambert azimuthal equal-area"},
+                     {"lon_0", c.x()},
+                     {"lat_0", c.y()},
+                     {"centre", "area centroid of the outer ring in longitude/latitude"},
+                     {"proj", proj4 ? proj4 : ""}};
+  CPLFree(proj4);
+  d["units"] = "m";
+}
+
+DomainInput read_dataset(GDALDataset& ds, const std::string& path, const DomainReadOptions& options) {
+  LayerPolygons found = layer_polygons(ds, path, options);
+  const std::size_t pick = pick_polygon(found.polygons, path, options);
+  RawPolygon chosen = std::move(found.polygons[pick]);
+  if (chosen.outer.empty()) throw InputError(path + ": the chosen polygon has an empty outer ring");
+  nlohmann::json d = {{"format", ds.GetDriver() ? ds.GetDriver()->GetDescription() : "unknown"},
+                      {"layer", found.layer->GetName()},
                       {"feature", chosen.feature},
                       {"polygon", pick},
-                      {"polygons", polys.size()},
+                      {"polygons", found.polygons.size()},
                       {"holes", chosen.holes.size()},
                       {"crs", nullptr},
                       {"projection", nullptr}};
-  const OGRSpatialReference* layer_srs = layer->GetSpatialRef();
+  const OGRSpatialReference* layer_srs = found.layer->GetSpatialRef();
   OGRSpatialReference given_srs;
   if (options.crs) {  // the caller's CRS instead of the layer's
     if (given_srs.SetFromUserInput(options.crs->c_str()) != OGRERR_NONE)
-      throw InputError(path + ": crs '" + *options.crs + "' is not a CRS that GDAL knows" +
-                       QuietGdal::last());
+      throw InputError(path + ": crs '" + *options.crs + "' is not a CRS that GDAL knows" + QuietGdal::last());
     layer_srs = &given_srs;
   }
   if (layer_srs) d["crs"] = layer_srs->GetName() ? layer_srs->GetName() : "unnamed";
@@ -279,52 +337,13 @@ DomainInput read_dataset(GDALDataset& dataset, const std::string& path, const Do
   // no CRS: the coordinates are kept.
   if (layer_srs && layer_srs->GetName() && std::strncmp(layer_srs->GetName(), "Undefined", 9) == 0) layer_srs = nullptr;
   const bool geographic = layer_srs && layer_srs->IsGeographic();
-  if (options.planar || !geographic) {
+  if (options.planar || !geographic)
     d["units"] = options.planar ? "as in the file (`planar`)"
                  : layer_srs    ? std::string(layer_srs->IsProjected() ? "projected CRS, kept" : "CRS kept")
                                 : std::string("no CRS: planar, as in the file");
-  } else {
-    // Geographic: check the range, then project to LAEA at the centroid.
-    for (const auto& p : chosen.outer)
-      if (!(std::abs(p.x()) <= 360.0 && std::abs(p.y()) <= 90.0))
-        throw InputError(path + ": coordinates (" + std::to_string(p.x()) + ", " + std::to_string(p.y()) +
-                         ") are not longitude/latitude degrees, which the layer's CRS (" +
-                         d["crs"].get<std::string>() + ") requires; set `planar` to keep them as they are");
-    const Eigen::Vector2d c = centroid(chosen.outer);
-    OGRSpatialReference src(*layer_srs);
-    src.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
-    OGRSpatialReference dst;
-    dst.CopyGeogCSFrom(&src);
-    dst.SetProjCS("Lambert azimuthal equal-area at the domain's centroid");
-    dst.SetLAEA(c.y(), c.x(), 0.0, 0.0);
-    dst.SetLinearUnits(SRS_UL_METER, 1.0);
-    dst.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
-    std::unique_ptr<OGRCoordinateTransformation> ct(OGRCreateCoordinateTransformation(&src, &dst));
-    if (!ct) throw InputError(path + ": cannot project the layer's CRS with PROJ" + QuietGdal::last());
-    auto project = [&](Ring& r) {
-      std::vector<double> x(r.size()), y(r.size());
-      for (std::size_t i = 0; i < r.size(); ++i) x[i] = r[i].x(), y[i] = r[i].y();
-      std::vector<int> ok(r.size(), 0);
-      if (!r.empty() && !ct->Transform(r.size(), x.data(), y.data(), nullptr, ok.data()))
-        throw InputError(path + ": PROJ could not project the coordinates" + QuietGdal::last());
-      for (std::size_t i = 0; i < r.size(); ++i) {
-        if (!ok[i] || !std::isfinite(x[i]) || !std::isfinite(y[i]))
-          throw InputError(path + ": PROJ could not project vertex " + std::to_string(i));
-        r[i] = {x[i], y[i]};
-      }
-    };
-    project(chosen.outer);
-    for (auto& h : chosen.holes) project(h);
-    char* proj4 = nullptr;
-    dst.exportToProj4(&proj4);
-    d["projection"] = {{"name", "Lambert azimuthal equal-area"},
-                       {"lon_0", c.x()},
-                       {"lat_0", c.y()},
-                       {"centre", "area centroid of the outer ring in longitude/latitude"},
-                       {"proj", proj4 ? proj4 : ""}};
-    CPLFree(proj4);
-    d["units"] = "m";
-  }
+  else
+    project_to_metres(chosen, *layer_srs, path, d);
+  DomainInput out;
   out.outer = to_polygon(chosen.outer);
   for (const auto& h : chosen.holes) out.holes.push_back(to_polygon(h));
   out.description = std::move(d);
