@@ -130,11 +130,11 @@ Eigen::Vector3d GmshRemeshGeometry::face_normal(int tag, const Eigen::Vector2d& 
   return f_.face_sign.at(tag) * n;
 }
 
-CadFeatures detect_features(double feature_angle) {
-  CadFeatures f;
-  double box[6];
-  gmsh::model::getBoundingBox(-1, -1, box[0], box[1], box[2], box[3], box[4], box[5]);
-  f.diagonal = Eigen::Vector3d(box[3] - box[0], box[4] - box[1], box[5] - box[2]).norm();
+namespace {
+
+// The model's faces that carry mesh triangles, sorted. \throw InputError for
+// elements other than linear triangles, or no triangles at all.
+std::vector<int> triangulated_faces() {
   gmsh::vectorpair faces;
   gmsh::model::getEntities(faces, 2);
   std::vector<int> face_tags;
@@ -152,62 +152,46 @@ CadFeatures detect_features(double feature_angle) {
     if (count > 0) face_tags.push_back(tag);
   }
   if (face_tags.empty()) throw InputError("the mesh has no triangles on the model's surfaces");
-  std::map<int, std::unique_ptr<GmshFace>> gf;
-  for (int tag : face_tags) {
-    gf[tag] = std::make_unique<GmshFace>(tag);
-    f.face_sign[tag] = face_orientation(*gf[tag]);
-    gmsh::vectorpair bnd;
-    gmsh::model::getBoundary({{2, tag}}, bnd, false, true, false);
-    for (const auto& [d, c] : bnd) {
-      f.curve_faces[std::abs(c)].push_back(tag);
-      f.face_curves[tag].push_back(std::abs(c));
-    }
-  }
-  // Dihedral angle across each curve: the largest angle between the oriented face
-  // normals at points along it. Features: sharp curves, curves of one face side
-  // (boundaries), non-manifold curves.
-  toolkit::UnionFind smoothly_joined(face_tags.size());
-  auto index_of = [&](int tag) {
-    return static_cast<int>(std::lower_bound(face_tags.begin(), face_tags.end(), tag) - face_tags.begin());
-  };
   std::sort(face_tags.begin(), face_tags.end());
-  for (const auto& [curve, fs] : f.curve_faces) {
-    std::vector<double> lo, hi;
-    gmsh::model::getParametrizationBounds(1, curve, lo, hi);
-    std::vector<Eigen::Vector3d> xs;
-    std::vector<double> ts;
-    for (int k = 1; k <= 5; ++k) {
-      std::vector<double> x;
-      ts.push_back(lo[0] + (hi[0] - lo[0]) * k / 6.0);
-      gmsh::model::getValue(1, curve, {ts.back()}, x);
-      xs.push_back(vec3(x));
-    }
-    double extent = 0.0;
-    for (const auto& x : xs) extent = std::max(extent, (x - xs.front()).norm());
-    const bool degenerate = !(extent > 1e-9 * f.diagonal);  // e.g. an OCC sphere's pole
-    double dihedral = 0.0;
-    if (fs.size() == 2 && !degenerate) {
-      for (std::size_t k = 0; k < xs.size(); ++k) {
-        std::array<Eigen::Vector3d, 2> n;
-        for (int side = 0; side < 2; ++side) {
-          const GmshFace& face = *gf[fs[side]];
-          n[side] = f.face_sign[fs[side]] *
-                    unit_normal(face.evaluate(uv_of_boundary_point(face, 1, curve, ts[k], xs[k], 1e-7 * f.diagonal), 1));
-        }
-        dihedral = std::max(dihedral, std::acos(std::clamp(n[0].dot(n[1]), -1.0, 1.0)));
-      }
-    } else if (!degenerate) {
-      dihedral = std::numbers::pi;
-    }
-    f.curve_dihedral[curve] = dihedral;
-    if (degenerate) continue;
-    if (fs.size() != 2 || dihedral > feature_angle) {
-      f.feature_curves.push_back(curve);
-    } else if (fs[0] != fs[1]) {
-      smoothly_joined.unite(static_cast<std::size_t>(index_of(fs[0])), static_cast<std::size_t>(index_of(fs[1])));
-    }
+  return face_tags;
+}
+
+// The dihedral angle across `curve`: the largest angle between the oriented
+// normals of its two faces at five points along it; pi for a curve of one face
+// side or of more than two (a boundary, non-manifold); nullopt for a curve
+// that is a point (an OCC sphere's pole).
+std::optional<double> curve_dihedral(int curve, const std::vector<int>& fs,
+                                     const std::map<int, std::unique_ptr<GmshFace>>& gf, const CadFeatures& f) {
+  std::vector<double> lo, hi;
+  gmsh::model::getParametrizationBounds(1, curve, lo, hi);
+  std::vector<Eigen::Vector3d> xs;
+  std::vector<double> ts;
+  for (int k = 1; k <= 5; ++k) {
+    std::vector<double> x;
+    ts.push_back(lo[0] + (hi[0] - lo[0]) * k / 6.0);
+    gmsh::model::getValue(1, curve, {ts.back()}, x);
+    xs.push_back(vec3(x));
   }
-  std::sort(f.feature_curves.begin(), f.feature_curves.end());
+  double extent = 0.0;
+  for (const auto& x : xs) extent = std::max(extent, (x - xs.front()).norm());
+  if (!(extent > 1e-9 * f.diagonal)) return std::nullopt;
+  if (fs.size() != 2) return std::numbers::pi;
+  double dihedral = 0.0;
+  for (std::size_t k = 0; k < xs.size(); ++k) {
+    std::array<Eigen::Vector3d, 2> n;
+    for (int side = 0; side < 2; ++side) {
+      const GmshFace& face = *gf.at(fs[side]);
+      n[side] = f.face_sign.at(fs[side]) *
+                unit_normal(face.evaluate(uv_of_boundary_point(face, 1, curve, ts[k], xs[k], 1e-7 * f.diagonal), 1));
+    }
+    dihedral = std::max(dihedral, std::acos(std::clamp(n[0].dot(n[1]), -1.0, 1.0)));
+  }
+  return dihedral;
+}
+
+// The patches: faces joined across smooth curves (union-find over face_tags'
+// positions), numbered in order of first face.
+void group_into_patches(CadFeatures& f, const std::vector<int>& face_tags, toolkit::UnionFind& smoothly_joined) {
   for (int tag : face_tags) {
     bool smooth = false;
     for (int c : f.face_curves[tag]) {
@@ -224,6 +208,10 @@ CadFeatures detect_features(double feature_angle) {
     f.patch_faces[it->second].push_back(face_tags[i]);
     f.patch_of_face[face_tags[i]] = it->second;
   }
+}
+
+// The model's points: corners where a feature curve ends, and the faces at each.
+void find_corners(CadFeatures& f) {
   std::set<int> corners;
   for (const auto& [curve, fs] : f.curve_faces) {
     std::vector<int> up, down;
@@ -236,6 +224,45 @@ CadFeatures detect_features(double feature_angle) {
     }
   }
   f.corners.assign(corners.begin(), corners.end());
+}
+
+}  // namespace
+
+CadFeatures detect_features(double feature_angle) {
+  CadFeatures f;
+  double box[6];
+  gmsh::model::getBoundingBox(-1, -1, box[0], box[1], box[2], box[3], box[4], box[5]);
+  f.diagonal = Eigen::Vector3d(box[3] - box[0], box[4] - box[1], box[5] - box[2]).norm();
+  const std::vector<int> face_tags = triangulated_faces();
+  std::map<int, std::unique_ptr<GmshFace>> gf;
+  for (int tag : face_tags) {
+    gf[tag] = std::make_unique<GmshFace>(tag);
+    f.face_sign[tag] = face_orientation(*gf[tag]);
+    gmsh::vectorpair bnd;
+    gmsh::model::getBoundary({{2, tag}}, bnd, false, true, false);
+    for (const auto& [d, c] : bnd) {
+      f.curve_faces[std::abs(c)].push_back(tag);
+      f.face_curves[tag].push_back(std::abs(c));
+    }
+  }
+  // Features: sharp curves, curves of one face side (boundaries), non-manifold
+  // curves; faces across the other curves are one patch.
+  toolkit::UnionFind smoothly_joined(face_tags.size());
+  auto index_of = [&](int tag) {
+    return static_cast<std::size_t>(std::lower_bound(face_tags.begin(), face_tags.end(), tag) - face_tags.begin());
+  };
+  for (const auto& [curve, fs] : f.curve_faces) {
+    const std::optional<double> dihedral = curve_dihedral(curve, fs, gf, f);
+    f.curve_dihedral[curve] = dihedral.value_or(0.0);
+    if (!dihedral) continue;
+    if (fs.size() != 2 || *dihedral > feature_angle)
+      f.feature_curves.push_back(curve);
+    else if (fs[0] != fs[1])
+      smoothly_joined.unite(index_of(fs[0]), index_of(fs[1]));
+  }
+  std::sort(f.feature_curves.begin(), f.feature_curves.end());
+  group_into_patches(f, face_tags, smoothly_joined);
+  find_corners(f);
   return f;
 }
 
