@@ -109,6 +109,14 @@ struct PetscPoissonSolver::Impl {
   std::vector<double> load;  // own rows of b
   std::vector<std::pair<PetscInt, int>> cell_cols;  // add_cell scratch: (global column, row of Kloc), sorted
 
+  // The steps of begin(), in order.
+  void number_rows(const AnalysisSpace& space, const std::vector<int>& interior, int ni);
+  std::vector<int> own_row_cells(const AnalysisSpace& space, const std::vector<int>& interior,
+                                 std::vector<std::int64_t>& start, std::vector<int>& cells) const;
+  void build_pattern(const AnalysisSpace& space, const std::vector<int>& interior, int ni,
+                     const std::vector<std::int64_t>& start, const std::vector<int>& cells);
+  bool own(PetscInt g) const { return g >= row_begin && g < row_end; }
+
   void release() {
     if (A) MatDestroy(&A);
     if (b) VecDestroy(&b);
@@ -140,30 +148,35 @@ bool PetscPoissonSolver::accepts(std::size_t ni) const {
   return ni >= impl_->options.auto_threshold;
 }
 
-std::vector<int> PetscPoissonSolver::begin(const AnalysisSpace& space, const std::vector<int>& interior, int ni) {
-  Impl& m = *impl_;
-  m.release();
-#if defined(__GLIBC__)
-  // Building the analysis space (hash maps of the basis and T-mesh
-  // construction) leaves ~0.35 GB of freed small blocks in the heap at 1e6
-  // DOFs, which glibc keeps resident; the matrix arrays below are large
-  // (mmap'ed) and would not reuse them. Give them back first.
-  malloc_trim(0);
-#endif
+namespace {
+
+// The interior numbers of the functions of cell c (-1: Dirichlet), in a buffer
+// reused from call to call.
+class CellRows {
+ public:
+  CellRows(const AnalysisSpace& space, const std::vector<int>& interior) : space_(space), interior_(interior) {}
+  const std::vector<int>& operator()(int c) {
+    space_.cell_dofs(static_cast<std::size_t>(c), rows_);
+    for (int& a : rows_) a = interior_[a];
+    return rows_;
+  }
+
+ private:
+  const AnalysisSpace& space_;
+  const std::vector<int>& interior_;
+  std::vector<int> rows_;
+};
+
+}  // namespace
+
+// Owner of interior DOF i: the process whose block of cells [r nc / P,
+// (r+1) nc / P) holds the first cell of its support. Each process finds it in
+// its own block (whose patches it holds), the minimum over the processes is
+// the first cell. Rows are numbered process by process (perm).
+void PetscPoissonSolver::Impl::number_rows(const AnalysisSpace& space, const std::vector<int>& interior, int ni) {
   const int nc = static_cast<int>(space.num_cells());
   const int P = process_count(), R = process_rank();
-  // The interior numbers of the functions of global cell c (-1: Dirichlet).
-  std::vector<int> cell_rows;
-  const auto rows_of = [&](int c) -> const std::vector<int>& {
-    space.cell_dofs(static_cast<std::size_t>(c), cell_rows);
-    for (int& a : cell_rows) a = interior[a];
-    return cell_rows;
-  };
-
-  // Owner of interior DOF i: the process whose block of cells
-  // [r nc / P, (r+1) nc / P) holds the first cell of its support. Each
-  // process finds it in its own block (whose patches it holds), the minimum
-  // over the processes is the first cell.
+  CellRows rows_of(space, interior);
   std::vector<int> first_cell(static_cast<std::size_t>(ni), std::numeric_limits<int>::max());
   for (int c = block_start(nc, R, P); c < block_start(nc, R + 1, P); ++c)
     for (int i : rows_of(c))
@@ -171,60 +184,69 @@ std::vector<int> PetscPoissonSolver::begin(const AnalysisSpace& space, const std
   if (P > 1) MPI_Allreduce(MPI_IN_PLACE, first_cell.data(), ni, MPI_INT, MPI_MIN, PETSC_COMM_WORLD);
   std::vector<int> owner(static_cast<std::size_t>(ni));
   std::vector<PetscInt> count(static_cast<std::size_t>(P) + 1, 0);
-  {
-    std::vector<int> starts(static_cast<std::size_t>(P) + 1);
-    for (int q = 0; q <= P; ++q) starts[q] = block_start(nc, q, P);
-    for (int i = 0; i < ni; ++i) {  // block of cell c: the last r with starts[r] <= c
-      const int c = first_cell[i];
-      const int r = static_cast<int>(std::upper_bound(starts.begin(), starts.end() - 1, c) - starts.begin()) - 1;
-      owner[i] = std::max(r, 0);
-      ++count[owner[i] + 1];
-    }
+  std::vector<int> starts(static_cast<std::size_t>(P) + 1);
+  for (int q = 0; q <= P; ++q) starts[q] = block_start(nc, q, P);
+  for (int i = 0; i < ni; ++i) {  // block of cell c: the last r with starts[r] <= c
+    const int c = first_cell[i];
+    const int r = static_cast<int>(std::upper_bound(starts.begin(), starts.end() - 1, c) - starts.begin()) - 1;
+    owner[i] = std::max(r, 0);
+    ++count[owner[i] + 1];
   }
   std::vector<int>().swap(first_cell);
   for (int q = 0; q < P; ++q) count[q + 1] += count[q];  // prefix: first row of each process
-  m.row_begin = count[R];
-  m.row_end = count[R + 1];
-  m.n = ni;
-  m.perm.assign(static_cast<std::size_t>(ni), 0);
-  {
-    std::vector<PetscInt> next(count.begin(), count.end() - 1);
-    for (int i = 0; i < ni; ++i) m.perm[i] = next[owner[i]]++;
-  }
-  std::vector<int>().swap(owner);
-  const auto own = [&m](PetscInt g) { return g >= m.row_begin && g < m.row_end; };
+  row_begin = count[R];
+  row_end = count[R + 1];
+  n = ni;
+  perm.assign(static_cast<std::size_t>(ni), 0);
+  std::vector<PetscInt> next(count.begin(), count.end() - 1);
+  for (int i = 0; i < ni; ++i) perm[i] = next[owner[i]]++;
+}
 
-  // The cells of this process: every cell in the support of an own row. Row k
-  // of K is sum over those cells of their element rows, so the process adds
-  // them up itself and no entry is sent to another process; a cell on the
-  // border of two processes' rows is computed by both (about 1 % of the cells
-  // with 2 processes at 1e6 DOFs). Those cells lie in the patches this process
-  // holds (the patches of its block and their neighbours: analysis_space.h).
-  const PetscInt nloc = m.row_end - m.row_begin;
-  std::vector<std::int64_t> start(static_cast<std::size_t>(nloc) + 1, 0);  // own row -> cells (CSR)
+// The cells of this process: every cell in the support of an own row, listed
+// per own row (CSR: start, cells). Row k of K is the sum over those cells of
+// their element rows, so the process adds them up itself and no entry is sent
+// to another process; a cell on the border of two processes' rows is computed
+// by both (about 1 % of the cells with 2 processes at 1e6 DOFs). Those cells
+// lie in the patches this process holds (the patches of its block and their
+// neighbours: analysis_space.h). Returns them once each.
+std::vector<int> PetscPoissonSolver::Impl::own_row_cells(const AnalysisSpace& space, const std::vector<int>& interior,
+                                                         std::vector<std::int64_t>& start,
+                                                         std::vector<int>& cells) const {
+  const int nc = static_cast<int>(space.num_cells());
+  CellRows rows_of(space, interior);
+  const PetscInt nloc = row_end - row_begin;
+  start.assign(static_cast<std::size_t>(nloc) + 1, 0);
   std::vector<int> cells_mine;
   for (int c = 0; c < nc; ++c) {
     if (!space.holds(space.cell(static_cast<std::size_t>(c)).first)) continue;
     bool mine = false;
     for (int i : rows_of(c))
-      if (i >= 0 && own(m.perm[i])) {
-        ++start[m.perm[i] - m.row_begin + 1];
+      if (i >= 0 && own(perm[i])) {
+        ++start[perm[i] - row_begin + 1];
         mine = true;
       }
     if (mine) cells_mine.push_back(c);
   }
   for (PetscInt k = 0; k < nloc; ++k) start[k + 1] += start[k];
-  std::vector<int> cells(static_cast<std::size_t>(start[nloc]));
-  {
-    std::vector<std::int64_t> fill(start.begin(), start.end() - 1);
-    for (int c : cells_mine)
-      for (int i : rows_of(c))
-        if (i >= 0 && own(m.perm[i])) cells[fill[m.perm[i] - m.row_begin]++] = c;
-  }
+  cells.assign(static_cast<std::size_t>(start[nloc]), 0);
+  std::vector<std::int64_t> fill(start.begin(), start.end() - 1);
+  for (int c : cells_mine)
+    for (int i : rows_of(c))
+      if (i >= 0 && own(perm[i])) cells[fill[perm[i] - row_begin]++] = c;
+  return cells_mine;
+}
 
-  // Row k's columns: the interior functions of the cells of its support, each
-  // once (mark), in global numbers, sorted. Pass 1 counts them (and collects
-  // the off-process ones); pass 2 writes them into hypre's arrays.
+// The own rows' pattern as hypre's ParCSR matrix, values zero. Row k's
+// columns: the interior functions of the cells of its support, each once
+// (mark), in global numbers, sorted. Pass 1 counts them (and collects the
+// off-process ones); pass 2 writes them into hypre's arrays (hypre's
+// conventions: diag column indices local, the diagonal entry first in each
+// row, which its smoothers rely on; offd column indices into the ascending
+// col_map_offd).
+void PetscPoissonSolver::Impl::build_pattern(const AnalysisSpace& space, const std::vector<int>& interior, int ni,
+                                             const std::vector<std::int64_t>& start, const std::vector<int>& cells) {
+  CellRows rows_of(space, interior);
+  const PetscInt nloc = row_end - row_begin;
   std::vector<PetscInt> mark(static_cast<std::size_t>(ni), -1), cols;
   const auto row_columns = [&](PetscInt k) {
     cols.clear();
@@ -232,7 +254,7 @@ std::vector<int> PetscPoissonSolver::begin(const AnalysisSpace& space, const std
       for (int i : rows_of(cells[e])) {
         if (i < 0 || mark[i] == k) continue;
         mark[i] = k;
-        cols.push_back(m.perm[i]);
+        cols.push_back(perm[i]);
       }
     std::sort(cols.begin(), cols.end());
   };
@@ -260,51 +282,63 @@ std::vector<int> PetscPoissonSolver::begin(const AnalysisSpace& space, const std
   if (nnz_d > std::numeric_limits<HYPRE_Int>::max() || nnz_o > std::numeric_limits<HYPRE_Int>::max())
     throw NumericalError("iterative solver: " + std::to_string(nnz_d + nnz_o) +
                          " matrix entries on one process exceed hypre's 32-bit index (use more processes)");
-
-  // hypre_ParCSRMatrix of the own rows (hypre's conventions: diag column
-  // indices local, the diagonal entry first in each row, which its smoothers
-  // rely on; offd column indices into the ascending col_map_offd).
-  HYPRE_BigInt starts[2] = {static_cast<HYPRE_BigInt>(m.row_begin), static_cast<HYPRE_BigInt>(m.row_end)};
-  m.parcsr = hypre_ParCSRMatrixCreate(PETSC_COMM_WORLD, ni, ni, starts, starts,
-                                      static_cast<HYPRE_Int>(offd_cols.size()), static_cast<HYPRE_Int>(nnz_d),
-                                      static_cast<HYPRE_Int>(nnz_o));
-  if (!m.parcsr || hypre_ParCSRMatrixInitialize_v2(m.parcsr, HYPRE_MEMORY_HOST) != 0)
+  HYPRE_BigInt starts[2] = {static_cast<HYPRE_BigInt>(row_begin), static_cast<HYPRE_BigInt>(row_end)};
+  parcsr = hypre_ParCSRMatrixCreate(PETSC_COMM_WORLD, ni, ni, starts, starts, static_cast<HYPRE_Int>(offd_cols.size()),
+                                    static_cast<HYPRE_Int>(nnz_d), static_cast<HYPRE_Int>(nnz_o));
+  if (!parcsr || hypre_ParCSRMatrixInitialize_v2(parcsr, HYPRE_MEMORY_HOST) != 0)
     throw NumericalError("iterative solver: hypre_ParCSRMatrixCreate failed");
-  hypre_CSRMatrix* diag = hypre_ParCSRMatrixDiag(m.parcsr);
-  hypre_CSRMatrix* offd = hypre_ParCSRMatrixOffd(m.parcsr);
-  m.di = hypre_CSRMatrixI(diag);
-  m.dj = hypre_CSRMatrixJ(diag);
-  m.dv = hypre_CSRMatrixData(diag);
-  m.oi = hypre_CSRMatrixI(offd);
-  m.oj = hypre_CSRMatrixJ(offd);
-  m.ov = hypre_CSRMatrixData(offd);
-  m.col_map = hypre_ParCSRMatrixColMapOffd(m.parcsr);
-  std::copy(offd_cols.begin(), offd_cols.end(), m.col_map);
-  m.di[0] = 0;
-  m.oi[0] = 0;
+  hypre_CSRMatrix* diag = hypre_ParCSRMatrixDiag(parcsr);
+  hypre_CSRMatrix* offd = hypre_ParCSRMatrixOffd(parcsr);
+  di = hypre_CSRMatrixI(diag);
+  dj = hypre_CSRMatrixJ(diag);
+  dv = hypre_CSRMatrixData(diag);
+  oi = hypre_CSRMatrixI(offd);
+  oj = hypre_CSRMatrixJ(offd);
+  ov = hypre_CSRMatrixData(offd);
+  col_map = hypre_ParCSRMatrixColMapOffd(parcsr);
+  std::copy(offd_cols.begin(), offd_cols.end(), col_map);
+  di[0] = 0;
+  oi[0] = 0;
   for (PetscInt k = 0; k < nloc; ++k) {
-    m.di[k + 1] = m.di[k] + d_nnz[k];
-    m.oi[k + 1] = m.oi[k] + o_nnz[k];
+    di[k + 1] = di[k] + d_nnz[k];
+    oi[k + 1] = oi[k] + o_nnz[k];
   }
   std::vector<HYPRE_Int>().swap(d_nnz);
   std::vector<HYPRE_Int>().swap(o_nnz);
   std::fill(mark.begin(), mark.end(), -1);
   for (PetscInt k = 0; k < nloc; ++k) {
     row_columns(k);
-    HYPRE_Int pd = m.di[k], po = m.oi[k];
-    m.dj[pd++] = static_cast<HYPRE_Int>(k);  // the diagonal first
+    HYPRE_Int pd = di[k], po = oi[k];
+    dj[pd++] = static_cast<HYPRE_Int>(k);  // the diagonal first
     for (PetscInt g : cols) {
-      if (g == m.row_begin + k) continue;
+      if (g == row_begin + k) continue;
       if (own(g))
-        m.dj[pd++] = static_cast<HYPRE_Int>(g - m.row_begin);
+        dj[pd++] = static_cast<HYPRE_Int>(g - row_begin);
       else
-        m.oj[po++] = static_cast<HYPRE_Int>(
+        oj[po++] = static_cast<HYPRE_Int>(
             std::lower_bound(offd_cols.begin(), offd_cols.end(), static_cast<HYPRE_BigInt>(g)) - offd_cols.begin());
     }
   }
-  std::fill(m.dv, m.dv + nnz_d, 0.0);
-  std::fill(m.ov, m.ov + nnz_o, 0.0);
-  m.load.assign(static_cast<std::size_t>(nloc), 0.0);
+  std::fill(dv, dv + nnz_d, 0.0);
+  std::fill(ov, ov + nnz_o, 0.0);
+  load.assign(static_cast<std::size_t>(nloc), 0.0);
+}
+
+std::vector<int> PetscPoissonSolver::begin(const AnalysisSpace& space, const std::vector<int>& interior, int ni) {
+  Impl& m = *impl_;
+  m.release();
+#if defined(__GLIBC__)
+  // Building the analysis space (hash maps of the basis and T-mesh
+  // construction) leaves ~0.35 GB of freed small blocks in the heap at 1e6
+  // DOFs, which glibc keeps resident; the matrix arrays below are large
+  // (mmap'ed) and would not reuse them. Give them back first.
+  malloc_trim(0);
+#endif
+  m.number_rows(space, interior, ni);
+  std::vector<std::int64_t> start;  // own row -> cells (CSR)
+  std::vector<int> cells;
+  std::vector<int> cells_mine = m.own_row_cells(space, interior, start, cells);
+  m.build_pattern(space, interior, ni, start, cells);
   return cells_mine;
 }
 
