@@ -32,6 +32,7 @@
 #include "bench_front_args.h"
 #include "tspline/io/polygon_reader.h"
 #include "tspline/validity/map_quality.h"
+#include "tspline/validity/map_energy.h"
 #include "tspline/validity/map_untangling.h"
 #include "tspline/pipeline/adaptive_parameterization.h"
 #include "tspline/pipeline/parameterization.h"

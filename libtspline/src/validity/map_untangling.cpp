@@ -1,4 +1,5 @@
 // Global untangling of a T-spline map; see map_untangling.h for the method.
+#include "tspline/validity/map_energy.h"
 #include "tspline/validity/map_untangling.h"
 
 #include <ceres/gradient_problem.h>

@@ -41,7 +41,7 @@
 #include <string>
 
 #include "tspline/validity/map_certification.h"
-#include "tspline/validity/map_energy.h"
+#include "tspline/validity/map_energy_options.h"
 #include "tspline/spline/tspline_map.h"
 
 namespace tspline {

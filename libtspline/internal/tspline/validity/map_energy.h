@@ -1,4 +1,5 @@
 #pragma once
+// Internal (not installed): the options are map_energy_options.h.
 // The distortion energy of a T-spline map as a function of its free control
 // points, for the global untangling and smoothing of the map itself
 // (map_untangling.h).
@@ -38,7 +39,7 @@
 // gradient cost O(samples x 16 + functions x 16) per element, without storing
 // basis values per sample.
 //
-// Hessian (projected Newton, issue 23). On a sample J is linear in the control
+// Hessian (projected Newton). On a sample J is linear in the control
 // points (J = dS/d(xi, eta), S = X / w, w independent of them), so the
 // sample's Hessian over the element's control points is A^T H_J A with A the
 // 4 x (2 n) map from control points to vec J and H_J the 4 x 4 Hessian of the
@@ -64,46 +65,9 @@
 #include "tspline/detail/tensor_grid.h"
 #include "tspline/spline/bezier_extraction.h"
 #include "tspline/spline/tspline_map.h"
+#include "tspline/validity/map_energy_options.h"
 
 namespace tspline {
-
-enum class ElementWeighting {
-  Uniform,  ///< every Bezier element has weight 1
-  Area      ///< weight = parametric area (an integral over the square)
-};
-
-struct MapEnergyOptions {
-  /// Points per direction per sub-square: Gauss-Lobatto (end points
-  /// included, n in [3, 5]) or Gauss-Legendre (n in [1, 6]).
-  int gauss = 5;
-  /// Gauss-Lobatto: samples on every element's corners and edges too. Measured
-  /// on Newfoundland: with 4 x 4 Gauss-Legendre points the optimizer folded the
-  /// map between samples along element edges (1,317 folded samples after the
-  /// first sample refinement, then a long second continuation).
-  bool lobatto = true;
-  double theta = 1.0 / 128;  ///< weight of the area term, in [0, 1)
-  int max_sample_level = 3;  ///< sample levels 0..this (2^l x 2^l sub-squares per element)
-  /// Uniform: small elements along a detailed coastline count as much as large
-  /// interior ones, which is where maps fold (measured on the bundled
-  /// coastlines: fewer continuation stages than Area).
-  ElementWeighting weighting = ElementWeighting::Uniform;
-  /// Threads for the energy and gradient (0: std::thread::hardware_concurrency).
-  int threads = 0;
-  /// Per basis function: may it move? Empty: every function not touching the
-  /// border. Otherwise only those marked (and not touching the border) are
-  /// variables, and only the elements they touch enter the energy (a local
-  /// problem: the rest of the map is fixed and adds a constant).
-  std::vector<char> movable;
-};
-
-/// Statistics over the current sample points (not a certificate).
-struct SampleStats {
-  std::size_t points = 0;
-  std::size_t nonpositive = 0;  ///< samples with det J <= 0
-  double min_det = 0.0;         ///< min det J / L^2 (normalized: 1 on average)
-  double min_mean_ratio = 0.0;  ///< min J_r
-  double mean_mean_ratio = 0.0; ///< weighted mean J_r
-};
 
 class MapEnergy {
  public:
