@@ -13,6 +13,7 @@ namespace {
 constexpr int kMax = BernsteinPoly::kMaxDegree;
 
 static_assert(2 * kMax <= kMaxBinomial, "products of Bernstein polynomials need C(2 kMax, k)");
+static_assert(kMax <= kMaxSplitDegree, "bernstein_subdivide splits rows of up to kMaxSplitDegree + 1 values");
 
 }  // namespace
 
@@ -38,11 +39,8 @@ void bernstein_values(int deg, double s, double* out) {
   for (int i = 0; i <= deg; ++i) out[i] = binomial(deg, i) * sp[i] * rp[deg - i];
 }
 
-namespace {
-
-// de Casteljau split of one coefficient row (stride `stride`, deg+1 values) at 1/2.
-void split_row(const double* in, int deg, int stride, double* left, double* right) {
-  double w[kMax + 1];
+void bernstein_split_half(const double* in, int deg, int stride, double* left, double* right) {
+  double w[kMaxSplitDegree + 1];
   for (int i = 0; i <= deg; ++i) w[i] = in[i * stride];
   for (int k = 0; k <= deg; ++k) {
     left[k * stride] = w[0];
@@ -50,8 +48,6 @@ void split_row(const double* in, int deg, int stride, double* left, double* righ
     for (int i = 0; i < deg - k; ++i) w[i] = 0.5 * (w[i] + w[i + 1]);
   }
 }
-
-}  // namespace
 
 // ---------------------------------------------------------------------------
 // Bernstein arithmetic
@@ -125,20 +121,6 @@ BernsteinPoly bernstein_axpy(const BernsteinPoly& a, double f, const BernsteinPo
   BernsteinPoly r = a;
   for (int k = 0; k < r.size(); ++k) r.c[k] += f * b.c[k];
   return r;
-}
-
-std::array<BernsteinPoly, 4> bernstein_subdivide(const BernsteinPoly& p) {
-  // Split in s row by row into left/right, then each in t column by column.
-  BernsteinPoly ls(p.m, p.n), rs(p.m, p.n);
-  for (int j = 0; j <= p.n; ++j)
-    split_row(&p.c[(p.m + 1) * j], p.m, 1, &ls.c[(p.m + 1) * j], &rs.c[(p.m + 1) * j]);
-  std::array<BernsteinPoly, 4> q = {BernsteinPoly(p.m, p.n), BernsteinPoly(p.m, p.n), BernsteinPoly(p.m, p.n),
-                                    BernsteinPoly(p.m, p.n)};
-  for (int i = 0; i <= p.m; ++i) {
-    split_row(&ls.c[i], p.n, p.m + 1, &q[0].c[i], &q[2].c[i]);
-    split_row(&rs.c[i], p.n, p.m + 1, &q[1].c[i], &q[3].c[i]);
-  }
-  return q;
 }
 
 }  // namespace tspline::detail

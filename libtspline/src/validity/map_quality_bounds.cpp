@@ -59,6 +59,7 @@ struct Poly12 {
 };
 
 static_assert(2 * kQ <= kMaxBinomial, "products of degree-kQ polynomials need C(2 kQ, k)");
+static_assert(kQ <= detail::kMaxSplitDegree, "bernstein_subdivide splits rows of up to kMaxSplitDegree + 1 values");
 
 Poly12 to_poly12(const BernsteinPoly& p) {
   Poly12 r(p.m, p.n);
@@ -113,30 +114,6 @@ Poly12 elevate12(Poly12 p) {
     p = q;
   }
   return p;
-}
-
-// de Casteljau split at 1/2 of deg + 1 values with the given stride.
-void split_row12(const double* in, int deg, int stride, double* left, double* right) {
-  double w[kQ + 1];
-  for (int i = 0; i <= deg; ++i) w[i] = in[i * stride];
-  for (int k = 0; k <= deg; ++k) {
-    left[k * stride] = w[0];
-    right[(deg - k) * stride] = w[deg - k];
-    for (int i = 0; i < deg - k; ++i) w[i] = 0.5 * (w[i] + w[i + 1]);
-  }
-}
-
-// The four quarters SW, SE, NW, NE (as detail::bernstein_subdivide).
-std::array<Poly12, 4> subdivide12(const Poly12& p) {
-  Poly12 ls(p.m, p.n), rs(p.m, p.n);
-  for (int j = 0; j <= p.n; ++j)
-    split_row12(&p.c[(p.m + 1) * j], p.m, 1, &ls.c[(p.m + 1) * j], &rs.c[(p.m + 1) * j]);
-  std::array<Poly12, 4> q = {Poly12(p.m, p.n), Poly12(p.m, p.n), Poly12(p.m, p.n), Poly12(p.m, p.n)};
-  for (int i = 0; i <= p.m; ++i) {
-    split_row12(&ls.c[i], p.n, p.m + 1, &q[0].c[i], &q[2].c[i]);
-    split_row12(&rs.c[i], p.n, p.m + 1, &q[1].c[i], &q[3].c[i]);
-  }
-  return q;
 }
 
 // One patch (the element or a sub-patch): the components of N_s, N_t (1) and
@@ -456,7 +433,7 @@ ElementQualityBound bound_element(const BezierElement& e, const std::vector<Eige
     const auto sx = bernstein_subdivide(p.nsx), sy = bernstein_subdivide(p.nsy);
     const auto tx = bernstein_subdivide(p.ntx), ty = bernstein_subdivide(p.nty);
     std::array<Poly12, 4> a, s2, t2;
-    if (p.ratio) a = subdivide12(p.a), s2 = subdivide12(p.s2), t2 = subdivide12(p.t2);
+    if (p.ratio) a = bernstein_subdivide(p.a), s2 = bernstein_subdivide(p.s2), t2 = bernstein_subdivide(p.t2);
     const double h = 0.5 * p.size;
     for (int q = 0; q < 4; ++q) {
       Patch c{sx[q], sy[q], tx[q], ty[q], a[q], s2[q], t2[q], p.ratio,

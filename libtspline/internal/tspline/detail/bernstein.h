@@ -34,9 +34,30 @@ BernsteinPoly bernstein_ds(const BernsteinPoly& a);
 BernsteinPoly bernstein_dt(const BernsteinPoly& a);
 /// a + f b, same bidegree.
 BernsteinPoly bernstein_axpy(const BernsteinPoly& a, double f, const BernsteinPoly& b);
+/// de Casteljau split at 1/2 of the deg + 1 values in[0], in[stride], ...
+/// (deg <= kMaxSplitDegree) into the coefficients of the left and right halves,
+/// written with the same stride.
+inline constexpr int kMaxSplitDegree = 24;
+void bernstein_split_half(const double* in, int deg, int stride, double* left, double* right);
+
 /// The four quarters of [0,1]^2 split at s = t = 1/2 (de Casteljau), each
-/// re-parameterized on [0,1]^2: SW, SE, NW, NE.
-std::array<BernsteinPoly, 4> bernstein_subdivide(const BernsteinPoly& p);
+/// re-parameterized on [0,1]^2: SW, SE, NW, NE. `Poly` is BernsteinPoly or any
+/// type with its layout (bidegree m, n; coefficients c[i + (m+1) j]; a
+/// constructor Poly(m, n)), such as the bidegree-(12, 12) polynomials of the
+/// quality bounds.
+template <class Poly>
+std::array<Poly, 4> bernstein_subdivide(const Poly& p) {
+  // Split in s row by row into left/right, then each in t column by column.
+  Poly ls(p.m, p.n), rs(p.m, p.n);
+  for (int j = 0; j <= p.n; ++j)
+    bernstein_split_half(&p.c[(p.m + 1) * j], p.m, 1, &ls.c[(p.m + 1) * j], &rs.c[(p.m + 1) * j]);
+  std::array<Poly, 4> q = {Poly(p.m, p.n), Poly(p.m, p.n), Poly(p.m, p.n), Poly(p.m, p.n)};
+  for (int i = 0; i <= p.m; ++i) {
+    bernstein_split_half(&ls.c[i], p.n, p.m + 1, &q[0].c[i], &q[2].c[i]);
+    bernstein_split_half(&rs.c[i], p.n, p.m + 1, &q[1].c[i], &q[3].c[i]);
+  }
+  return q;
+}
 
 /// The Bernstein basis values B_i^deg(s), i = 0..deg (deg <= BernsteinPoly::kMaxDegree), into out[0..deg].
 void bernstein_values(int deg, double s, double* out);
