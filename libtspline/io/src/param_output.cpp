@@ -1,6 +1,5 @@
 #include "tspline/io/param_output.h"
 
-#include <Eigen/LU>
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -12,6 +11,7 @@
 #include <utility>
 
 #include "toolkit/io/atomic_file.h"
+#include "tspline/detail/vtu_fields.h"
 #include "tspline/io/bezier_vtu.h"
 #include "tspline/io/cell_grid.h"
 #include "tspline/io/front_output.h"
@@ -28,26 +28,18 @@ namespace tspline::io {
 
 toolkit::io::VtuMesh surface_vtu(const TSplineMap& map, int k) {
   if (k < 1 || k > 64) throw toolkit::InputError("samples per cell edge must be in [1, 64]");
-  std::vector<double> jr, det, js;
-  std::vector<Eigen::Vector2d> param;
-  const std::size_t points = map.mesh().num_cells() * static_cast<std::size_t>((k + 1) * (k + 1));
-  jr.reserve(points), det.reserve(points), js.reserve(points), param.reserve(points);
+  detail::SampleQualityFields quality;
+  quality.reserve(map.mesh().num_cells() * static_cast<std::size_t>((k + 1) * (k + 1)));
   // The samples of a cell from its Bezier elements (element_map.h).
   const BezierExtraction extraction(map.basis());
   CellMapEvaluator cell_map(extraction, map.control_points());
   toolkit::io::VtuMesh out = cell_grid_vtu(map.mesh(), k, [&](int c, const Eigen::Vector2d& uv) {
     cell_map.set_cell(c);
     const MapDerivatives d = cell_map.at(uv);
-    jr.push_back(mean_ratio_jacobian(d.J));
-    det.push_back(d.J.determinant());
-    js.push_back(scaled_jacobian(d.J));
-    param.push_back(uv);
+    quality.push(d.J, uv);
     return d.x;
   });
-  out.point_scalars["mean_ratio_jacobian"] = std::move(jr);
-  out.point_scalars["det_jacobian"] = std::move(det);
-  out.point_scalars["scaled_jacobian"] = std::move(js);
-  out.point_vectors["parametric"] = std::move(param);
+  quality.attach_to(out);
   return out;
 }
 
@@ -95,8 +87,8 @@ toolkit::io::VtuMesh physical_tmesh_vtu(const TSplineMap& map, int k, const MapC
   if (quality && quality->size() != mesh.num_cells()) quality = nullptr;
   const double nan = std::numeric_limits<double>::quiet_NaN();
   toolkit::io::VtuMesh out;
-  std::vector<Eigen::Vector2d> param;
-  std::vector<int> vertex, hanging, boundary;
+  detail::TMeshPointFields fields;
+  std::vector<int> vertex;
   // One point per parametric position: a segment is sampled from its
   // lexicographically smaller end, so both cells along it get the same doubles.
   std::map<std::pair<double, double>, int> index;
@@ -107,10 +99,9 @@ toolkit::io::VtuMesh physical_tmesh_vtu(const TSplineMap& map, int k, const MapC
     if (added) {
       cell_map.set_cell(c);
       out.points.push_back(cell_map.at(uv).x);
-      param.push_back(uv);
+      fields.push(uv, v >= 0 && mesh.vertex_is_hanging(v),
+                  uv.x() == 0.0 || uv.x() == 1.0 || uv.y() == 0.0 || uv.y() == 1.0);
       vertex.push_back(v);
-      hanging.push_back(v >= 0 && mesh.vertex_is_hanging(v) ? 1 : 0);
-      boundary.push_back(uv.x() == 0.0 || uv.x() == 1.0 || uv.y() == 0.0 || uv.y() == 1.0 ? 1 : 0);
     }
     return it->second;
   };
@@ -154,8 +145,7 @@ toolkit::io::VtuMesh physical_tmesh_vtu(const TSplineMap& map, int k, const MapC
   }
   // The points were counted as they came: the arrays at their final size (all
   // patches' parts are held at once before they are merged).
-  out.points.shrink_to_fit(), param.shrink_to_fit(), vertex.shrink_to_fit();
-  hanging.shrink_to_fit(), boundary.shrink_to_fit();
+  out.points.shrink_to_fit(), vertex.shrink_to_fit(), fields.shrink_to_fit();
   out.cell_ints["level"] = std::move(level);
   out.cell_ints["valid"] = std::move(valid);
   out.cell_ints["certified"] = std::move(certified);
@@ -163,10 +153,8 @@ toolkit::io::VtuMesh physical_tmesh_vtu(const TSplineMap& map, int k, const MapC
   out.cell_scalars["relative_det_lower_bound"] = std::move(relative);
   out.cell_scalars["min_det_jacobian"] = std::move(min_det);
   out.cell_scalars["min_mean_ratio_jacobian"] = std::move(min_jr);
-  out.point_vectors["parametric"] = std::move(param);
   out.point_ints["vertex"] = std::move(vertex);
-  out.point_ints["hanging"] = std::move(hanging);
-  out.point_ints["boundary"] = std::move(boundary);
+  fields.attach_to(out);
   return out;
 }
 
