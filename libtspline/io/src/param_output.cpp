@@ -215,6 +215,24 @@ nlohmann::json certification_json(const MapCertification& c) {
           {"seconds", c.seconds}};
 }
 
+// One adaptive round's untangling of the control points.
+nlohmann::json untangling_json(const MapUntanglingReport& u) {
+  return {{"free_points", u.free_points},
+          {"elements", u.elements},
+          {"samples", u.samples},
+          {"stages", u.stages},
+          {"lbfgs_iterations", u.iterations},
+          {"evaluations", u.evaluations},
+          {"sample_refinements", u.sample_refinements},
+          {"local_repairs", u.local_repairs},
+          {"local_repairs_certified", u.local_repairs_certified},
+          {"samples_nonpositive_before", u.before.nonpositive},
+          {"samples_nonpositive_after", u.after.nonpositive},
+          {"certified", u.certified},
+          {"stop_reason", u.stop_reason},
+          {"seconds", u.seconds}};
+}
+
 // The options the result was computed with (what a rerun needs).
 nlohmann::json options_json(const ParameterizationOptions& o, const AdaptiveOptions& a) {
   using nlohmann::json;
@@ -393,21 +411,7 @@ nlohmann::json param_report(const ParameterizationResult& r, const std::string& 
                    {"cells_refined_after", it.refined_cells},
                    {"interpolation_relative_residual", it.fit.relative_residual},
                    {"control_points_optimized", it.control_points_optimized},
-                   {"untangling",
-                    {{"free_points", it.untangling.free_points},
-                     {"elements", it.untangling.elements},
-                     {"samples", it.untangling.samples},
-                     {"stages", it.untangling.stages},
-                     {"lbfgs_iterations", it.untangling.iterations},
-                     {"evaluations", it.untangling.evaluations},
-                     {"sample_refinements", it.untangling.sample_refinements},
-                     {"local_repairs", it.untangling.local_repairs},
-                     {"local_repairs_certified", it.untangling.local_repairs_certified},
-                     {"samples_nonpositive_before", it.untangling.before.nonpositive},
-                     {"samples_nonpositive_after", it.untangling.after.nonpositive},
-                     {"certified", it.untangling.certified},
-                     {"stop_reason", it.untangling.stop_reason},
-                     {"seconds", it.untangling.seconds}}},
+                   {"untangling", untangling_json(it.untangling)},
                    {"jacobian", map_quality_json(it.quality)},
                    {"seconds", it.seconds}});
   if (ad.certify)
