@@ -51,20 +51,10 @@ TMesh uniform(int level) {
   return m;
 }
 
-// Uniform level-`level` mesh, then `splits` random refinements and a balance.
+// Uniform level-`level` mesh, then `splits` random refinements (leaves below
+// level 7) and a balance.
 TMesh make_mesh(int level, int splits, unsigned seed) {
-  TMesh m(level);
-  std::mt19937 rng(seed);
-  for (int s = 0; s < splits; ++s) {
-    std::vector<int> leaves;
-    for (std::size_t n = 0; n < m.nodes().size(); ++n)
-      if (m.node(static_cast<int>(n)).is_leaf() && m.node(static_cast<int>(n)).level < 7)
-        leaves.push_back(static_cast<int>(n));
-    m.refine(leaves[std::uniform_int_distribution<std::size_t>(0, leaves.size() - 1)(rng)]);
-  }
-  m.balance();
-  m.build_topology();
-  return m;
+  return test_support::random_leaf_splits(level, splits, seed, /*max_level=*/7);
 }
 
 // Control points from a smooth nonlinear function of each interpolation point.

@@ -119,14 +119,14 @@ inline tspline::TMesh random_tmesh(unsigned seed, int rounds, int max_level) {
 }
 
 /// Uniform level-`level` mesh, then `splits` splits of random leaves of level
-/// below 6, then a balance.
-inline tspline::TMesh random_leaf_splits(int level, int splits, unsigned seed) {
+/// below `max_level`, then a balance.
+inline tspline::TMesh random_leaf_splits(int level, int splits, unsigned seed, int max_level = 6) {
   tspline::TMesh m(level);
   std::mt19937 rng(seed);
   for (int s = 0; s < splits; ++s) {
     std::vector<int> leaves;
     for (std::size_t n = 0; n < m.nodes().size(); ++n)
-      if (m.node(static_cast<int>(n)).is_leaf() && m.node(static_cast<int>(n)).level < 6)
+      if (m.node(static_cast<int>(n)).is_leaf() && m.node(static_cast<int>(n)).level < max_level)
         leaves.push_back(static_cast<int>(n));
     m.refine(leaves[std::uniform_int_distribution<std::size_t>(0, leaves.size() - 1)(rng)]);
   }
