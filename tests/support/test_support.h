@@ -97,6 +97,14 @@ inline AppRun run_program(const std::string& exe, const std::string& args, const
   return r;
 }
 
+/// `r` after requiring that it exited with 0 (its stdout and stderr shown if not).
+inline AppRun require_success(AppRun r) {
+  CAPTURE(r.out);
+  CAPTURE(r.err);
+  REQUIRE(r.exit_code == 0);
+  return r;
+}
+
 /// Runs `tspline ARGS` (or another built program) with stdout and stderr captured in files of `dir`.
 inline AppRun run_app(const std::string& args, const std::filesystem::path& dir,
                       const std::string& program = TSPLINE_APP_PATH) {
