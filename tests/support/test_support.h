@@ -111,6 +111,17 @@ inline AppRun run_app(const std::string& args, const std::filesystem::path& dir,
   return run_program(program, args, dir);
 }
 
+/// `tspline param POLYGON -q --out OUT [OPTIONS]` on a bundled polygon
+/// (polygon_file), required to succeed; returns the map's file OUT/tspline.json.
+inline std::filesystem::path param_polygon(const std::string& polygon, const std::filesystem::path& out,
+                                           const std::string& options = "") {
+  const AppRun r = run_app("param " + quoted(std::filesystem::path(polygon_file(polygon))) + " -q --out " +
+                               quoted(out) + (options.empty() ? "" : " " + options),
+                           out.parent_path());
+  REQUIRE(r.exit_code == 0);
+  return out / "tspline.json";
+}
+
 /// A balanced T-mesh from the uniform 4x4 mesh by `rounds` splits of the leaves
 /// containing random points (leaves of level max_level are not split).
 inline tspline::TMesh random_tmesh(unsigned seed, int rounds, int max_level) {
