@@ -98,25 +98,14 @@ TEST_SUITE("check_app") {
     const fs::path d = scratch("bad");
     std::ofstream(d / "bad.json") << "{\"format\": \"tspline\", \"version\": 99}";
     const std::string ok = write_map(d, "id", tspline::greville_identity_map(test_support::uniform_mesh(1)));
-    struct Case {
-      std::string args, needle;
-      int code;
-    };
-    const std::vector<Case> cases{
+    const std::vector<test_support::BadInvocation> cases{
         {"check '" + (d / "missing.json").string() + "'", "missing.json", 2},
         {"check '" + (d / "bad.json").string() + "'", "/version: unsupported version 99", 1},
         {"check", "TSPLINE", 1},
         {"check " + ok + " --depth 99", "--depth", 1},
         {"check " + ok + " --depth x", "--depth", 1},
     };
-    for (const Case& c : cases) {
-      const auto r = run_app(c.args, d);
-      CAPTURE(c.args);
-      CAPTURE(r.err);
-      CHECK(r.exit_code == c.code);
-      CHECK(count_lines(r.err) == 1);
-      CHECK(contains(r.err, c.needle));
-    }
+    for (const test_support::BadInvocation& c : cases) test_support::check_bad_invocation(c, d);
     const auto h = run_app("check --help", d);
     CHECK(h.exit_code == 0);
     CHECK(contains(h.out, "--depth"));

@@ -111,6 +111,25 @@ inline AppRun run_app(const std::string& args, const std::filesystem::path& dir,
   return run_program(program, args, dir);
 }
 
+/// A bad invocation of `tspline`: its arguments, a part of the one error line
+/// it must print, and its exit code.
+struct BadInvocation {
+  std::string args, needle;
+  int code;
+};
+
+/// Runs `c` (run_app in `dir`) and checks its exit code and its one error line;
+/// returns the run for further checks.
+inline AppRun check_bad_invocation(const BadInvocation& c, const std::filesystem::path& dir) {
+  const AppRun r = run_app(c.args, dir);
+  CAPTURE(c.args);
+  CAPTURE(r.err);
+  CHECK(r.exit_code == c.code);
+  CHECK(count_lines(r.err) == 1);
+  CHECK(contains(r.err, c.needle));
+  return r;
+}
+
 /// `tspline param POLYGON -q --out OUT [OPTIONS]` on a bundled polygon
 /// (polygon_file), required to succeed; returns the map's file OUT/tspline.json.
 inline std::filesystem::path param_polygon(const std::string& polygon, const std::filesystem::path& out,
