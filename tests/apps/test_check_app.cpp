@@ -115,11 +115,7 @@ TEST_SUITE("check_app") {
   TEST_CASE(
       "param: the report says certified_valid, with the counts and the bound; check agrees on tspline.json") {
     const fs::path d = scratch("param");
-    const auto r = run_app(
-        "param --layout single '" + test_support::polygon_file("disk.txt") + "' --out '" + (d / "out").string() + "' --quiet",
-        d);
-    CAPTURE(r.err);
-    REQUIRE(r.exit_code == 0);
+    const fs::path map = test_support::param_polygon("disk.txt", d / "out", "--layout single");
     const auto rep = nlohmann::json::parse(slurp(d / "out" / "report.json"));
     CHECK(rep["certified_valid"] == true);
     const auto& c = rep["certification"];
@@ -140,7 +136,7 @@ TEST_SUITE("check_app") {
     CHECK(u["samples_nonpositive_after"] == 0);
     CHECK(u["free_points"].get<int>() > 0);
     for (const auto& it : its) CHECK(it["certification"].contains("elements_certified"));
-    const auto k = run_app("check '" + (d / "out" / "tspline.json").string() + "'", d);
+    const auto k = run_app("check '" + map.string() + "'", d);
     CHECK(k.exit_code == 0);
     CHECK(contains(k.out, "certified: " + std::to_string(c["elements"].get<int>()) + " of "));
     const auto h = run_app("param --help", d);

@@ -137,6 +137,7 @@ inline std::filesystem::path param_polygon(const std::string& polygon, const std
   const AppRun r = run_app("param " + quoted(std::filesystem::path(polygon_file(polygon))) + " -q --out " +
                                quoted(out) + (options.empty() ? "" : " " + options),
                            out.parent_path());
+  CAPTURE(r.err);
   REQUIRE(r.exit_code == 0);
   return out / "tspline.json";
 }
