@@ -115,18 +115,15 @@ int run_check(const CheckArgs& args) {
 }  // namespace
 
 void add_check_command(CLI::App& app, CommandAction& action) {
-  auto args = std::make_shared<CheckArgs>();
-  CLI::App* check = app.add_subcommand(
-      "check",
+  const auto [check, args] = add_subcommand<CheckArgs>(
+      app, "check",
       "Certify that det J > 0 on the whole domain of a T-spline file, not only at sample points: on every "
       "Bezier "
       "element (T-mesh cell split by the knot lines of its functions) the numerator of det J is written as a "
       "polynomial of bidegree (8,8) in the Bernstein basis and proved positive by its coefficients, with de "
       "Casteljau subdivision where needed. Exit 0 if certified valid, 3 if not (the elements and parametric "
       "points where det J < 0 are listed)");
-  check->add_option("TSPLINE", args->file, "T-spline file (tspline.json, see docs/tspline_format.md)")
-      ->type_name("FILE")
-      ->required();
+  add_tspline_file_argument(*check, args->file);
   check
       ->add_option("--depth", args->depth,
                    "Subdivision levels at most per element (each halves both directions); an element neither "
@@ -136,7 +133,7 @@ void add_check_command(CLI::App& app, CommandAction& action) {
   check
       ->add_option("--max-listed", args->max_listed, "List at most this many elements that are not certified")
       ->capture_default_str();
-  check->callback([args, &action] { action = [args] { return run_check(*args); }; });
+  run_when_parsed(check, args, action, run_check);
 }
 
 }  // namespace tspline_app

@@ -79,11 +79,10 @@ void export_multipatch_bezier(const tspline::io::LoadedMaps& maps, const ExportA
 }  // namespace
 
 void add_export_command(CLI::App& app, CommandAction& action) {
-  using Args = ExportArgs;
-  auto a = std::make_shared<Args>();
-  CLI::App* cmd = app.add_subcommand(
-      "export", "Write the T-spline as rational Bezier elements with their extraction operators (Scott et al. "
-                "2011), the interchange form for T-spline IGA in finite element codes (docs/bezier_format.md)");
+  const auto [cmd, a] = add_subcommand<ExportArgs>(
+      app, "export",
+      "Write the T-spline as rational Bezier elements with their extraction operators (Scott et al. 2011), "
+      "the interchange form for T-spline IGA in finite element codes (docs/bezier_format.md)");
   cmd->add_option("TSPLINE", a->file, "T-spline file written by `tspline param`")->required();
   cmd->add_option("--bezier", a->bezier, "Output JSON file of Bezier elements");
   cmd->add_option("--msh", a->msh,

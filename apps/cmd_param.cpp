@@ -111,10 +111,9 @@ struct ParamArgs {
 }  // namespace
 
 void add_param_command(CLI::App& app, CommandAction& action) {
-  auto args = std::make_shared<ParamArgs>();
-  auto settings = std::make_shared<ParamSettings>();
-  CLI::App* param = app.add_subcommand(
-      "param", "Parameterize the domain bounded by a polygon: adapted T-mesh, Coons start, untangling and smoothing, "
+  const auto [param, args] = add_subcommand<ParamArgs>(
+      app, "param",
+      "Parameterize the domain bounded by a polygon: adapted T-mesh, Coons start, untangling and smoothing, "
       "cubic T-spline fit, Jacobian check and adaptive refinement");
   param
       ->add_option(
@@ -123,6 +122,7 @@ void add_param_command(CLI::App& app, CommandAction& action) {
           "(Shapefile, GeoPackage, KML, GML, GeoJSON, ...; longitude/latitude are projected to metres)")
       ->required();
   param->add_option("--out", args->out_dir, "Output directory (created if missing)")->required();
+  auto settings = std::make_shared<ParamSettings>();
   add_param_options(*param, settings);  // the table shared with the Python module (param_options.h)
   param->add_flag("--quiet,-q", args->quiet, "Print errors only");
   param->add_flag("--json", args->json_events,

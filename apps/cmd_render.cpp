@@ -45,9 +45,8 @@ const char* view_name(tspline::io::RenderView v) {
 }  // namespace
 
 void add_render_command(CLI::App& app, CommandAction& action) {
-  auto a = std::make_shared<RenderArgs>();
-  CLI::App* cmd = app.add_subcommand(
-      "render",
+  const auto [cmd, a] = add_subcommand<RenderArgs>(
+      app, "render",
       "Draw a picture (PNG, SVG or PDF) of the outputs in DIR without ParaView or a display: the map's mean ratio Jacobian J_r "
       "(jacobian), the curved T-mesh (tmesh), the control net (control-net) of `tspline param`, or u_h of "
       "`tspline poisson` (solution)");

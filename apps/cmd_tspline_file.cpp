@@ -134,14 +134,11 @@ int run_info(const std::string& file) {
 }  // namespace
 
 void add_tspline_file_commands(CLI::App& app, CommandAction& action) {
-  auto eval_args = std::make_shared<EvalArgs>();
-  CLI::App* eval = app.add_subcommand(
-      "eval",
+  const auto [eval, eval_args] = add_subcommand<EvalArgs>(
+      app, "eval",
       "Evaluate the T-spline map S(u, v) of a T-spline file at parametric points. Prints one line per point: "
       "'u v x y' (with --derivatives also 'dx/du dy/du dx/dv dy/dv det_J'), numbers with 17 significant digits");
-  eval->add_option("TSPLINE", eval_args->file, "T-spline file (tspline.json, see docs/tspline_format.md)")
-      ->type_name("FILE")
-      ->required();
+  add_tspline_file_argument(*eval, eval_args->file);
   eval->add_option("--at", eval_args->at,
                    "Parametric point U V, both in [0, 1] (u along xi, v along eta); repeat for several points, "
                    "printed in the given order")
@@ -152,17 +149,14 @@ void add_tspline_file_commands(CLI::App& app, CommandAction& action) {
       ->type_name("P");
   eval->add_flag("--derivatives,-d", eval_args->derivatives,
                  "Also print the Jacobian columns dS/du = (dx/du, dy/du), dS/dv = (dx/dv, dy/dv) and det J");
-  eval->callback([eval_args, &action] { action = [eval_args] { return run_eval(*eval_args); }; });
+  run_when_parsed(eval, eval_args, action, run_eval);
 
-  auto info_file = std::make_shared<std::string>();
-  CLI::App* info = app.add_subcommand(
-      "info",
+  const auto [info, info_file] = add_subcommand<std::string>(
+      app, "info",
       "Describe a T-spline file: format version, source, T-mesh counts (cells, vertices, hanging vertices, max "
       "level), blending functions by kind, bounding boxes of the control points and the boundary polygon, corners");
-  info->add_option("TSPLINE", *info_file, "T-spline file (tspline.json, see docs/tspline_format.md)")
-      ->type_name("FILE")
-      ->required();
-  info->callback([info_file, &action] { action = [info_file] { return run_info(*info_file); }; });
+  add_tspline_file_argument(*info, *info_file);
+  run_when_parsed(info, info_file, action, run_info);
 }
 
 }  // namespace tspline_app

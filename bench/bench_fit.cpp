@@ -15,25 +15,20 @@
 #include "tspline/pipeline/parameterization.h"
 #include "tspline/spline/tspline_fit.h"
 
-using bench::since;
-
 int main(int argc, char** argv) {
   const std::optional<tspline::FrontResult> front_result = bench::front_from_args(argc, argv);
   if (!front_result) return 1;
   const tspline::FrontResult& front = *front_result;
-  auto t = std::chrono::steady_clock::now();
+  bench::Laps lap;
   const tspline::TSplineBasis basis(front.mesh);
-  const double t_basis = since(t);
-  t = std::chrono::steady_clock::now();
+  const double t_basis = lap();
   tspline::FitReport rep;
   const tspline::TSplineMap map = tspline::fit_tspline(front.mesh, front.optimized, front.boundary, &rep);
-  const double t_fit = since(t);  // includes its own basis construction
-  t = std::chrono::steady_clock::now();
+  const double t_fit = lap();  // includes its own basis construction
   const tspline::MapQualityStats q = tspline::map_quality(map, 4);
-  const double t_check = since(t);
-  t = std::chrono::steady_clock::now();
+  const double t_check = lap();
   tspline::dense_map_quality(map);
-  const double t_dense = since(t);
+  const double t_dense = lap();
   rusage ru{};
   getrusage(RUSAGE_SELF, &ru);
   std::printf("%9zu %9zu %9.4f %9.4f %9.4f %9.4f %9.1f %8.3f\n", front.mesh.num_cells(), basis.size(), t_basis, t_fit,

@@ -1,6 +1,6 @@
 #pragma once
 // Shared by the benchmarks that take `POLYGON INIT_LEVEL [TOL_REL]`: the
-// stopwatch, and the front half (T-mesh, Coons, optimization) at that
+// stopwatches, and the front half (T-mesh, Coons, optimization) at that
 // resolution with one corner trial.
 #include <chrono>
 #include <cstdio>
@@ -15,6 +15,21 @@ namespace bench {
 
 using since_t = double (*)(toolkit::Clock::time_point);
 inline constexpr since_t since = toolkit::seconds_since;
+
+/// A stopwatch of consecutive stages: each call returns the seconds since the
+/// previous call (the first: since construction) and starts the next stage.
+class Laps {
+ public:
+  double operator()() {
+    const toolkit::Clock::time_point now = toolkit::Clock::now();
+    const double seconds = std::chrono::duration<double>(now - start_).count();
+    start_ = now;
+    return seconds;
+  }
+
+ private:
+  toolkit::Clock::time_point start_ = toolkit::Clock::now();
+};
 
 /// The front half for POLYGON INIT_LEVEL [TOL_REL = 1e-6]; empty (after a usage
 /// line on stderr) if the arguments are missing.

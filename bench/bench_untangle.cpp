@@ -25,6 +25,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <type_traits>
 
 #include <Eigen/CholmodSupport>
 #include <Eigen/IterativeLinearSolvers>
@@ -169,21 +170,20 @@ int main(int argc, char** argv) {
           Eigen::VectorXd y;
           int its = 0;
           double err = 0;
-          if (pre == 0) {
-            Eigen::ConjugateGradient<Eigen::SparseMatrix<double>, Eigen::Lower | Eigen::Upper, Eigen::DiagonalPreconditioner<double>> cg;
+          // CG with the preconditioner of type Pre (a std::type_identity<Pre>).
+          auto solve_cg = [&](auto preconditioner) {
+            using Pre = typename decltype(preconditioner)::type;
+            Eigen::ConjugateGradient<Eigen::SparseMatrix<double>, Eigen::Lower | Eigen::Upper, Pre> cg;
             cg.setTolerance(tol);
             cg.setMaxIterations(5000);
             cg.compute(Hf);
             y = cg.solve(-g);
             its = cg.iterations(), err = cg.error();
-          } else {
-            Eigen::ConjugateGradient<Eigen::SparseMatrix<double>, Eigen::Lower | Eigen::Upper, Eigen::IncompleteCholesky<double>> cg;
-            cg.setTolerance(tol);
-            cg.setMaxIterations(5000);
-            cg.compute(Hf);
-            y = cg.solve(-g);
-            its = cg.iterations(), err = cg.error();
-          }
+          };
+          if (pre == 0)
+            solve_cg(std::type_identity<Eigen::DiagonalPreconditioner<double>>{});
+          else
+            solve_cg(std::type_identity<Eigen::IncompleteCholesky<double>>{});
           std::printf("  CG %s tol %g: %d its, err %g, %.1f ms, |y - d|/|d| %.3g, slope ratio %.3f\n", pre ? "IC" : "Jacobi", tol, its, err, 1e3 * (cpu_seconds() - c), (y - d).norm() / d.norm(), g.dot(y) / g.dot(d));
         }
     }

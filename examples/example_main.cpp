@@ -14,20 +14,25 @@
 
 int run(int argc, char** argv);  // the example
 
+namespace {
+
+/// The exit code for a library error: 1 to 3 for the errors a caller can act
+/// on, 4 for anything else (a bug).
+int exit_code_for(const std::exception& e) {
+  if (dynamic_cast<const toolkit::InputError*>(&e)) return 1;
+  if (dynamic_cast<const toolkit::IoError*>(&e)) return 2;
+  if (dynamic_cast<const toolkit::NumericalError*>(&e)) return 3;
+  return 4;
+}
+
+}  // namespace
+
 int main(int argc, char** argv) {
   try {
     return run(argc, argv);
-  } catch (const toolkit::InputError& e) {
-    std::fprintf(stderr, "error: %s\n", e.what());
-    return 1;
-  } catch (const toolkit::IoError& e) {
-    std::fprintf(stderr, "error: %s\n", e.what());
-    return 2;
-  } catch (const toolkit::NumericalError& e) {
-    std::fprintf(stderr, "error: %s\n", e.what());
-    return 3;
   } catch (const std::exception& e) {
-    std::fprintf(stderr, "internal error: %s\n", e.what());
-    return 4;
+    const int code = exit_code_for(e);
+    std::fprintf(stderr, "%s: %s\n", code == 4 ? "internal error" : "error", e.what());
+    return code;
   }
 }

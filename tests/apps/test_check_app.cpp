@@ -98,25 +98,14 @@ TEST_SUITE("check_app") {
     const fs::path d = scratch("bad");
     std::ofstream(d / "bad.json") << "{\"format\": \"tspline\", \"version\": 99}";
     const std::string ok = write_map(d, "id", tspline::greville_identity_map(test_support::uniform_mesh(1)));
-    struct Case {
-      std::string args, needle;
-      int code;
-    };
-    const std::vector<Case> cases{
+    const std::vector<test_support::BadInvocation> cases{
         {"check '" + (d / "missing.json").string() + "'", "missing.json", 2},
         {"check '" + (d / "bad.json").string() + "'", "/version: unsupported version 99", 1},
         {"check", "TSPLINE", 1},
         {"check " + ok + " --depth 99", "--depth", 1},
         {"check " + ok + " --depth x", "--depth", 1},
     };
-    for (const Case& c : cases) {
-      const auto r = run_app(c.args, d);
-      CAPTURE(c.args);
-      CAPTURE(r.err);
-      CHECK(r.exit_code == c.code);
-      CHECK(count_lines(r.err) == 1);
-      CHECK(contains(r.err, c.needle));
-    }
+    for (const test_support::BadInvocation& c : cases) test_support::check_bad_invocation(c, d);
     const auto h = run_app("check --help", d);
     CHECK(h.exit_code == 0);
     CHECK(contains(h.out, "--depth"));
@@ -126,11 +115,7 @@ TEST_SUITE("check_app") {
   TEST_CASE(
       "param: the report says certified_valid, with the counts and the bound; check agrees on tspline.json") {
     const fs::path d = scratch("param");
-    const auto r = run_app(
-        "param --layout single '" + test_support::polygon_file("disk.txt") + "' --out '" + (d / "out").string() + "' --quiet",
-        d);
-    CAPTURE(r.err);
-    REQUIRE(r.exit_code == 0);
+    const fs::path map = test_support::param_polygon("disk.txt", d / "out", "--layout single");
     const auto rep = nlohmann::json::parse(slurp(d / "out" / "report.json"));
     CHECK(rep["certified_valid"] == true);
     const auto& c = rep["certification"];
@@ -151,7 +136,7 @@ TEST_SUITE("check_app") {
     CHECK(u["samples_nonpositive_after"] == 0);
     CHECK(u["free_points"].get<int>() > 0);
     for (const auto& it : its) CHECK(it["certification"].contains("elements_certified"));
-    const auto k = run_app("check '" + (d / "out" / "tspline.json").string() + "'", d);
+    const auto k = run_app("check '" + map.string() + "'", d);
     CHECK(k.exit_code == 0);
     CHECK(contains(k.out, "certified: " + std::to_string(c["elements"].get<int>()) + " of "));
     const auto h = run_app("param --help", d);

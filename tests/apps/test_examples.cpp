@@ -10,6 +10,7 @@
 
 namespace fs = std::filesystem;
 using test_support::contains;
+using test_support::require_success;
 using test_support::run_program;
 
 namespace {
@@ -53,10 +54,7 @@ fs::path example1_output() {
 
 TEST_SUITE("examples") {
   TEST_CASE("ex1: parameterize a polygon") {
-    const test_support::AppRun& r = example1().run;
-    CAPTURE(r.out);
-    CAPTURE(r.err);
-    REQUIRE(r.exit_code == 0);
+    const test_support::AppRun r = require_success(example1().run);
     CHECK(value_after(r.out, "valid") == 1.0);
     CHECK(value_after(r.out, "certified") == 1.0);
     // The steps by hand: the Coons start of the flower folds at its petals and
@@ -86,10 +84,7 @@ TEST_SUITE("examples") {
 
   TEST_CASE("ex2: corners and tolerance") {
     const fs::path d = scratch("ex2");
-    const auto r = run_program(EXAMPLE_CORNERS_TOLERANCE, "", d);
-    CAPTURE(r.out);
-    CAPTURE(r.err);
-    REQUIRE(r.exit_code == 0);
+    const auto r = require_success(run_program(EXAMPLE_CORNERS_TOLERANCE, "", d));
     // One line per tolerance; the cell count grows as the tolerance shrinks and
     // the chosen corners are the images of the square's corners.
     std::istringstream in(r.out);
@@ -112,10 +107,7 @@ TEST_SUITE("examples") {
 
   TEST_CASE("ex3: read back and evaluate") {
     const fs::path d = scratch("ex3");
-    const auto r = run_program(EXAMPLE_EVALUATE, q(example1_output()), d);
-    CAPTURE(r.out);
-    CAPTURE(r.err);
-    REQUIRE(r.exit_code == 0);
+    const auto r = require_success(run_program(EXAMPLE_EVALUATE, q(example1_output()), d));
     CHECK(value_after(r.out, "det J =") > 0.0);
     const double jr = value_after(r.out, "J_r =");
     CHECK(jr > 0.0);
@@ -128,19 +120,13 @@ TEST_SUITE("examples") {
 
   TEST_CASE("ex4: adaptive Poisson with user f and g") {
     const fs::path d = scratch("ex4");
-    const auto r = run_program(EXAMPLE_POISSON, q(example1_output()), d);
-    CAPTURE(r.out);
-    CAPTURE(r.err);
-    REQUIRE(r.exit_code == 0);
+    const auto r = require_success(run_program(EXAMPLE_POISSON, q(example1_output()), d));
     CHECK(value_after(r.out, "H1 error reduced by") >= 2.0);
   }
 
   TEST_CASE("ex5: untangle a planar mesh") {
     const fs::path d = scratch("ex5");
-    const auto r = run_program(EXAMPLE_UNTANGLE, "", d);
-    CAPTURE(r.out);
-    CAPTURE(r.err);
-    REQUIRE(r.exit_code == 0);
+    const auto r = require_success(run_program(EXAMPLE_UNTANGLE, "", d));
     CHECK(value_after(r.out, "before: inverted") > 10);
     CHECK(value_after(r.out, "after: inverted") == 0.0);
   }
@@ -151,14 +137,12 @@ TEST_SUITE("examples") {
     // It draws with Cairo: fontconfig's caches live to the end of the process
     // (not a leak of ours), suppressed for LeakSanitizer in the sanitizer build.
     const std::string supp = std::string(TSPLINE_TEST_DATA_DIR) + "/../support/lsan_cairo.supp";
-    const auto r = run_program("/usr/bin/env",
-                               q("LSAN_OPTIONS=suppressions=" + supp + ":print_suppressions=0") + " " +
-                                   q(EXAMPLE_MOVING_BOUNDARY) + " " + q(coast) + " " + q(d / "out"),
-                               d);
-    CAPTURE(r.out);
-    CAPTURE(r.err);
     // The example checks that every step is certified and at least half as good as the cold start.
-    REQUIRE(r.exit_code == 0);
+    const auto r = require_success(run_program("/usr/bin/env",
+                                               q("LSAN_OPTIONS=suppressions=" + supp + ":print_suppressions=0") +
+                                                   " " + q(EXAMPLE_MOVING_BOUNDARY) + " " + q(coast) + " " +
+                                                   q(d / "out"),
+                                               d));
     CHECK(contains(r.out, "  20 "));
     CHECK(contains(r.out, "of 20 steps kept the T-mesh"));
     CHECK(!contains(r.out, " NO "));

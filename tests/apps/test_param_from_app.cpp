@@ -37,6 +37,17 @@ void write_ring(const fs::path& path, const std::vector<Eigen::Vector2d>& v) {
   for (const auto& p : v) out << p.x() << ' ' << p.y() << '\n';
 }
 
+// `tspline param DOMAIN --quiet --from DIR/first/tspline.json --out DIR/OUT`:
+// a warm start from the test's first run in DIR, required to succeed.
+void warm_start(const fs::path& dir, const fs::path& domain, const std::string& out) {
+  const auto r = run_program(TSPLINE_APP_PATH,
+                             "param " + q(domain) + " --quiet --from " + q(dir / "first" / "tspline.json") +
+                                 " --out " + q(dir / out),
+                             dir);
+  CAPTURE(r.err);
+  REQUIRE(r.exit_code == 0);
+}
+
 }  // namespace
 
 TEST_SUITE("param_from_app") {
@@ -80,38 +91,34 @@ TEST_SUITE("param_from_app") {
     std::vector<Eigen::Vector2d> rotated;
     for (const auto& p : ring) rotated.push_back(R * p + t);
     write_ring(d / "rotated.txt", rotated);
-    const auto rigid = run_program(TSPLINE_APP_PATH,
-                                   "param " + q(d / "rotated.txt") + " --quiet --from " +
-                                       q(d / "first" / "tspline.json") + " --out " + q(d / "rigid"),
-                                   d);
-    CAPTURE(rigid.err);
-    REQUIRE(rigid.exit_code == 0);
+    warm_start(d, d / "rotated.txt", "rigid");
     const std::vector<Eigen::Vector2d> M = control_points(d / "rigid" / "tspline.json");
     REQUIRE(M.size() == P.size());
     err = 0.0;
     for (std::size_t i = 0; i < P.size(); ++i) err = std::max(err, (M[i] - (R * P[i] + t)).norm());
     CHECK(err < 1e-11);
 
-    // One vertex fewer: an input error naming the counts, and no output folder.
-    write_ring(d / "short.txt", std::vector<Eigen::Vector2d>(ring.begin(), ring.end() - 1));
-    const auto shorter = run_program(TSPLINE_APP_PATH,
-                                     "param " + q(d / "short.txt") + " --from " + q(d / "first" / "tspline.json") +
-                                         " --out " + q(d / "short"),
-                                     d);
-    CHECK(shorter.exit_code == 1);
-    CHECK(contains(shorter.err, "the outer ring of the moved boundary has 71 vertices"));
-    CHECK(!fs::exists(d / "short" / "tspline.json"));
+    // A moved ring `name`.txt that is no move of the first one: an input error
+    // saying why, and no output folder.
+    auto rejected_move = [&](const std::string& name, const std::vector<Eigen::Vector2d>& moved,
+                             const std::string& message) {
+      CAPTURE(name);
+      write_ring(d / (name + ".txt"), moved);
+      const auto r = run_program(TSPLINE_APP_PATH,
+                                 "param " + q(d / (name + ".txt")) + " --from " + q(d / "first" / "tspline.json") +
+                                     " --out " + q(d / name),
+                                 d);
+      CHECK(r.exit_code == 1);
+      CHECK(contains(r.err, message));
+      CHECK(!fs::exists(d / name / "tspline.json"));
+    };
+    // One vertex fewer: the message names the counts.
+    rejected_move("short", std::vector<Eigen::Vector2d>(ring.begin(), ring.end() - 1),
+                  "the outer ring of the moved boundary has 71 vertices");
     // Two vertices swapped: the ring crosses itself (edges named by file index).
     std::vector<Eigen::Vector2d> crossing = ring;
     std::swap(crossing[5], crossing[40]);
-    write_ring(d / "crossing.txt", crossing);
-    const auto crossed = run_program(TSPLINE_APP_PATH,
-                                     "param " + q(d / "crossing.txt") + " --from " + q(d / "first" / "tspline.json") +
-                                         " --out " + q(d / "crossing"),
-                                     d);
-    CHECK(crossed.exit_code == 1);
-    CHECK(contains(crossed.err, "not simple"));
-    CHECK(!fs::exists(d / "crossing" / "tspline.json"));
+    rejected_move("crossing", crossing, "not simple");
     // A layout option with --from: the layout is the previous map's.
     const auto layout = run_program(TSPLINE_APP_PATH,
                                     "param " + q(coast) + " --layout quad --from " +
@@ -147,12 +154,7 @@ TEST_SUITE("param_from_app") {
       out << std::cos(th) * x - std::sin(th) * y + 5.0 << ' ' << std::sin(th) * x + std::cos(th) * y - 2.0 << '\n';
     }
     out.close();
-    const auto moved = run_program(TSPLINE_APP_PATH,
-                                   "param " + q(d / "moved.txt") + " --quiet --from " +
-                                       q(d / "first" / "tspline.json") + " --out " + q(d / "moved"),
-                                   d);
-    CAPTURE(moved.err);
-    REQUIRE(moved.exit_code == 0);
+    warm_start(d, d / "moved.txt", "moved");
     std::ifstream a(d / "first" / "tspline.json"), b(d / "moved" / "tspline.json");
     const nlohmann::json A = nlohmann::json::parse(a), B = nlohmann::json::parse(b);
     REQUIRE(A.at("patches").size() == B.at("patches").size());

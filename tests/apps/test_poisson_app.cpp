@@ -35,26 +35,12 @@ using test_support::slurp;
 fs::path scratch(const std::string& name) { return test_support::scratch_dir("poisson_app", name); }
 
 /// The path in single quotes for the shell.
-std::string q(const fs::path& p) {
-  std::string s = "'";
-  s += p.string();
-  s += '\'';
-  return s;
-}
+std::string q(const fs::path& p) { return test_support::quoted(p); }
 
 /// tspline.json of a bundled polygon, made once per process by `tspline param`.
 fs::path geometry(const std::string& polygon) {
-  static std::map<std::string, fs::path> made;
-  auto it = made.find(polygon);
-  if (it != made.end()) return it->second;
-  const fs::path d = scratch("geometry_" + polygon);
-  const auto r =
-      run_app("param --layout single " + q(test_support::polygon_file(polygon)) + " --out " + q(d / "out") + " -q", d);
-  CAPTURE(r.err);
-  REQUIRE(r.exit_code == 0);
-  const fs::path file = d / "out" / "tspline.json";
+  const fs::path file = test_support::single_patch_map("poisson_app", polygon);
   REQUIRE(fs::exists(file));
-  made[polygon] = file;
   return file;
 }
 

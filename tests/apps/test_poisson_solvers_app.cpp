@@ -30,17 +30,7 @@ fs::path scratch(const std::string& name) { return test_support::scratch_dir("po
 
 /// tspline.json of a bundled polygon, made once per process by `tspline param`.
 fs::path geometry(const std::string& polygon) {
-  static std::map<std::string, fs::path> made;
-  auto it = made.find(polygon);
-  if (it != made.end()) return it->second;
-  const fs::path d = scratch("geometry_" + polygon);
-  const auto r = run_app("param --layout single " + q(test_support::polygon_file(polygon)) + " --out " + q(d / "out") +
-                             " -q",
-                         d);
-  CAPTURE(r.err);
-  REQUIRE(r.exit_code == 0);
-  made[polygon] = d / "out" / "tspline.json";
-  return made[polygon];
+  return test_support::single_patch_map("poisson_solvers_app", polygon);
 }
 
 json report(const fs::path& out) { return test_support::poisson_report(out); }

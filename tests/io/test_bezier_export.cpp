@@ -89,13 +89,10 @@ TEST_SUITE("bezier_export") {
 
   TEST_CASE("tspline export --bezier: file and bad input") {
     const fs::path d = test_support::scratch_dir("bezier_export", "app");
-    const auto p = test_support::run_app("param --layout single " + test_support::quoted(test_support::polygon_file("disk.txt")) +
-                                             " -q --out " + test_support::quoted(d / "disk"),
-                                         d);
-    REQUIRE(p.exit_code == 0);
+    const fs::path map = test_support::param_polygon("disk.txt", d / "disk", "--layout single");
     const fs::path out = d / "disk_bezier.json";
-    const auto r = test_support::run_app(
-        "export " + test_support::quoted(d / "disk" / "tspline.json") + " --bezier " + test_support::quoted(out), d);
+    const auto r =
+        test_support::run_app("export " + test_support::quoted(map) + " --bezier " + test_support::quoted(out), d);
     CAPTURE(r.err);
     REQUIRE(r.exit_code == 0);
     CHECK(test_support::contains(r.out, "Bezier elements"));

@@ -193,15 +193,10 @@ TEST_SUITE("msh_export") {
 
   TEST_CASE("tspline export --msh: file and bad input") {
     const fs::path d = test_support::scratch_dir("msh_export", "app");
-    const auto p = test_support::run_app("param " + test_support::quoted(test_support::polygon_file("disk.txt")) +
-                                             " -q --out " + test_support::quoted(d / "disk"),
-                                         d);
-    REQUIRE(p.exit_code == 0);
+    const fs::path map = test_support::param_polygon("disk.txt", d / "disk");
     const fs::path out = d / "disk.msh";
     const auto r =
-        test_support::run_app("export " + test_support::quoted(d / "disk" / "tspline.json") + " --msh " +
-                                  test_support::quoted(out),
-                              d);
+        test_support::run_app("export " + test_support::quoted(map) + " --msh " + test_support::quoted(out), d);
     CAPTURE(r.err);
     REQUIRE(r.exit_code == 0);
     CHECK(test_support::contains(r.out, "Gmsh type 36"));
@@ -209,7 +204,7 @@ TEST_SUITE("msh_export") {
     CHECK(text.rfind("$MeshFormat\n4.1 0 8\n", 0) == 0);
     CHECK(test_support::contains(text, "\n2 1 36 "));
     // Neither output: one error line, exit 1.
-    const auto none = test_support::run_app("export " + test_support::quoted(d / "disk" / "tspline.json"), d);
+    const auto none = test_support::run_app("export " + test_support::quoted(map), d);
     CHECK(none.exit_code == 1);
     CHECK(test_support::count_lines(none.err) == 1);
     const auto bad = test_support::run_app(

@@ -83,13 +83,19 @@ struct Grid {
   int id(int i, int j) const { return j * (n + 1) + i; }
 };
 
-/// Quad grid: per cell around a free node, the 3 triangles (x, p, q) over pairs of the other corners.
-Grid make_quad_grid(int n) {
+/// The (n+1) x (n+1) nodes of the unit square's grid, no free nodes yet.
+Grid grid_nodes(int n) {
   Grid g;
   g.n = n;
   const double h = 1.0 / n;
   for (int j = 0; j <= n; ++j)
     for (int i = 0; i <= n; ++i) g.param.emplace_back(i * h, j * h);
+  return g;
+}
+
+/// Quad grid: per cell around a free node, the 3 triangles (x, p, q) over pairs of the other corners.
+Grid make_quad_grid(int n) {
+  Grid g = grid_nodes(n);
   for (int j = 1; j < n; ++j)
     for (int i = 1; i < n; ++i) {
       std::vector<LocalTriangle> tris;
@@ -115,11 +121,7 @@ Grid make_quad_grid(int n) {
 
 /// Triangle grid: each cell split along its (i,j)-(i+1,j+1) diagonal; a node's star has 6 triangles.
 Grid make_triangle_grid(int n) {
-  Grid g;
-  g.n = n;
-  const double h = 1.0 / n;
-  for (int j = 0; j <= n; ++j)
-    for (int i = 0; i <= n; ++i) g.param.emplace_back(i * h, j * h);
+  Grid g = grid_nodes(n);
   std::vector<std::array<int, 3>> all;
   for (int j = 0; j < n; ++j)
     for (int i = 0; i < n; ++i) {

@@ -1,6 +1,7 @@
 #pragma once
-// Shared helpers of the `tspline poisson` end-to-end suites: the convergence
-// table, the comparison of two runs' errors, and runs under mpirun.
+// Shared helpers of the `tspline poisson` end-to-end suites: their geometry
+// maps, the convergence table, the comparison of two runs' errors, and runs
+// under mpirun.
 #include <doctest/doctest.h>
 
 #include <cmath>
@@ -10,11 +11,23 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "test_support.h"
 
 namespace test_support {
+
+/// tspline.json of a bundled polygon as one patch (`tspline param --layout
+/// single`), made once per process and suite, in the suite's scratch folder.
+inline std::filesystem::path single_patch_map(const std::string& suite, const std::string& polygon) {
+  static std::map<std::pair<std::string, std::string>, std::filesystem::path> made;
+  const auto key = std::make_pair(suite, polygon);
+  if (const auto it = made.find(key); it != made.end()) return it->second;
+  const std::filesystem::path file =
+      param_polygon(polygon, scratch_dir(suite, "geometry_" + polygon) / "out", "--layout single");
+  return made[key] = file;
+}
 
 /// convergence.csv as one map column -> text per row.
 inline std::vector<std::map<std::string, std::string>> read_csv(const std::filesystem::path& p) {

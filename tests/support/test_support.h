@@ -97,10 +97,49 @@ inline AppRun run_program(const std::string& exe, const std::string& args, const
   return r;
 }
 
+/// `r` after requiring that it exited with 0 (its stdout and stderr shown if not).
+inline AppRun require_success(AppRun r) {
+  CAPTURE(r.out);
+  CAPTURE(r.err);
+  REQUIRE(r.exit_code == 0);
+  return r;
+}
+
 /// Runs `tspline ARGS` (or another built program) with stdout and stderr captured in files of `dir`.
 inline AppRun run_app(const std::string& args, const std::filesystem::path& dir,
                       const std::string& program = TSPLINE_APP_PATH) {
   return run_program(program, args, dir);
+}
+
+/// A bad invocation of `tspline`: its arguments, a part of the one error line
+/// it must print, and its exit code.
+struct BadInvocation {
+  std::string args, needle;
+  int code;
+};
+
+/// Runs `c` (run_app in `dir`) and checks its exit code and its one error line;
+/// returns the run for further checks.
+inline AppRun check_bad_invocation(const BadInvocation& c, const std::filesystem::path& dir) {
+  const AppRun r = run_app(c.args, dir);
+  CAPTURE(c.args);
+  CAPTURE(r.err);
+  CHECK(r.exit_code == c.code);
+  CHECK(count_lines(r.err) == 1);
+  CHECK(contains(r.err, c.needle));
+  return r;
+}
+
+/// `tspline param POLYGON -q --out OUT [OPTIONS]` on a bundled polygon
+/// (polygon_file), required to succeed; returns the map's file OUT/tspline.json.
+inline std::filesystem::path param_polygon(const std::string& polygon, const std::filesystem::path& out,
+                                           const std::string& options = "") {
+  const AppRun r = run_app("param " + quoted(std::filesystem::path(polygon_file(polygon))) + " -q --out " +
+                               quoted(out) + (options.empty() ? "" : " " + options),
+                           out.parent_path());
+  CAPTURE(r.err);
+  REQUIRE(r.exit_code == 0);
+  return out / "tspline.json";
 }
 
 /// A balanced T-mesh from the uniform 4x4 mesh by `rounds` splits of the leaves
@@ -119,14 +158,14 @@ inline tspline::TMesh random_tmesh(unsigned seed, int rounds, int max_level) {
 }
 
 /// Uniform level-`level` mesh, then `splits` splits of random leaves of level
-/// below 6, then a balance.
-inline tspline::TMesh random_leaf_splits(int level, int splits, unsigned seed) {
+/// below `max_level`, then a balance.
+inline tspline::TMesh random_leaf_splits(int level, int splits, unsigned seed, int max_level = 6) {
   tspline::TMesh m(level);
   std::mt19937 rng(seed);
   for (int s = 0; s < splits; ++s) {
     std::vector<int> leaves;
     for (std::size_t n = 0; n < m.nodes().size(); ++n)
-      if (m.node(static_cast<int>(n)).is_leaf() && m.node(static_cast<int>(n)).level < 6)
+      if (m.node(static_cast<int>(n)).is_leaf() && m.node(static_cast<int>(n)).level < max_level)
         leaves.push_back(static_cast<int>(n));
     m.refine(leaves[std::uniform_int_distribution<std::size_t>(0, leaves.size() - 1)(rng)]);
   }

@@ -35,6 +35,11 @@ const std::vector<std::pair<std::string, std::size_t>> kDomains = {
     {"square", 16}, {"lshape_cw", 48}, {"disk", 256},   {"flower", 400},
     {"gear", 480},  {"fjords", 800},   {"cshape", 302}, {"blob_bay", 360}};
 
+// The message of the InputError of corners_from_file_indices(p, indices).
+std::string corners_error(const Polygon& p, const std::array<long long, 4>& indices) {
+  return message_of<InputError>([&] { corners_from_file_indices(p, indices); });
+}
+
 double perimeter(const Polygon& p) {
   double s = 0;
   for (std::size_t i = 0; i < p.vertices.size(); ++i)
@@ -129,34 +134,20 @@ TEST_SUITE("boundary") {
 
   TEST_CASE("error: corner index out of range") {
     const Polygon p = validated("square");
-    CHECK(contains(message_of<InputError>([&] {
-                     corners_from_file_indices(p, {0, 16, 8, 12});
-                   }),
+    CHECK(contains(corners_error(p, {0, 16, 8, 12}),
                    "corner 2: vertex index 16 is out of range (the file has vertices 0..15)"));
-    CHECK(contains(message_of<InputError>([&] {
-                     corners_from_file_indices(p, {-1, 4, 8, 12});
-                   }),
-                   "corner 1: vertex index -1 is out of range"));
+    CHECK(contains(corners_error(p, {-1, 4, 8, 12}), "corner 1: vertex index -1 is out of range"));
   }
 
   TEST_CASE("error: corner index repeated") {
     const Polygon p = validated("square");
-    CHECK(contains(message_of<InputError>([&] {
-                     corners_from_file_indices(p, {0, 4, 4, 12});
-                   }),
-                   "corner 3: vertex index 4 is repeated (also corner 2)"));
+    CHECK(contains(corners_error(p, {0, 4, 4, 12}), "corner 3: vertex index 4 is repeated (also corner 2)"));
   }
 
   TEST_CASE("error: corners not in cyclic order") {
     const Polygon p = validated("square");
-    CHECK(contains(message_of<InputError>([&] {
-                     corners_from_file_indices(p, {0, 8, 4, 12});
-                   }),
-                   "corner 3: vertex index 4 is out of cyclic order"));
-    CHECK(contains(message_of<InputError>([&] {
-                     corners_from_file_indices(p, {12, 8, 4, 0});
-                   }),
-                   "corner 3: vertex index 4 is out of cyclic order"));
+    CHECK(contains(corners_error(p, {0, 8, 4, 12}), "corner 3: vertex index 4 is out of cyclic order"));
+    CHECK(contains(corners_error(p, {12, 8, 4, 0}), "corner 3: vertex index 4 is out of cyclic order"));
   }
 
   // ---- corners -----------------------------------------------------------------

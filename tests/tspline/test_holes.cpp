@@ -46,6 +46,19 @@ std::string validation_error(const Domain& d) {
   return message_of<tspline::InputError>([&] { (void)tspline::validate_domain(d); });
 }
 
+// A domain validated with the default options, and the notes on what it cleaned.
+struct ValidatedDomain {
+  Domain domain;
+  std::vector<std::string> notes;
+};
+ValidatedDomain validate_with_notes(const Domain& raw) {
+  ValidatedDomain out;
+  tspline::DomainCleaningOptions how;
+  how.notes = &out.notes;
+  out.domain = tspline::validate_domain(raw, how);
+  return out;
+}
+
 // The square [0,4]^2 with the square hole [1,3]^2, cut along the diagonals.
 Domain framed_square() { return Domain{square(0, 0, 4, 4), {square(1, 1, 3, 3)}}; }
 std::vector<Cut> diagonal_cuts() {
@@ -168,10 +181,7 @@ TEST_SUITE("holes") {
   TEST_CASE("Maldives islet 9: its 10 cm needle at vertex 0 goes, and the islet is a valid hole") {
     const Domain raw = read_text_domain(holes_file("maldives_islet9.txt"));
     REQUIRE(raw.holes.size() == 1);
-    std::vector<std::string> notes;
-    tspline::DomainCleaningOptions how;
-    how.notes = &notes;
-    const Domain v = tspline::validate_domain(raw, how);
+    const auto [v, notes] = validate_with_notes(raw);
     REQUIRE(notes.size() == 1);
     CHECK(notes[0] == "hole 1: removed vertex 0 (tip of a zero-area spike: edges 6-0 and 0-1 overlap)");
     CHECK(v.holes[0].vertices.size() == 6);
@@ -219,10 +229,7 @@ TEST_SUITE("holes") {
     // vertices whose lobes cancel, its hull 0.0012 < 0.002: repaired by default.
     const Domain islet{square(0, 0, 10, 10),
                        {make_polygon({{5.04, 5.03}, {5.04, 5.0}, {5.0, 5.0}, {5.0, 4.97}})}};
-    std::vector<std::string> islet_notes;
-    tspline::DomainCleaningOptions defaults;
-    defaults.notes = &islet_notes;
-    const Domain hulled = tspline::validate_domain(islet, defaults);
+    const auto [hulled, islet_notes] = validate_with_notes(islet);
     REQUIRE(islet_notes.size() == 1);
     CAPTURE(islet_notes[0]);
     CHECK(contains(islet_notes[0], "hole 1: crosses itself; replaced by its convex hull (4 of its 4 vertices; area 0"));
@@ -238,10 +245,7 @@ TEST_SUITE("holes") {
     // Maldives islet 140: three nearly collinear vertices, no area at the needle width.
     const Domain sliver{square(0, 0, 10, 10),
                         {square(1, 1, 2, 2), make_polygon({{5, 5}, {7, 5.00001}, {6, 5}}), square(3, 3, 4, 4)}};
-    std::vector<std::string> notes;
-    tspline::DomainCleaningOptions how;
-    how.notes = &notes;
-    const Domain d = tspline::validate_domain(sliver, how);
+    const auto [d, notes] = validate_with_notes(sliver);
     CHECK(d.holes.size() == 2);
     REQUIRE(notes.size() == 1);
     CHECK(notes[0] ==

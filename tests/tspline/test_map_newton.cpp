@@ -37,6 +37,22 @@ Eigen::Matrix2d mat(const Eigen::Vector4d& v) {
   return J;
 }
 
+// Random Jacobians from a seeded generator: independent N(0, 1) entries drawn
+// row by row, plus `shift` on the diagonal (a positive shift makes valid ones,
+// det J > 0, more likely).
+struct RandomJacobians {
+  explicit RandomJacobians(unsigned seed) : rng(seed) {}
+  Eigen::Matrix2d operator()(double shift) {
+    Eigen::Vector4d v;
+    for (int i = 0; i < 4; ++i) v[i] = n01(rng);
+    Eigen::Matrix2d J = mat(v);
+    if (shift != 0.0) J += Eigen::Matrix2d::Identity() * shift;
+    return J;
+  }
+  std::mt19937 rng;
+  std::normal_distribution<double> n01{0.0, 1.0};
+};
+
 // The term of map_energy.h written out directly (no (P, Q) split).
 double term_direct(const Eigen::Matrix2d& J, double eps, double theta, double power) {
   const double D = J.determinant();
@@ -55,13 +71,10 @@ Eigen::MatrixXd dense_symmetric(const Eigen::SparseMatrix<double>& H) {
 
 TEST_SUITE("map_newton") {
   TEST_CASE("sample term: value, gradient and Hessian in J against the formula and finite differences") {
-    std::mt19937 rng(17);
-    std::normal_distribution<double> n01(0.0, 1.0);
+    RandomJacobians random_jacobian(17);
     int folded = 0, valid = 0;
     for (int trial = 0; trial < 60; ++trial) {
-      Eigen::Matrix2d J;
-      J << n01(rng), n01(rng), n01(rng), n01(rng);
-      if (trial % 3 == 0) J += Eigen::Matrix2d::Identity() * 1.5;  // more valid ones
+      const Eigen::Matrix2d J = random_jacobian(trial % 3 == 0 ? 1.5 : 0.0);  // more valid ones
       (J.determinant() > 0 ? valid : folded)++;
       for (double eps : {1.0, 0.1, 1e-3})
         for (double power : {1.0, 4.0}) {
@@ -96,13 +109,10 @@ TEST_SUITE("map_newton") {
   }
 
   TEST_CASE("sample term: the analytic projection is the eigenvalue clamp, PSD, exact where already PSD") {
-    std::mt19937 rng(5);
-    std::normal_distribution<double> n01(0.0, 1.0);
+    RandomJacobians random_jacobian(5);
     int indefinite = 0, definite = 0;
     for (int trial = 0; trial < 200; ++trial) {
-      Eigen::Matrix2d J;
-      J << n01(rng), n01(rng), n01(rng), n01(rng);
-      if (trial % 2 == 0) J += Eigen::Matrix2d::Identity() * 1.2;
+      Eigen::Matrix2d J = random_jacobian(trial % 2 == 0 ? 1.2 : 0.0);
       if (trial == 0) J = Eigen::Matrix2d::Identity();      // z-perp / w direction degenerate (w = 0)
       if (trial == 1) J << 1.0, 0.0, 0.0, -1.0;              // z = 0
       for (double eps : {1.0, 0.05})

@@ -57,6 +57,15 @@ TMesh hanging_mesh() {
   return m;
 }
 
+// The local submesh of the vertex at (x, y), required to exist and to be
+// hanging or not as `hanging` says.
+std::vector<meshopt::LocalTriangle> submesh_of_vertex_at(const TMesh& m, double x, double y, bool hanging) {
+  const int v = vertex_at(m, x, y);
+  REQUIRE(v >= 0);
+  REQUIRE(m.vertex_is_hanging(v) == hanging);
+  return tspline::detail::local_submesh(m, v);
+}
+
 double optimum_distance(const TMesh& m, int v, const std::vector<Eigen::Vector2d>& x, bool weighted) {
   const auto tris = tspline::detail::local_submesh(m, v, weighted);
   meshopt::SmoothingOptions opt;
@@ -81,21 +90,13 @@ TEST_SUITE("tmesh_submesh") {
   }
 
   TEST_CASE("regular vertex with cells of scale 1:2:4 gets weights 1, 2, 4 (Eq. 4)") {
-    const TMesh m = regular_124_mesh();
-    const int v = vertex_at(m, 0.5, 0.5);
-    REQUIRE(v >= 0);
-    REQUIRE_FALSE(m.vertex_is_hanging(v));
-    const auto tris = tspline::detail::local_submesh(m, v);
+    const auto tris = submesh_of_vertex_at(regular_124_mesh(), 0.5, 0.5, /*hanging=*/false);
     CHECK(tris.size() == 12);
     CHECK(weight_histogram(tris) == std::map<double, int>{{1.0, 3}, {2.0, 6}, {4.0, 3}});
   }
 
   TEST_CASE("hanging vertex: 11 triangles, the T-junction cell's 5 weighted 8/5 (Eq. 5)") {
-    const TMesh m = hanging_mesh();
-    const int v = vertex_at(m, 0.5, 0.75);
-    REQUIRE(v >= 0);
-    REQUIRE(m.vertex_is_hanging(v));
-    const auto tris = tspline::detail::local_submesh(m, v);
+    const auto tris = submesh_of_vertex_at(hanging_mesh(), 0.5, 0.75, /*hanging=*/true);
     CHECK(tris.size() == 11);
     CHECK(weight_histogram(tris) == std::map<double, int>{{1.0, 6}, {1.6, 5}});
     for (const auto& t : tris) CHECK(t.ideal_inv.determinant() > 0.0);

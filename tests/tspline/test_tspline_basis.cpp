@@ -86,6 +86,21 @@ Eigen::Vector2d in_cell(const TMesh& m, int c, double s, double t) {
   return {lo.x() + s * (hi.x() - lo.x()), lo.y() + t * (hi.y() - lo.y())};
 }
 
+// Random points of cells: in_cell at relative positions uniform in [lo, hi)^2.
+struct RandomCellPoints {
+  RandomCellPoints(unsigned seed, double lo, double hi) : rng(seed), u(lo, hi) {}
+  Eigen::Vector2d operator()(const TMesh& m, int c) { return in_cell(m, c, u(rng), u(rng)); }
+  std::mt19937 rng;
+  std::uniform_real_distribution<double> u;
+};
+
+// random_tmesh(seed, rounds, max_level), required to have hanging vertices.
+TMesh random_tmesh_with_hanging_vertices(unsigned seed, int rounds, int max_level) {
+  TMesh m = random_tmesh(seed, rounds, max_level);
+  REQUIRE(m.num_hanging_vertices() > 0);
+  return m;
+}
+
 // Sum of R and of its derivatives at uv in cell c: 1, 0, 0 (relative to the scale).
 void check_partition_of_unity(const TSplineBasis& B, int c, const Eigen::Vector2d& uv) {
   BasisValues v;
@@ -237,8 +252,7 @@ TEST_SUITE("tspline_basis") {
       m.build_topology();
       check_partition_everywhere(m, 100 + level);
     }
-    const TMesh r = random_tmesh(7, 120, 8);
-    REQUIRE(r.num_hanging_vertices() > 0);
+    const TMesh r = random_tmesh_with_hanging_vertices(7, 120, 8);
     check_partition_everywhere(r, 5);
     const TMesh b = boundary_mesh(4);
     REQUIRE(b.num_hanging_vertices() > 0);
@@ -246,15 +260,13 @@ TEST_SUITE("tspline_basis") {
   }
 
   TEST_CASE("derivatives of R match finite differences on a T-mesh") {
-    const TMesh m = random_tmesh(21, 60, 7);
-    REQUIRE(m.num_hanging_vertices() > 0);
+    const TMesh m = random_tmesh_with_hanging_vertices(21, 60, 7);
     const TSplineBasis B(m);
-    std::mt19937 rng(4);
-    std::uniform_real_distribution<double> u(0.1, 0.9);
+    RandomCellPoints random_point(4, 0.1, 0.9);
     BasisValues v, vxp, vxm, vyp, vym;
     for (int c = 0; c < static_cast<int>(m.num_cells()); ++c) {
       const double h = 1e-5 * m.cell_size(c);
-      const Eigen::Vector2d p = in_cell(m, c, u(rng), u(rng));
+      const Eigen::Vector2d p = random_point(m, c);
       B.evaluate(c, p, v);
       B.evaluate(c, p + Eigen::Vector2d(h, 0), vxp);
       B.evaluate(c, p - Eigen::Vector2d(h, 0), vxm);
@@ -365,11 +377,9 @@ TEST_SUITE("tspline_basis") {
   }
 
   TEST_CASE("support lists contain every function non-zero on the cell") {
-    const TMesh m = random_tmesh(9, 40, 6);
-    REQUIRE(m.num_hanging_vertices() > 0);
+    const TMesh m = random_tmesh_with_hanging_vertices(9, 40, 6);
     const TSplineBasis B(m);
-    std::mt19937 rng(8);
-    std::uniform_real_distribution<double> u(0.0, 1.0);
+    RandomCellPoints random_point(8, 0.0, 1.0);
     for (int c = 0; c < static_cast<int>(m.num_cells()); ++c) {
       const std::vector<int>& ids = B.functions_on_cell(c);
       CHECK(std::is_sorted(ids.begin(), ids.end()));
@@ -383,7 +393,7 @@ TEST_SUITE("tspline_basis") {
         CHECK(f.knots_eta[4] > lo.y());
       }
       for (int k = 0; k < 4; ++k) {
-        const Eigen::Vector2d p = in_cell(m, c, u(rng), u(rng));
+        const Eigen::Vector2d p = random_point(m, c);
         for (int a = 0; a < static_cast<int>(B.size()); ++a) {
           const BlendingFunction& f = B.function(a);
           const double N = tspline::cubic_bspline(f.knots_xi, p.x()) * tspline::cubic_bspline(f.knots_eta, p.y());

@@ -12,41 +12,35 @@
 
 namespace toolkit {
 
-/// Invalid input from the caller or user: a malformed file, an invalid
-/// polygon or mesh, options out of range. Exit code 1 in the programs.
-class InputError : public std::invalid_argument {
+/// The shape of every toolkit exception: a standard exception `Base` with its
+/// constructors (one message). `Tag` makes each use its own type, so that a
+/// catch clause tells them apart.
+template <class Base, class Tag>
+class Error : public Base {
  public:
-  using std::invalid_argument::invalid_argument;
+  using Base::Base;
 };
 
+/// Invalid input from the caller or user: a malformed file, an invalid
+/// polygon or mesh, options out of range. Exit code 1 in the programs.
+using InputError = Error<std::invalid_argument, struct InputErrorTag>;
+
 /// A file could not be read or written. Exit code 2.
-class IoError : public std::runtime_error {
- public:
-  using std::runtime_error::runtime_error;
-};
+using IoError = Error<std::runtime_error, struct IoErrorTag>;
 
 /// A numerical procedure failed in a way the caller must know about (e.g. a
 /// singular system). Exit code 3.
-class NumericalError : public std::runtime_error {
- public:
-  using std::runtime_error::runtime_error;
-};
+using NumericalError = Error<std::runtime_error, struct NumericalErrorTag>;
 
 /// A broken invariant: a bug in the toolkit, never the caller's data (a
 /// T-mesh that lost its 2:1 balance, blending functions that vanish inside
 /// the domain). Exit code 4 in the programs ("internal error"). Data and
 /// option errors are InputError, whatever function finds them.
-class InternalError : public std::logic_error {
- public:
-  using std::logic_error::logic_error;
-};
+using InternalError = Error<std::logic_error, struct InternalErrorTag>;
 
 /// The run was stopped on request (SIGINT / SIGTERM) before it finished; no
 /// output was written. Exit code 130 in the programs (128 + SIGINT), the shell's
 /// convention for a run ended by Ctrl-C.
-class Interrupted : public std::runtime_error {
- public:
-  using std::runtime_error::runtime_error;
-};
+using Interrupted = Error<std::runtime_error, struct InterruptedTag>;
 
 }  // namespace toolkit

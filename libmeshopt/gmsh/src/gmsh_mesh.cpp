@@ -12,6 +12,7 @@
 
 #include <Eigen/Geometry>
 
+#include "gmsh_elements.h"
 #include "gmsh_util.h"
 
 namespace meshopt::gmsh_io {
@@ -126,17 +127,9 @@ GmshSurfaceMesh read_surface_mesh() {
   gmsh::vectorpair faces;
   gmsh::model::getEntities(faces, 2);
   for (const auto& [dim, tag] : faces) {
-    std::vector<int> types;
-    std::vector<std::vector<std::size_t>> elem_tags, elem_nodes;
-    gmsh::model::mesh::getElements(types, elem_tags, elem_nodes, 2, tag);
-    std::size_t count = 0;
-    for (std::size_t k = 0; k < types.size(); ++k) {
-      if (types[k] != 2 && types[k] != 3)
-        throw InputError(cat("surface ", tag, " has elements of Gmsh type ", types[k],
-                             "; only linear triangles (2) and quadrangles (3) are supported"));
-      count += elem_tags[k].size();
-    }
-    if (count == 0) continue;
+    const FaceElements elements =
+        face_elements(tag, {2, 3}, "only linear triangles (2) and quadrangles (3) are supported");
+    if (elements.count == 0) continue;
     const int f = static_cast<int>(out.faces.size());
     out.faces.push_back(std::make_unique<GmshFace>(tag));
     m.faces.push_back(out.faces.back().get());
@@ -177,14 +170,14 @@ GmshSurfaceMesh read_surface_mesh() {
                              " away from the node"));
     }
     const std::size_t first_element = m.elements.size();
-    for (std::size_t k = 0; k < types.size(); ++k) {
-      const int nv = types[k] == 2 ? 3 : 4;
-      for (std::size_t e = 0; e < elem_tags[k].size(); ++e) {
+    for (std::size_t k = 0; k < elements.types.size(); ++k) {
+      const int nv = elements.types[k] == 2 ? 3 : 4;
+      for (std::size_t e = 0; e < elements.tags[k].size(); ++e) {
         SurfaceElement el;
         el.nv = nv;
         el.face = f;
         for (int i = 0; i < nv; ++i) {
-          const std::size_t nt = elem_nodes[k][nv * e + i];
+          const std::size_t nt = elements.nodes[k][nv * e + i];
           const auto xt = xyz_of.find(nt);
           if (xt != xyz_of.end()) {
             el.v[i] = node_index(nt, &xyz[3 * xt->second]);

@@ -15,6 +15,7 @@
 #include <set>
 #include <unordered_map>
 
+#include "gmsh_elements.h"
 #include "gmsh_util.h"
 #include "meshopt/flip_energy.h"
 #include "meshopt/gmsh/gmsh_mesh.h"
@@ -138,19 +139,9 @@ std::vector<int> triangulated_faces() {
   gmsh::vectorpair faces;
   gmsh::model::getEntities(faces, 2);
   std::vector<int> face_tags;
-  for (const auto& [dim, tag] : faces) {
-    std::vector<int> types;
-    std::vector<std::vector<std::size_t>> et, en;
-    gmsh::model::mesh::getElements(types, et, en, 2, tag);
-    std::size_t count = 0;
-    for (std::size_t k = 0; k < types.size(); ++k) {
-      if (types[k] != 2)
-        throw InputError(cat("surface ", tag, " has elements of Gmsh type ", types[k],
-                             "; remeshing needs linear triangles (type 2)"));
-      count += et[k].size();
-    }
-    if (count > 0) face_tags.push_back(tag);
-  }
+  for (const auto& [dim, tag] : faces)
+    if (face_elements(tag, {2}, "remeshing needs linear triangles (type 2)").count > 0)
+      face_tags.push_back(tag);
   if (face_tags.empty()) throw InputError("the mesh has no triangles on the model's surfaces");
   std::sort(face_tags.begin(), face_tags.end());
   return face_tags;

@@ -3,6 +3,7 @@
 #include <Eigen/LU>
 #include <array>
 
+#include "tspline/detail/vtu_fields.h"
 #include "tspline/spline/bezier_extraction.h"
 #include "tspline/spline/element_map.h"
 #include "tspline/validity/map_quality.h"
@@ -61,8 +62,10 @@ toolkit::io::VtuMesh bezier_vtu(const TSplineMap& map, const MapCertification* c
   toolkit::io::VtuMesh out;
   const std::size_t np = 16 * elements.size();
   out.points.resize(np);
-  std::vector<double> weight(np), jr(np), det(np), sj(np);
-  std::vector<Eigen::Vector2d> param(np), lo, hi;
+  std::vector<double> weight(np);
+  detail::SampleQualityFields quality;
+  quality.resize(np);
+  std::vector<Eigen::Vector2d> lo, hi;
   std::vector<int> cell, level, patch;
   out.cells.reserve(elements.size()), out.cell_types.reserve(elements.size());
   out.higher_order_degrees.reserve(elements.size());
@@ -95,8 +98,8 @@ toolkit::io::VtuMesh bezier_vtu(const TSplineMap& map, const MapCertification* c
         const int k = i + 4 * j;
         out.points[q] = Eigen::Vector2d(H(k, 0), H(k, 1)) / H(k, 2);
         weight[q] = H(k, 2);
-        jr[q] = D[0](i, j), det[q] = D[1](i, j), sj[q] = D[2](i, j);
-        param[q] = {D[3](i, j), D[4](i, j)};
+        quality.mean_ratio[q] = D[0](i, j), quality.det[q] = D[1](i, j), quality.scaled[q] = D[2](i, j);
+        quality.parametric[q] = {D[3](i, j), D[4](i, j)};
       }
     std::vector<int> ids(16);
     for (int k = 0; k < 16; ++k) ids[k] = static_cast<int>(16 * e) + k;
@@ -110,10 +113,7 @@ toolkit::io::VtuMesh bezier_vtu(const TSplineMap& map, const MapCertification* c
   }
   out.point_scalars["RationalWeights"] = std::move(weight);
   out.rational_weights = "RationalWeights";
-  out.point_scalars["mean_ratio_jacobian"] = std::move(jr);
-  out.point_scalars["det_jacobian"] = std::move(det);
-  out.point_scalars["scaled_jacobian"] = std::move(sj);
-  out.point_vectors["parametric"] = std::move(param);
+  quality.attach_to(out);
   out.cell_ints["patch"] = std::move(patch);
   out.cell_ints["cell"] = std::move(cell);
   out.cell_ints["level"] = std::move(level);

@@ -3,6 +3,7 @@
 #include <filesystem>
 
 #include "toolkit/io/atomic_file.h"
+#include "tspline/detail/vtu_fields.h"
 #include "tspline/io/output_files.h"
 
 namespace tspline::io {
@@ -24,17 +25,11 @@ toolkit::io::VtuMesh tmesh_vtu(const TMesh& mesh, const std::vector<Eigen::Vecto
   out.cell_ints["level"] = std::move(level);
   out.cell_ints["valid"] = std::move(valid);
   out.cell_scalars["min_quality"] = std::move(minq);
-  const auto nv = mesh.num_vertices();
-  std::vector<int> hanging(nv), boundary(nv);
-  std::vector<Eigen::Vector2d> param(nv);
-  for (int v = 0; v < static_cast<int>(nv); ++v) {
-    hanging[v] = mesh.vertex_is_hanging(v) ? 1 : 0;
-    boundary[v] = mesh.vertex_on_boundary(v) ? 1 : 0;
-    param[v] = mesh.vertex_param(v);
-  }
-  out.point_ints["hanging"] = std::move(hanging);
-  out.point_ints["boundary"] = std::move(boundary);
-  out.point_vectors["parametric"] = std::move(param);
+  detail::TMeshPointFields fields;
+  fields.reserve(mesh.num_vertices());
+  for (int v = 0; v < static_cast<int>(mesh.num_vertices()); ++v)
+    fields.push(mesh.vertex_param(v), mesh.vertex_is_hanging(v), mesh.vertex_on_boundary(v));
+  fields.attach_to(out);
   return out;
 }
 

@@ -1,6 +1,5 @@
 #include "tspline/io/param_output.h"
 
-#include <Eigen/LU>
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -12,6 +11,7 @@
 #include <utility>
 
 #include "toolkit/io/atomic_file.h"
+#include "tspline/detail/vtu_fields.h"
 #include "tspline/io/bezier_vtu.h"
 #include "tspline/io/cell_grid.h"
 #include "tspline/io/front_output.h"
@@ -28,26 +28,18 @@ namespace tspline::io {
 
 toolkit::io::VtuMesh surface_vtu(const TSplineMap& map, int k) {
   if (k < 1 || k > 64) throw toolkit::InputError("samples per cell edge must be in [1, 64]");
-  std::vector<double> jr, det, js;
-  std::vector<Eigen::Vector2d> param;
-  const std::size_t points = map.mesh().num_cells() * static_cast<std::size_t>((k + 1) * (k + 1));
-  jr.reserve(points), det.reserve(points), js.reserve(points), param.reserve(points);
+  detail::SampleQualityFields quality;
+  quality.reserve(map.mesh().num_cells() * static_cast<std::size_t>((k + 1) * (k + 1)));
   // The samples of a cell from its Bezier elements (element_map.h).
   const BezierExtraction extraction(map.basis());
   CellMapEvaluator cell_map(extraction, map.control_points());
   toolkit::io::VtuMesh out = cell_grid_vtu(map.mesh(), k, [&](int c, const Eigen::Vector2d& uv) {
     cell_map.set_cell(c);
     const MapDerivatives d = cell_map.at(uv);
-    jr.push_back(mean_ratio_jacobian(d.J));
-    det.push_back(d.J.determinant());
-    js.push_back(scaled_jacobian(d.J));
-    param.push_back(uv);
+    quality.push(d.J, uv);
     return d.x;
   });
-  out.point_scalars["mean_ratio_jacobian"] = std::move(jr);
-  out.point_scalars["det_jacobian"] = std::move(det);
-  out.point_scalars["scaled_jacobian"] = std::move(js);
-  out.point_vectors["parametric"] = std::move(param);
+  quality.attach_to(out);
   return out;
 }
 
@@ -95,8 +87,8 @@ toolkit::io::VtuMesh physical_tmesh_vtu(const TSplineMap& map, int k, const MapC
   if (quality && quality->size() != mesh.num_cells()) quality = nullptr;
   const double nan = std::numeric_limits<double>::quiet_NaN();
   toolkit::io::VtuMesh out;
-  std::vector<Eigen::Vector2d> param;
-  std::vector<int> vertex, hanging, boundary;
+  detail::TMeshPointFields fields;
+  std::vector<int> vertex;
   // One point per parametric position: a segment is sampled from its
   // lexicographically smaller end, so both cells along it get the same doubles.
   std::map<std::pair<double, double>, int> index;
@@ -107,10 +99,9 @@ toolkit::io::VtuMesh physical_tmesh_vtu(const TSplineMap& map, int k, const MapC
     if (added) {
       cell_map.set_cell(c);
       out.points.push_back(cell_map.at(uv).x);
-      param.push_back(uv);
+      fields.push(uv, v >= 0 && mesh.vertex_is_hanging(v),
+                  uv.x() == 0.0 || uv.x() == 1.0 || uv.y() == 0.0 || uv.y() == 1.0);
       vertex.push_back(v);
-      hanging.push_back(v >= 0 && mesh.vertex_is_hanging(v) ? 1 : 0);
-      boundary.push_back(uv.x() == 0.0 || uv.x() == 1.0 || uv.y() == 0.0 || uv.y() == 1.0 ? 1 : 0);
     }
     return it->second;
   };
@@ -154,8 +145,7 @@ toolkit::io::VtuMesh physical_tmesh_vtu(const TSplineMap& map, int k, const MapC
   }
   // The points were counted as they came: the arrays at their final size (all
   // patches' parts are held at once before they are merged).
-  out.points.shrink_to_fit(), param.shrink_to_fit(), vertex.shrink_to_fit();
-  hanging.shrink_to_fit(), boundary.shrink_to_fit();
+  out.points.shrink_to_fit(), vertex.shrink_to_fit(), fields.shrink_to_fit();
   out.cell_ints["level"] = std::move(level);
   out.cell_ints["valid"] = std::move(valid);
   out.cell_ints["certified"] = std::move(certified);
@@ -163,10 +153,8 @@ toolkit::io::VtuMesh physical_tmesh_vtu(const TSplineMap& map, int k, const MapC
   out.cell_scalars["relative_det_lower_bound"] = std::move(relative);
   out.cell_scalars["min_det_jacobian"] = std::move(min_det);
   out.cell_scalars["min_mean_ratio_jacobian"] = std::move(min_jr);
-  out.point_vectors["parametric"] = std::move(param);
   out.point_ints["vertex"] = std::move(vertex);
-  out.point_ints["hanging"] = std::move(hanging);
-  out.point_ints["boundary"] = std::move(boundary);
+  fields.attach_to(out);
   return out;
 }
 
@@ -225,6 +213,24 @@ nlohmann::json certification_json(const MapCertification& c) {
           {"min_det_lower_bound", finite(c.min_det_lower_bound)},
           {"max_subdivision_depth", c.max_depth_used},
           {"seconds", c.seconds}};
+}
+
+// One adaptive round's untangling of the control points.
+nlohmann::json untangling_json(const MapUntanglingReport& u) {
+  return {{"free_points", u.free_points},
+          {"elements", u.elements},
+          {"samples", u.samples},
+          {"stages", u.stages},
+          {"lbfgs_iterations", u.iterations},
+          {"evaluations", u.evaluations},
+          {"sample_refinements", u.sample_refinements},
+          {"local_repairs", u.local_repairs},
+          {"local_repairs_certified", u.local_repairs_certified},
+          {"samples_nonpositive_before", u.before.nonpositive},
+          {"samples_nonpositive_after", u.after.nonpositive},
+          {"certified", u.certified},
+          {"stop_reason", u.stop_reason},
+          {"seconds", u.seconds}};
 }
 
 // The options the result was computed with (what a rerun needs).
@@ -405,21 +411,7 @@ nlohmann::json param_report(const ParameterizationResult& r, const std::string& 
                    {"cells_refined_after", it.refined_cells},
                    {"interpolation_relative_residual", it.fit.relative_residual},
                    {"control_points_optimized", it.control_points_optimized},
-                   {"untangling",
-                    {{"free_points", it.untangling.free_points},
-                     {"elements", it.untangling.elements},
-                     {"samples", it.untangling.samples},
-                     {"stages", it.untangling.stages},
-                     {"lbfgs_iterations", it.untangling.iterations},
-                     {"evaluations", it.untangling.evaluations},
-                     {"sample_refinements", it.untangling.sample_refinements},
-                     {"local_repairs", it.untangling.local_repairs},
-                     {"local_repairs_certified", it.untangling.local_repairs_certified},
-                     {"samples_nonpositive_before", it.untangling.before.nonpositive},
-                     {"samples_nonpositive_after", it.untangling.after.nonpositive},
-                     {"certified", it.untangling.certified},
-                     {"stop_reason", it.untangling.stop_reason},
-                     {"seconds", it.untangling.seconds}}},
+                   {"untangling", untangling_json(it.untangling)},
                    {"jacobian", map_quality_json(it.quality)},
                    {"seconds", it.seconds}});
   if (ad.certify)

@@ -9,6 +9,7 @@
 #include "tspline/io/tspline_file.h"
 
 #include <algorithm>
+#include <array>
 #include <cerrno>
 #include <cmath>
 #include <cstring>
@@ -16,10 +17,12 @@
 #include <fstream>
 #include <map>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <sstream>
 #include <stdexcept>
 #include <tuple>
 
+#include "tspline/detail/enum_names.h"
 #include "tspline/errors.h"
 #include "toolkit/io/atomic_file.h"
 
@@ -34,14 +37,10 @@ using Kind = BlendingFunction::Kind;
 constexpr int kVersion = 1;
 constexpr const char* kNormalization = "R_alpha = N_alpha / sum_beta N_beta";
 
-const char* kind_name(Kind k) {
-  switch (k) {
-    case Kind::Anchor: return "anchor";
-    case Kind::EdgeExtra: return "edge";
-    case Kind::CornerExtra: return "corner";
-  }
-  return "?";
-}
+constexpr std::array<detail::EnumName<Kind>, 3> kKindNames{
+    {{Kind::Anchor, "anchor"}, {Kind::EdgeExtra, "edge"}, {Kind::CornerExtra, "corner"}}};
+
+const char* kind_name(Kind k) { return detail::enum_name(kKindNames, k, "?"); }
 
 json vec2(const Eigen::Vector2d& p) { return json::array({p.x(), p.y()}); }
 json knots(const std::array<double, 5>& k) { return json(k); }
@@ -271,11 +270,9 @@ class Reader {
       const json& f = fs[k];
       if (!f.is_object()) fail(p, "expected an object");
       const std::string kind = string(member(f, p, "kind"), p + "/kind");
-      Kind kd;
-      if (kind == "anchor") kd = Kind::Anchor;
-      else if (kind == "edge") kd = Kind::EdgeExtra;
-      else if (kind == "corner") kd = Kind::CornerExtra;
-      else fail(p + "/kind", "expected \"anchor\", \"edge\" or \"corner\", found \"" + kind + "\"");
+      const std::optional<Kind> parsed = detail::enum_value(kKindNames, kind);
+      if (!parsed) fail(p + "/kind", "expected \"anchor\", \"edge\" or \"corner\", found \"" + kind + "\"");
+      const Kind kd = *parsed;
       const json& vj = member(f, p, "vertex");
       if (!vj.is_array() || vj.size() != 2) fail(p + "/vertex", "expected 2 integers [X, Y]");
       const I64 X = integer(vj[0], p + "/vertex/0", 0, TMesh::kRoot);

@@ -1,33 +1,34 @@
 #include "tspline/pipeline/domain_parameterization.h"
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <future>
 #include <limits>
 #include <mutex>
+#include <optional>
 #include <sstream>
 
+#include "tspline/detail/enum_names.h"
 #include "tspline/errors.h"
 #include "tspline/layout/quad_mesher.h"
 #include "tspline/multipatch/automatic_cuts.h"
 
 namespace tspline {
 
+namespace {
+
+constexpr std::array<detail::EnumName<LayoutMode>, 3> kLayoutModeNames{
+    {{LayoutMode::Auto, "auto"}, {LayoutMode::Single, "single"}, {LayoutMode::Quad, "quad"}}};
+
+}  // namespace
+
 LayoutMode parse_layout_mode(const std::string& name) {
-  if (name == "auto") return LayoutMode::Auto;
-  if (name == "single") return LayoutMode::Single;
-  if (name == "quad") return LayoutMode::Quad;
+  if (const std::optional<LayoutMode> mode = detail::enum_value(kLayoutModeNames, name)) return *mode;
   throw InputError("layout '" + name + "' is not one of auto, single, quad");
 }
 
-const char* layout_mode_name(LayoutMode mode) {
-  switch (mode) {
-    case LayoutMode::Auto: return "auto";
-    case LayoutMode::Single: return "single";
-    case LayoutMode::Quad: return "quad";
-  }
-  return "auto";
-}
+const char* layout_mode_name(LayoutMode mode) { return detail::enum_name(kLayoutModeNames, mode, "auto"); }
 
 namespace {
 

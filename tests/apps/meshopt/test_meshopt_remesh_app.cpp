@@ -37,12 +37,10 @@ TEST_CASE("meshopt remesh: a fused cylinder and sphere, outputs readable by Gmsh
   const fs::path dir = test_support::scratch_dir("meshopt_remesh_app", "cad");
   write_model(dir / "model.brep");
   const std::string model = std::string("'") + (dir / "model.brep").string() + "'";
-  const auto run = run_meshopt("remesh " + model + " --out '" + (dir / "out/r.msh").string() + "' --vtu '" +
-                                   (dir / "out/r.vtu").string() + "' --length 0.15 --anisotropy 0.5",
-                               dir);
-  CAPTURE(run.out);
-  CAPTURE(run.err);
-  REQUIRE(run.exit_code == 0);
+  const auto run = test_support::require_success(
+      run_meshopt("remesh " + model + " --out '" + (dir / "out/r.msh").string() + "' --vtu '" +
+                      (dir / "out/r.vtu").string() + "' --length 0.15 --anisotropy 0.5",
+                  dir));
   CHECK(contains(run.out, "meshopt remesh:"));
   CHECK(contains(run.out, "chordal deviation"));
   const nlohmann::json rep = nlohmann::json::parse(test_support::slurp(dir / "out/r.json"));
