@@ -7,8 +7,9 @@
 # (pytest, tests/python) run after the Release suites, not under the sanitizers,
 # and then every command of README.md (scripts/run_readme_commands.sh).
 # Before the sanitizer suites, the libFuzzer targets (scripts/run_fuzz.sh: clang,
-# ASan, 20 s each), so that the run still ends with doctest's summaries (the sanitized
-# suites run in groups, one per core at a time: scripts/run_test_chunks.sh).
+# ASan, 20 s each, one per core at a time), so that the run still ends with
+# doctest's summaries. Both doctest runs go in groups of suites, one per core at
+# a time (scripts/run_test_chunks.sh), with a total at the end.
 # Exits non-zero if any test fails.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -22,7 +23,9 @@ stage "Release build and tests"
 # install_deps put numpy and pytest), whatever python3 comes first on PATH.
 PYTHON=${PYTHON:-/usr/bin/python3}
 BUILD_DIR=build BUILD_TYPE=Release bash scripts/build.sh -DPython3_EXECUTABLE="$PYTHON"
-./build/tests/unit_tests
+# Most test cases run on one core: the suites in groups, one per core at a time
+# (scripts/run_test_chunks.sh), each group with its doctest summary.
+bash scripts/run_test_chunks.sh ./build/tests/unit_tests
 stage "Python module (pytest; build/python)"
 PYTHONPATH="$PWD/build/python" "$PYTHON" -m pytest -p no:cacheprovider tests/python
 stage "README commands (every command of README.md, against the Release build)"
