@@ -2,7 +2,7 @@
 # Installs the Debian 12 packages the project needs, if any is missing.
 # Needs root (or sudo) only when something must be installed.
 set -euo pipefail
-PACKAGES=(build-essential cmake pkg-config libeigen3-dev libcgal-dev libgmp-dev libmpfr-dev libceres-dev
+PACKAGES=(build-essential cmake ninja-build pkg-config libeigen3-dev libcgal-dev libgmp-dev libmpfr-dev libceres-dev
           libvtk9-dev doctest-dev nlohmann-json3-dev libcli11-dev
           libmuparser-dev libsuitesparse-dev libgmsh-dev gmsh libpetsc-real-dev openmpi-bin
           libgdal-dev libcairo2-dev fonts-dejavu-core

@@ -80,6 +80,11 @@ TEST_SUITE("app") {
     }
     CHECK(wm["min_mean_ratio"].get<double>() == doctest::Approx(1.0).epsilon(1e-9));
     CHECK(wm["points_per_element"] == 81);
+    // The corners the boundary fixes: right angles, the sides' tangents of equal speed.
+    CHECK(wm["boundary_corner"]["scaled_jacobian"].get<double>() == doctest::Approx(1.0).epsilon(1e-9));
+    CHECK(wm["boundary_corner"]["mean_ratio"].get<double>() == doctest::Approx(1.0).epsilon(1e-9));
+    CHECK(wm["boundary_corner"]["angle_degrees"].get<double>() == doctest::Approx(90.0).epsilon(1e-9));
+    CHECK(r.out.find("; the boundary fixes the scaled Jacobian at 1 at a corner of 90.0 degrees") != std::string::npos);
     CHECK(r.out.find("whole map: J_r >= 1 certified (min 1 in a dense sample of 676 points per element), scaled "
                      "Jacobian >= 1 certified (sampled min 1)") != std::string::npos);
     for (const char* stage : {"boundary", "tmesh", "coons", "optimization", "total"})

@@ -80,6 +80,9 @@ TEST_SUITE("holes_app") {
       // ... also where a single-patch report has it, so readers need no case for several patches.
       CHECK(rep["jacobian"]["whole_map"][q] == t);
     }
+    // Every corner of the square has a cut ending there (its diagonals), so no
+    // patch corner has both sides on the rings: nothing for the boundary to fix.
+    CHECK_FALSE(rep["totals"]["whole_map"].contains("boundary_corner"));
     CHECK(rep["certified_valid"] == true);
     double dense = 2.0;
     for (const auto& p : rep["patches"]) dense = std::min(dense, p["jacobian"]["whole_map"]["min_mean_ratio"].get<double>());

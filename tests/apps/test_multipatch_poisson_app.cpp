@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 #include <filesystem>
 #include <map>
 #include <nlohmann/json.hpp>
@@ -107,6 +108,24 @@ TEST_SUITE("multipatch_poisson_app") {
         CHECK(s["glued_pairs"].get<std::size_t>() > 0);
       }
     }
+  }
+
+  TEST_CASE("the sea's report: the worst corner the boundary fixes bounds the certified whole-map figures") {
+    // The box around the islands has patch corners with both sides on the
+    // outer ring; J there is the pair of boundary tangents (corner_quality.h),
+    // so no certified lower bound can exceed its figures.
+    const json rep = json::parse(test_support::slurp(map_of("seas/comoros.txt").parent_path() / "report.json"));
+    const json& w = rep["totals"]["whole_map"];
+    REQUIRE(w.contains("boundary_corner"));
+    const json& c = w["boundary_corner"];
+    CHECK(c["patch"].get<std::size_t>() < rep["patches"].size());
+    CHECK(c["angle_degrees"].get<double>() > 0.0);
+    CHECK(c["angle_degrees"].get<double>() < 180.0);
+    CHECK(c["scaled_jacobian"].get<double>() == doctest::Approx(std::sin(c["angle_degrees"].get<double>() * std::numbers::pi / 180.0)).epsilon(1e-9));
+    CHECK(c["mean_ratio"].get<double>() <= c["scaled_jacobian"].get<double>() + 1e-12);  // |J_r| <= |J_s|
+    CHECK(w["scaled_jacobian"]["certified_lower_bound"].get<double>() <= c["scaled_jacobian"].get<double>());
+    CHECK(w["mean_ratio"]["certified_lower_bound"].get<double>() <= c["mean_ratio"].get<double>());
+    CHECK(rep["jacobian"]["whole_map"]["boundary_corner"] == c);
   }
 
   TEST_CASE("adaptive gaussian: the refined region crosses interfaces, the space stays conforming, H1 falls") {

@@ -1,9 +1,11 @@
 #include "tspline/io/multipatch_output.h"
 
+#include <array>
 #include <exception>
 #include <filesystem>
 #include <functional>
 #include <future>
+#include <optional>
 #include <initializer_list>
 #include <stdexcept>
 #include <string_view>
@@ -22,6 +24,23 @@ namespace tspline::io {
 namespace {
 
 using json = nlohmann::json;
+
+// The worst patch corner whose two sides lie on the domain's boundary (rings,
+// not cuts: a corner on a cut could move with the layout).
+std::optional<BoundaryCornerQuality> worst_domain_corner(const MultiPatchResult& R) {
+  std::optional<BoundaryCornerQuality> worst;
+  for (std::size_t p = 0; p < R.patches.size(); ++p) {
+    if (!R.patches[p].map) continue;
+    const std::array<int, 4>& cut = R.layout.patches[p].side_cut;
+    std::array<bool, 4> on_rings{};
+    for (int k = 0; k < 4; ++k) on_rings[k] = cut[(k + 3) % 4] < 0 && cut[k] < 0;
+    auto c = worst_boundary_corner(*R.patches[p].map, on_rings);
+    if (!c) continue;
+    c->patch = p;
+    if (!worst || c->scaled_jacobian < worst->scaled_jacobian) worst = c;
+  }
+  return worst;
+}
 
 // The patches' whole-map quality figures combined (combine_whole_map_quality_json).
 json whole_map_of(const json& patch_reports) {
@@ -94,6 +113,8 @@ json multipatch_report(const MultiPatchResult& R, const std::string& input_path,
                    {"seconds", seconds}};
   // What a single-patch report has at its top level, over every patch, so
   // that a reader of report.json needs no case for multi-patch maps.
+  if (const auto corner = worst_domain_corner(R))
+    rep["totals"]["whole_map"]["boundary_corner"] = boundary_corner_json(*corner);
   rep["certified_valid"] = R.certified_valid();
   rep["valid"] = R.valid();
   rep["jacobian"]["min_mean_ratio_jacobian"] = R.min_mean_ratio_gauss();

@@ -307,6 +307,17 @@ nlohmann::json whole_map_quality_json(const MapQualityBounds& q, const QualityBo
             {"seconds", q.seconds}}}};
 }
 
+nlohmann::json boundary_corner_json(const BoundaryCornerQuality& c) {
+  return {{"scaled_jacobian", c.scaled_jacobian},
+          {"mean_ratio", c.mean_ratio},
+          {"angle_degrees", c.angle_degrees},
+          {"at", {c.at.x(), c.at.y()}},
+          {"patch", c.patch},
+          {"corner", c.corner},
+          {"note", "J at a corner whose two sides are the domain's boundary is the pair of boundary tangents, which "
+                   "no interior control point changes: the whole-map minima cannot exceed these values"}};
+}
+
 std::string whole_map_quality_summary(const nlohmann::json& w) {
   auto num = [](const nlohmann::json& v) {
     if (v.is_null()) return std::string("none");
@@ -321,9 +332,17 @@ std::string whole_map_quality_summary(const nlohmann::json& w) {
   const std::string sample =
       k > 0 ? "min " + num(jr.at("sampled_min")) + " in a dense sample of " + std::to_string(k) + " points per element"
             : "no dense sample";
-  return "whole map: J_r >= " + num(jr.at("certified_lower_bound")) + " certified (" + sample +
-         "), scaled Jacobian >= " + num(sj.at("certified_lower_bound")) + " certified (" +
-         (k > 0 ? "sampled min " + num(sj.at("sampled_min")) : std::string("no dense sample")) + ")";
+  std::string line = "whole map: J_r >= " + num(jr.at("certified_lower_bound")) + " certified (" + sample +
+                     "), scaled Jacobian >= " + num(sj.at("certified_lower_bound")) + " certified (" +
+                     (k > 0 ? "sampled min " + num(sj.at("sampled_min")) : std::string("no dense sample")) + ")";
+  if (w.contains("boundary_corner")) {
+    const nlohmann::json& c = w.at("boundary_corner");
+    char angle[32];
+    std::snprintf(angle, sizeof angle, "%.1f", c.at("angle_degrees").get<double>());
+    line += "; the boundary fixes the scaled Jacobian at " + num(c.at("scaled_jacobian")) + " at a corner of " +
+            angle + " degrees";
+  }
+  return line;
 }
 
 nlohmann::json combine_whole_map_quality_json(const std::vector<nlohmann::json>& whole_maps) {
@@ -390,6 +409,8 @@ nlohmann::json param_report(const ParameterizationResult& r, const std::string& 
   if (r.map) {
     const QualityBoundOptions qo = report_quality_bound_options();
     rep["jacobian"]["whole_map"].update(whole_map_quality_json(certified_map_quality(*r.map, qo), qo));
+    if (const auto corner = worst_boundary_corner(*r.map))
+      rep["jacobian"]["whole_map"]["boundary_corner"] = boundary_corner_json(*corner);
   }
   rep["boundary_curve_proven_simple"] = r.boundary_simple;
   if (!r.boundary_problem.empty()) rep["boundary_problem"] = r.boundary_problem;

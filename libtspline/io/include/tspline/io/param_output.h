@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "tspline/pipeline/adaptive_parameterization.h"
+#include "tspline/validity/corner_quality.h"
 #include "tspline/validity/map_quality_bounds.h"
 #include "toolkit/io/vtu_writer.h"
 
@@ -81,9 +82,17 @@ QualityBoundOptions report_quality_bound_options();
 /// limit, seconds). Parametric locations are of the patch holding them.
 nlohmann::json whole_map_quality_json(const MapQualityBounds& bounds, const QualityBoundOptions& options);
 
+/// The worst corner of the parameter square whose two sides are the domain's
+/// boundary (corner_quality.h): "scaled_jacobian", "mean_ratio",
+/// "angle_degrees", "at" (x, y), "patch" and "corner"; written as
+/// jacobian.whole_map.boundary_corner: the whole-map minima cannot exceed it.
+nlohmann::json boundary_corner_json(const BoundaryCornerQuality& corner);
+
 /// One line for the command line from a whole_map_quality_json object, e.g.
 /// "whole map: J_r >= 0.0354 certified (min 0.0357 in a 26 x 26 sample per
-/// element), scaled Jacobian >= 0.0357 certified (sample 0.0357)".
+/// element), scaled Jacobian >= 0.0357 certified (sample 0.0357)", and where
+/// the object has a boundary_corner, what that corner allows ("; at most 0.182
+/// at a boundary corner of 10.5 degrees, which the boundary fixes").
 std::string whole_map_quality_summary(const nlohmann::json& whole_map);
 
 /// The same figures over several patches from their reports' jacobian.whole_map

@@ -1,0 +1,105 @@
+// The quality the boundary fixes at the corners of the parameter square
+// (corner_quality.h): against the angles of a bilinear quad, and unchanged by
+// every control point the untangling may move.
+#include <doctest/doctest.h>
+
+#include <array>
+#include <cmath>
+#include <numbers>
+#include <random>
+
+#include "separable_maps.h"
+#include "test_support.h"
+#include "tspline/validity/corner_quality.h"
+#include "tspline/validity/map_energy.h"
+
+namespace {
+
+using Eigen::Vector2d;
+
+// The bilinear map of [0,1]^2 onto the quad q0 q1 q2 q3 (counter-clockwise, q_k
+// the image of corner k): on a mesh without T-junctions the Greville
+// interpolant reproduces it exactly (linear in each direction).
+tspline::TSplineMap bilinear_map(const std::array<Vector2d, 4>& q, int level) {
+  tspline::TSplineMap map = tspline::greville_identity_map(test_support::uniform_mesh(level));
+  std::vector<Vector2d> P = map.control_points();
+  for (Vector2d& p : P) {
+    const double u = p.x(), v = p.y();
+    p = (1 - u) * (1 - v) * q[0] + u * (1 - v) * q[1] + u * v * q[2] + (1 - u) * v * q[3];
+  }
+  map.set_control_points(P);
+  return map;
+}
+
+// The quad's interior angle at q_k and what the Jacobian there gives: the
+// columns are the edges from q_k along the two sides (lengths a and b), so
+// J_s = sin(angle) and J_r = 2 a b sin(angle) / (a^2 + b^2).
+struct CornerFigures {
+  double angle_degrees, scaled, mean_ratio;
+};
+CornerFigures corner_figures(const std::array<Vector2d, 4>& q, int k) {
+  const Vector2d e1 = q[(k + 1) % 4] - q[k], e2 = q[(k + 3) % 4] - q[k];
+  const double a = e1.norm(), b = e2.norm();
+  const double angle = std::acos(e1.dot(e2) / (a * b));
+  return {angle * 180.0 / std::numbers::pi, std::sin(angle), 2 * a * b * std::sin(angle) / (a * a + b * b)};
+}
+
+}  // namespace
+
+TEST_SUITE("corner_quality") {
+  TEST_CASE("a bilinear quad: the worst corner has the angle farthest from 90 degrees, J_s = sin, J_r = 2ab sin / (a^2+b^2)") {
+    // Interior angles 90, 63.4, 135 and 71.6 degrees (sum 360): the scaled
+    // Jacobian is the sine, so the obtuse 135 degrees at q2 is the worst
+    // (0.707), then 63.4 degrees at q1 (0.894).
+    const std::array<Vector2d, 4> q = {Vector2d(0, 0), Vector2d(4, 0), Vector2d(3, 2), Vector2d(0, 3)};
+    CHECK(corner_figures(q, 0).angle_degrees + corner_figures(q, 1).angle_degrees +
+              corner_figures(q, 2).angle_degrees + corner_figures(q, 3).angle_degrees ==
+          doctest::Approx(360.0).epsilon(1e-12));
+    const tspline::TSplineMap map = bilinear_map(q, 2);
+    for (const auto& [counted, expected] :
+         {std::pair{std::array<bool, 4>{true, true, true, true}, 2}, std::pair{std::array<bool, 4>{true, true, false, true}, 1},
+          std::pair{std::array<bool, 4>{true, false, false, false}, 0}}) {
+      CAPTURE(expected);
+      const auto worst = tspline::worst_boundary_corner(map, counted);
+      REQUIRE(worst.has_value());
+      CHECK(worst->corner == expected);
+      const CornerFigures f = corner_figures(q, expected);
+      CHECK(worst->angle_degrees == doctest::Approx(f.angle_degrees).epsilon(1e-12));
+      CHECK(worst->scaled_jacobian == doctest::Approx(f.scaled).epsilon(1e-12));
+      CHECK(worst->mean_ratio == doctest::Approx(f.mean_ratio).epsilon(1e-12));
+      CHECK((worst->at - q[expected]).norm() < 1e-12);
+    }
+    CHECK(tspline::worst_boundary_corner(map)->scaled_jacobian == doctest::Approx(std::sqrt(0.5)).epsilon(1e-12));
+    CHECK_FALSE(tspline::worst_boundary_corner(map, {false, false, false, false}).has_value());
+  }
+
+  TEST_CASE("no control point the untangling moves changes J at a corner") {
+    // A T-mesh with hanging vertices, mapped onto a quad; every free control
+    // point of the map energy (the functions whose support stays off the
+    // border) moved at random: J changes inside, not at the four corners.
+    const std::array<Vector2d, 4> q = {Vector2d(0, 0), Vector2d(5, 1), Vector2d(4, 4), Vector2d(-1, 2)};
+    tspline::TSplineMap map = tspline::greville_identity_map(test_support::random_leaf_splits(2, 12, 7));
+    std::vector<Vector2d> P = map.control_points();
+    for (Vector2d& p : P) {
+      const double u = p.x(), v = p.y();
+      p = (1 - u) * (1 - v) * q[0] + u * (1 - v) * q[1] + u * v * q[2] + (1 - u) * v * q[3];
+    }
+    map.set_control_points(P);
+    const std::array<Vector2d, 4> corners = {Vector2d(0, 0), Vector2d(1, 0), Vector2d(1, 1), Vector2d(0, 1)};
+    std::array<Eigen::Matrix2d, 4> before;
+    for (int k = 0; k < 4; ++k) before[k] = map.jacobian(corners[k]);
+    const Eigen::Matrix2d inside_before = map.jacobian(Vector2d(0.4, 0.55));
+
+    const tspline::MapEnergy energy(map);
+    REQUIRE(!energy.free_functions().empty());
+    std::mt19937 rng(3);
+    std::uniform_real_distribution<double> shift(-0.3, 0.3);
+    for (int a : energy.free_functions()) P[a] += Vector2d(shift(rng), shift(rng));
+    map.set_control_points(P);
+    for (int k = 0; k < 4; ++k) {
+      CAPTURE(k);
+      CHECK((map.jacobian(corners[k]) - before[k]).norm() <= 1e-12 * before[k].norm());
+    }
+    CHECK((map.jacobian(Vector2d(0.4, 0.55)) - inside_before).norm() > 1e-3);
+  }
+}
