@@ -15,6 +15,7 @@
 #include "tspline/io/tspline_file.h"
 #include "tspline/multipatch/multipatch_parameterization.h"
 #include "tspline/validity/map_certification.h"
+#include "tspline/validity/corner_quality.h"
 #include "tspline/validity/map_quality.h"
 #include "tspline/validity/map_quality_bounds.h"
 
@@ -58,6 +59,10 @@ bool check_map(const tspline::io::LoadedTSpline& t, const CheckArgs& args) {
   std::printf("scaled Jacobian >= %.6g on the whole map (certified lower bound; min %.6g in a dense sample of %d x %d "
               "points per element)\n",
               qb.scaled.lower_bound, qb.scaled.sampled, qo.samples_per_edge + 1, qo.samples_per_edge + 1);
+  if (const auto corner = tspline::worst_boundary_corner(t.map))
+    std::printf("scaled Jacobian at the worst corner of the square, which the boundary fixes: %.6g (J_r %.6g; "
+                "interior angle %.1f degrees at (x, y) = (%.6g, %.6g)): no whole-map minimum can exceed it\n",
+                corner->scaled_jacobian, corner->mean_ratio, corner->angle_degrees, corner->at.x(), corner->at.y());
   std::printf("J_r min over a dense sample of %d x %d points per element: %.6g\n", qo.samples_per_edge + 1,
               qo.samples_per_edge + 1, qb.mean_ratio.sampled);
   std::printf("J_r min over the samples below: %.6g (the smaller of the two)\n",

@@ -58,6 +58,10 @@ TEST_SUITE("check_app") {
     CHECK(contains(r.out, "certified: 16 of 16 elements"));
     CHECK(contains(r.out, "det J > 0 proven false: 0 elements\n"));
     CHECK(contains(r.out, "result: certified valid"));
+    // Only inner control points moved: the corners keep the square's right
+    // angles and equal speeds, whatever the inside does.
+    CHECK(contains(r.out, "scaled Jacobian at the worst corner of the square, which the boundary fixes: 1 (J_r 1; "
+                          "interior angle 90.0 degrees"));
   }
 
   TEST_CASE("check: a map folded between the Gauss points fails (exit 3), naming the element and the point") {
