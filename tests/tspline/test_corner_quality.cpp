@@ -7,6 +7,7 @@
 #include <cmath>
 #include <numbers>
 #include <random>
+#include <utility>
 
 #include "separable_maps.h"
 #include "test_support.h"
@@ -17,11 +18,11 @@ namespace {
 
 using Eigen::Vector2d;
 
-// The bilinear map of [0,1]^2 onto the quad q0 q1 q2 q3 (counter-clockwise, q_k
-// the image of corner k): on a mesh without T-junctions the Greville
-// interpolant reproduces it exactly (linear in each direction).
-tspline::TSplineMap bilinear_map(const std::array<Vector2d, 4>& q, int level) {
-  tspline::TSplineMap map = tspline::greville_identity_map(test_support::uniform_mesh(level));
+// The Greville map of `mesh` carried by the bilinear map of [0,1]^2 onto the
+// quad q0 q1 q2 q3 (counter-clockwise, q_k the image of corner k): on a mesh
+// without T-junctions it is that bilinear map exactly (linear in each direction).
+tspline::TSplineMap bilinear_map(const std::array<Vector2d, 4>& q, tspline::TMesh mesh) {
+  tspline::TSplineMap map = tspline::greville_identity_map(std::move(mesh));
   std::vector<Vector2d> P = map.control_points();
   for (Vector2d& p : P) {
     const double u = p.x(), v = p.y();
@@ -55,7 +56,7 @@ TEST_SUITE("corner_quality") {
     CHECK(corner_figures(q, 0).angle_degrees + corner_figures(q, 1).angle_degrees +
               corner_figures(q, 2).angle_degrees + corner_figures(q, 3).angle_degrees ==
           doctest::Approx(360.0).epsilon(1e-12));
-    const tspline::TSplineMap map = bilinear_map(q, 2);
+    const tspline::TSplineMap map = bilinear_map(q, test_support::uniform_mesh(2));
     for (const auto& [counted, expected] :
          {std::pair{std::array<bool, 4>{true, true, true, true}, 2}, std::pair{std::array<bool, 4>{true, true, false, true}, 1},
           std::pair{std::array<bool, 4>{true, false, false, false}, 0}}) {
@@ -78,13 +79,8 @@ TEST_SUITE("corner_quality") {
     // point of the map energy (the functions whose support stays off the
     // border) moved at random: J changes inside, not at the four corners.
     const std::array<Vector2d, 4> q = {Vector2d(0, 0), Vector2d(5, 1), Vector2d(4, 4), Vector2d(-1, 2)};
-    tspline::TSplineMap map = tspline::greville_identity_map(test_support::random_leaf_splits(2, 12, 7));
+    tspline::TSplineMap map = bilinear_map(q, test_support::random_leaf_splits(2, 12, 7));
     std::vector<Vector2d> P = map.control_points();
-    for (Vector2d& p : P) {
-      const double u = p.x(), v = p.y();
-      p = (1 - u) * (1 - v) * q[0] + u * (1 - v) * q[1] + u * v * q[2] + (1 - u) * v * q[3];
-    }
-    map.set_control_points(P);
     const std::array<Vector2d, 4> corners = {Vector2d(0, 0), Vector2d(1, 0), Vector2d(1, 1), Vector2d(0, 1)};
     std::array<Eigen::Matrix2d, 4> before;
     for (int k = 0; k < 4; ++k) before[k] = map.jacobian(corners[k]);
