@@ -120,7 +120,7 @@ int run_check(const CheckArgs& args) {
 }  // namespace
 
 void add_check_command(CLI::App& app, CommandAction& action) {
-  const auto [check, args] = add_subcommand<CheckArgs>(
+  const Subcommand<CheckArgs> check_sub = add_subcommand<CheckArgs>(
       app, "check",
       "Certify that det J > 0 on the whole domain of a T-spline file, not only at sample points: on every "
       "Bezier "
@@ -128,6 +128,8 @@ void add_check_command(CLI::App& app, CommandAction& action) {
       "polynomial of bidegree (8,8) in the Bernstein basis and proved positive by its coefficients, with de "
       "Casteljau subdivision where needed. Exit 0 if certified valid, 3 if not (the elements and parametric "
       "points where det J < 0 are listed)");
+  CLI::App* const check = check_sub.cmd;
+  const std::shared_ptr<CheckArgs> args = check_sub.args;
   add_tspline_file_argument(*check, args->file);
   check
       ->add_option("--depth", args->depth,

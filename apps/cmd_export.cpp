@@ -79,10 +79,12 @@ void export_multipatch_bezier(const tspline::io::LoadedMaps& maps, const ExportA
 }  // namespace
 
 void add_export_command(CLI::App& app, CommandAction& action) {
-  const auto [cmd, a] = add_subcommand<ExportArgs>(
+  const Subcommand<ExportArgs> cmd_sub = add_subcommand<ExportArgs>(
       app, "export",
       "Write the T-spline as rational Bezier elements with their extraction operators (Scott et al. 2011), "
       "the interchange form for T-spline IGA in finite element codes (docs/bezier_format.md)");
+  CLI::App* const cmd = cmd_sub.cmd;
+  const std::shared_ptr<ExportArgs> a = cmd_sub.args;
   cmd->add_option("TSPLINE", a->file, "T-spline file written by `tspline param`")->required();
   cmd->add_option("--bezier", a->bezier, "Output JSON file of Bezier elements");
   cmd->add_option("--msh", a->msh,

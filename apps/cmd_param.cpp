@@ -111,10 +111,12 @@ struct ParamArgs {
 }  // namespace
 
 void add_param_command(CLI::App& app, CommandAction& action) {
-  const auto [param, args] = add_subcommand<ParamArgs>(
+  const Subcommand<ParamArgs> param_sub = add_subcommand<ParamArgs>(
       app, "param",
       "Parameterize the domain bounded by a polygon: adapted T-mesh, Coons start, untangling and smoothing, "
       "cubic T-spline fit, Jacobian check and adaptive refinement");
+  CLI::App* const param = param_sub.cmd;
+  const std::shared_ptr<ParamArgs> args = param_sub.args;
   param
       ->add_option(
           "DOMAIN", args->input,

@@ -325,7 +325,7 @@ int run_poisson(const PoissonArgs& args) {
 }  // namespace
 
 void add_poisson_command(CLI::App& app, CommandAction& action) {
-  const auto [cmd, a] = add_subcommand<PoissonArgs>(
+  const Subcommand<PoissonArgs> cmd_sub = add_subcommand<PoissonArgs>(
       app, "poisson",
       "Solve -Laplace(u) = f in the domain of a T-spline file (one patch or a multi-patch map), u = g on its "
       "boundary, with isogeometric analysis (cubic hierarchical B-splines of an analysis T-mesh per patch that "
@@ -340,6 +340,8 @@ void add_poisson_command(CLI::App& app, CommandAction& action) {
       "control points of every patch and L its longer side: sinsin u = sin(pi X) sin(pi Y); polynomial u = X^3 + "
       "X^2 Y - 2 Y^3 + X Y (in the discrete space when the map is affine); gaussian u = exp(-((x-x0)^2 + "
       "(y-y0)^2)/s^2) with (x0, y0) the centre of that box and s = 0.1 x its diagonal");
+  CLI::App* const cmd = cmd_sub.cmd;
+  const std::shared_ptr<PoissonArgs> a = cmd_sub.args;
   add_tspline_file_argument(*cmd, a->file, "T-spline file (tspline.json written by `tspline param`)");
   cmd->add_option("--out", a->out_dir, "Output directory (created when the first step is done)")
       ->type_name("DIR")

@@ -45,11 +45,13 @@ const char* view_name(tspline::io::RenderView v) {
 }  // namespace
 
 void add_render_command(CLI::App& app, CommandAction& action) {
-  const auto [cmd, a] = add_subcommand<RenderArgs>(
+  const Subcommand<RenderArgs> cmd_sub = add_subcommand<RenderArgs>(
       app, "render",
       "Draw a picture (PNG, SVG or PDF) of the outputs in DIR without ParaView or a display: the map's mean ratio Jacobian J_r "
       "(jacobian), the curved T-mesh (tmesh), the control net (control-net) of `tspline param`, or u_h of "
       "`tspline poisson` (solution)");
+  CLI::App* const cmd = cmd_sub.cmd;
+  const std::shared_ptr<RenderArgs> a = cmd_sub.args;
   cmd->add_option("DIR", a->dir, "Output directory of `tspline param` or `tspline poisson`")->required();
   cmd->add_option("--png,--image", a->png, "Picture to write: PNG, SVG or PDF by the extension")->required();
   cmd->add_option("--view", a->view,

@@ -134,10 +134,12 @@ int run_info(const std::string& file) {
 }  // namespace
 
 void add_tspline_file_commands(CLI::App& app, CommandAction& action) {
-  const auto [eval, eval_args] = add_subcommand<EvalArgs>(
+  const Subcommand<EvalArgs> eval_sub = add_subcommand<EvalArgs>(
       app, "eval",
       "Evaluate the T-spline map S(u, v) of a T-spline file at parametric points. Prints one line per point: "
       "'u v x y' (with --derivatives also 'dx/du dy/du dx/dv dy/dv det_J'), numbers with 17 significant digits");
+  CLI::App* const eval = eval_sub.cmd;
+  const std::shared_ptr<EvalArgs> eval_args = eval_sub.args;
   add_tspline_file_argument(*eval, eval_args->file);
   eval->add_option("--at", eval_args->at,
                    "Parametric point U V, both in [0, 1] (u along xi, v along eta); repeat for several points, "
@@ -151,10 +153,12 @@ void add_tspline_file_commands(CLI::App& app, CommandAction& action) {
                  "Also print the Jacobian columns dS/du = (dx/du, dy/du), dS/dv = (dx/dv, dy/dv) and det J");
   run_when_parsed(eval, eval_args, action, run_eval);
 
-  const auto [info, info_file] = add_subcommand<std::string>(
+  const Subcommand<std::string> info_sub = add_subcommand<std::string>(
       app, "info",
       "Describe a T-spline file: format version, source, T-mesh counts (cells, vertices, hanging vertices, max "
       "level), blending functions by kind, bounding boxes of the control points and the boundary polygon, corners");
+  CLI::App* const info = info_sub.cmd;
+  const std::shared_ptr<std::string> info_file = info_sub.args;
   add_tspline_file_argument(*info, *info_file);
   run_when_parsed(info, info_file, action, run_info);
 }

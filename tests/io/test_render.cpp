@@ -234,10 +234,10 @@ TEST_SUITE("render") {
       CHECK(pixel(-0.1, 2).white());
       CHECK(pixel(2, 4.1).white());
       std::vector<Rgb8> octants;
-      for (const auto& [X, Y] : std::vector<std::pair<double, double>>{
+      for (const std::pair<double, double>& at : std::vector<std::pair<double, double>>{
                {1, 0.3}, {3, 0.3}, {3.7, 1}, {3.7, 3}, {3, 3.7}, {1, 3.7}, {0.3, 3}, {0.3, 1}}) {
-        const Rgb8 c = pixel(X, Y);
-        INFO("at (" << X << ", " << Y << "): " << c.r << "," << c.g << "," << c.b);
+        const Rgb8 c = pixel(at.first, at.second);
+        INFO("at (" << at.first << ", " << at.second << "): " << c.r << "," << c.g << "," << c.b);
         CHECK_FALSE(c.white());
         CHECK_FALSE(c.dark());
         for (const Rgb8& o : octants) CHECK_FALSE(o == c);

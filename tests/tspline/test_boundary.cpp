@@ -63,7 +63,9 @@ double dist_to_polygon(const Polygon& p, const V2& x) {
 TEST_SUITE("boundary") {
   // ---- reading and validating the test domains --------------------------------
   TEST_CASE("every test domain reads with its header's vertex count and validates CCW") {
-    for (const auto& [name, count] : kDomains) {
+    for (const auto& domain : kDomains) {
+      const std::string& name = domain.first;
+      const std::size_t count = domain.second;
       CAPTURE(name);
       const Polygon raw = read(name);
       CHECK(raw.vertices.size() == count);
@@ -204,7 +206,8 @@ TEST_SUITE("boundary") {
   }
 
   TEST_CASE("choose_corners: every test domain -> four distinct convex vertices, deterministic") {
-    for (const auto& [name, count] : kDomains) {
+    for (const auto& domain : kDomains) {
+      const std::string& name = domain.first;
       CAPTURE(name);
       const Polygon p = validated(name);
       const Corners c = choose_corners(p);

@@ -57,9 +57,11 @@ TEST_SUITE("corner_quality") {
               corner_figures(q, 2).angle_degrees + corner_figures(q, 3).angle_degrees ==
           doctest::Approx(360.0).epsilon(1e-12));
     const tspline::TSplineMap map = bilinear_map(q, test_support::uniform_mesh(2));
-    for (const auto& [counted, expected] :
+    for (const auto& counted_expected :
          {std::pair{std::array<bool, 4>{true, true, true, true}, 2}, std::pair{std::array<bool, 4>{true, true, false, true}, 1},
           std::pair{std::array<bool, 4>{true, false, false, false}, 0}}) {
+      const auto& [counted, corner] = counted_expected;
+      const int expected = corner;
       CAPTURE(expected);
       const auto worst = tspline::worst_boundary_corner(map, counted);
       REQUIRE(worst.has_value());

@@ -229,7 +229,9 @@ TEST_SUITE("holes") {
     // vertices whose lobes cancel, its hull 0.0012 < 0.002: repaired by default.
     const Domain islet{square(0, 0, 10, 10),
                        {make_polygon({{5.04, 5.03}, {5.04, 5.0}, {5.0, 5.0}, {5.0, 4.97}})}};
-    const auto [hulled, islet_notes] = validate_with_notes(islet);
+    const ValidatedDomain islet_validated = validate_with_notes(islet);
+    const Domain& hulled = islet_validated.domain;
+    const std::vector<std::string>& islet_notes = islet_validated.notes;
     REQUIRE(islet_notes.size() == 1);
     CAPTURE(islet_notes[0]);
     CHECK(contains(islet_notes[0], "hole 1: crosses itself; replaced by its convex hull (4 of its 4 vertices; area 0"));

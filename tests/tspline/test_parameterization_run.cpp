@@ -105,7 +105,9 @@ TEST_SUITE("parameterization_run") {
               {"`min_jacobian`", [](auto&, auto& a) { a.min_jacobian = 0.0; }},
               {"`certification.max_depth`", [](auto&, auto& a) { a.certification.max_depth = 21; }},
               {"`untangling.quality_power`", [](auto&, auto& a) { a.untangling.quality_power = 0.5; }}};
-    for (const auto& [name, spoil] : cases) {
+    for (const auto& name_spoil : cases) {
+      const std::string& name = name_spoil.first;
+      const auto& spoil = name_spoil.second;
       CAPTURE(name);
       tspline::ParameterizationOptions o;
       tspline::AdaptiveOptions a;

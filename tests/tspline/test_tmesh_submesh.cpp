@@ -105,7 +105,8 @@ TEST_SUITE("tmesh_submesh") {
   TEST_CASE("Appendix, regular vertex: weighted optimum of a 1:2:4 orthogonal mesh is orthogonal") {
     const TMesh m = regular_124_mesh();
     const int v = vertex_at(m, 0.5, 0.5);
-    for (const auto& [a, b] : {std::pair{1.0, 1.0}, std::pair{1.0, 2.0}, std::pair{3.0, 0.7}}) {
+    for (const std::pair<double, double>& ab : {std::pair{1.0, 1.0}, std::pair{1.0, 2.0}, std::pair{3.0, 0.7}}) {
+      const double a = ab.first, b = ab.second;
       CAPTURE(a);
       CAPTURE(b);
       const auto x = stretched(m, a, b);
@@ -119,7 +120,8 @@ TEST_SUITE("tmesh_submesh") {
   TEST_CASE("Appendix, hanging vertex: weighted optimum is orthogonal for any a != b") {
     const TMesh m = hanging_mesh();
     const int v = vertex_at(m, 0.5, 0.75);
-    for (const auto& [a, b] : {std::pair{1.0, 2.0}, std::pair{2.0, 1.0}, std::pair{0.5, 1.3}, std::pair{3.0, 1.0}}) {
+    for (const std::pair<double, double>& ab : {std::pair{1.0, 2.0}, std::pair{2.0, 1.0}, std::pair{0.5, 1.3}, std::pair{3.0, 1.0}}) {
+      const double a = ab.first, b = ab.second;
       CAPTURE(a);
       CAPTURE(b);
       const auto x = stretched(m, a, b);

@@ -22,7 +22,6 @@ using detail::BernsteinPoly;
 using detail::bernstein_values;
 using detail::ElementJacobian;
 using detail::element_jacobian;
-constexpr int kMax = BernsteinPoly::kMaxDegree;
 
 // Gauss-Legendre (5 points on [0,1]) nodes, weights and the Bernstein values of
 // degrees 3 and 8 there, for the element mean of det J.
