@@ -13,7 +13,7 @@ bin=$1
 shift
 jobs=${JOBS:-$(nproc)}
 [[ $jobs =~ ^[1-9][0-9]*$ ]] || { echo "run_test_chunks.sh: JOBS must be a positive integer, got '$jobs'" >&2; exit 1; }
-# Measured under the sanitizers (about 6x the Release times): these few hold
+# Measured under the sanitizers (about 4x the Release times): these few hold
 # half of the run's CPU time (the multi-patch convergence rates, surface
 # smoothing on CAD models, the hardening runs, the examples as processes).
 SLOW_FIRST=(multipatch_poisson_app meshopt_surface_meshes hardening examples poisson holes_poisson

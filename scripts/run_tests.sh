@@ -46,7 +46,7 @@ stage "ASan+UBSan build and tests"
 # time of RelWithDebInfo's -O2 -g, as the sanitizers' documentation recommends.
 BUILD_DIR=build-asan BUILD_TYPE=RelWithDebInfo bash scripts/build.sh -DTSPLINE_SANITIZE=ON -DTSPLINE_BUILD_BENCH=OFF \
   -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g1 -DNDEBUG"
-# The sanitized suites run about six times slower than the Release ones: in
+# The sanitized suites run about four times slower than the Release ones: in
 # groups of suites, one per core at a time (scripts/run_test_chunks.sh), each
 # group with its doctest summary and a total at the end.
 ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
