@@ -25,8 +25,8 @@ struct Subcommand {
 };
 
 /// Registers subcommand `name` on `app` with a fresh `Args` for its options.
-/// (Name its members, not a structured binding of it: clang before 16, which
-/// builds the sanitizer tests, cannot capture a structured binding in a lambda.)
+/// (Name its members, not a structured binding of it: clang before 16, e.g.
+/// Debian 12's clang 14, cannot capture a structured binding in a lambda.)
 template <class Args>
 Subcommand<Args> add_subcommand(CLI::App& app, std::string name, std::string description) {
   return {app.add_subcommand(std::move(name), std::move(description)), std::make_shared<Args>()};

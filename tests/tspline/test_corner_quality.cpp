@@ -60,8 +60,8 @@ TEST_SUITE("corner_quality") {
     for (const auto& counted_expected :
          {std::pair{std::array<bool, 4>{true, true, true, true}, 2}, std::pair{std::array<bool, 4>{true, true, false, true}, 1},
           std::pair{std::array<bool, 4>{true, false, false, false}, 0}}) {
-      const auto& [counted, corner] = counted_expected;
-      const int expected = corner;
+      const std::array<bool, 4>& counted = counted_expected.first;
+      const int expected = counted_expected.second;
       CAPTURE(expected);
       const auto worst = tspline::worst_boundary_corner(map, counted);
       REQUIRE(worst.has_value());
