@@ -101,6 +101,37 @@ TEST_SUITE("quad_layout") {
     CHECK(tspline::ring_nodes(tri, {}).size() == 4);
   }
 
+  TEST_CASE("ring nodes: a spike or crack shorter than a quarter piece is a node, sharp at its own edges") {
+    // An 8 x 4 rectangle with, in its bottom side, a crack 0.1 deep and 0.04
+    // wide (inner angle 337.4 degrees at its tip, a turn of 157.4) and, in its
+    // top side, a spike 0.1 out (inner angle 22.6). With patch size 4 the
+    // corner test looks a quarter piece (1) either side, where the ring turns
+    // by only 12.7 degrees: the tips are nodes because they are sharp at the
+    // vertex itself (RingNodeOptions::sharp_turn, 150 degrees).
+    // (Off the sides' middles, where the split by size puts nodes anyway.)
+    const tspline::Polygon p = make_polygon({{0, 0}, {2.98, 0}, {3, 0.1}, {3.02, 0}, {8, 0}, {8, 4}, {5.02, 4},
+                                             {5, 4.1}, {4.98, 4}, {0, 4}});
+    const tspline::RingCurve r(p.vertices);
+    const double crack_tip = r.arc(2), spike_tip = r.arc(7);
+    CHECK(std::abs(r.turn(2)) > 157.0 * std::numbers::pi / 180.0);
+    CHECK(std::abs(r.turn(7)) > 157.0 * std::numbers::pi / 180.0);
+    auto size = [](const Eigen::Vector2d&) { return 4.0; };
+    auto has = [](const std::vector<double>& nodes, double s) {
+      return std::any_of(nodes.begin(), nodes.end(), [s](double n) { return std::abs(n - s) < 1e-12; });
+    };
+    const std::vector<double> nodes = tspline::ring_nodes(r, {}, size);
+    CHECK(has(nodes, crack_tip));
+    CHECK(has(nodes, spike_tip));
+    // The rectangle's own corners stay nodes.
+    for (const std::size_t corner : {0u, 4u, 5u, 9u}) CHECK(has(nodes, r.arc(corner)));
+    // Without the rule (no vertex is sharper than a half turn) neither tip is a node.
+    tspline::RingNodeOptions blunt;
+    blunt.sharp_turn = std::numbers::pi;
+    const std::vector<double> old = tspline::ring_nodes(r, blunt, size);
+    CHECK_FALSE(has(old, crack_tip));
+    CHECK_FALSE(has(old, spike_tip));
+  }
+
   TEST_CASE("size field: the local width in a neck, growing away from it at the grading rate") {
     const tspline::Domain d = tspline::validate_domain({dumbbell(0.5), {}});
     tspline::SizeFieldOptions o;

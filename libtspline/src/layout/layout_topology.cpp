@@ -47,6 +47,22 @@ double region_figure(const LayoutMesh& m, const LayoutTopology& t, const LayoutQ
   return f;
 }
 
+// The patch corners at the given nodes that the layout's final check rejects
+// (quad_layout.cpp: outside 1-170 degrees where the map sees it, at the node
+// itself: the ring's own edge, or the straight cut).
+int rejected_corners(const LayoutMesh& m, const LayoutTopology& t, const LayoutQuality& Q,
+                     const std::vector<int>& nodes) {
+  int count = 0;
+  for (const int n : nodes)
+    for (const auto& [q, j] : t.corners_of(n)) {
+      const auto [a, b] = Q.corner_vectors(m, t, q, j, 0.0);
+      const double l = a.norm() * b.norm();
+      const double sn = l > 0.0 ? (a.x() * b.y() - a.y() * b.x()) / l : -1.0;
+      if (!(sn > 0.0175 && (a.dot(b) > 0.0 || sn > 0.174))) ++count;
+    }
+  return count;
+}
+
 double corner_sj(const Eigen::Vector2d& p, const Eigen::Vector2d& next, const Eigen::Vector2d& prev) {
   const Eigen::Vector2d e1 = next - p, e2 = prev - p;
   const double l = e1.norm() * e2.norm();
@@ -254,6 +270,7 @@ RotationTry try_rotations(const LayoutMesh& whole, const LayoutTopology& whole_t
     const std::vector<int> hex(h.begin(), h.end());
     const std::vector<int> free = one_ring(m, t, hex);
     if (best == -1e300) before = region_figure(m, t, Q, free);
+    const int rejected_before = rejected_corners(m, t, Q, free);
     for (const int r : {1, 2}) {
       // Diagonal h_r - h_{r+3}; the shared edge's ends lose one quad each.
       const int d0 = h[r], d1 = h[r + 3];
@@ -269,7 +286,10 @@ RotationTry try_rotations(const LayoutMesh& whole, const LayoutTopology& whole_t
       const LayoutTopology ct(c);
       bool valid = true;
       for (const int n : free) valid = valid && admissible(c, ct, n);
-      if (!valid) continue;
+      // Never more corners that the final check rejects: a tangled
+      // neighbourhood's worst figure can rise while a ring node is left the
+      // corner of one quad on a straight coast, which no node move mends.
+      if (!valid || rejected_corners(c, ct, Q, free) > rejected_before) continue;
       const double after = region_figure(c, ct, Q, free);
       if (after > best) {
         best = after;

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 #include <utility>
 
 namespace tspline {
@@ -159,7 +160,12 @@ std::vector<double> ring_nodes(const RingCurve& ring, const RingNodeOptions& o,
       const double l = std::min(0.25 * h, 0.1 * L);
       const Eigen::Vector2d u = ring.point(ring.arc(i) + l) - p, w = p - ring.point(ring.arc(i) - l);
       const double turn = std::abs(std::atan2(w.x() * u.y() - w.y() * u.x(), w.dot(u)));
-      if (turn > o.corner_turn) turns.push_back({turn, ring.arc(i)});
+      // A vertex sharp at its own edges (a spike or a crack narrower than the
+      // quarter piece) is a node too, ahead of every other: inside a side it
+      // leaves the patch map J_r about sin^2(phi / 2) there (layout_quality.h),
+      // 0.003 for a tip of 6 degrees, where a patch corner has sin(phi) = 0.1.
+      if (std::abs(ring.turn(i)) > o.sharp_turn) turns.push_back({std::numbers::pi + std::abs(ring.turn(i)), ring.arc(i)});
+      else if (turn > o.corner_turn) turns.push_back({turn, ring.arc(i)});
     }
     std::sort(turns.begin(), turns.end(), std::greater<>());
     std::vector<double> kept;

@@ -9,8 +9,12 @@
 // reflex coastal tip the cut it needs: a ring node whose domain angle phi is
 // split into k corners gets phi / k each, SJ <= sin(phi / k)). A rotation is
 // kept where, after the nodes around it are optimized again
-// (layout_optimizer.h), the worst quad around it is better than before; inner
-// nodes keep valence >= 3, and no edge is doubled.
+// (layout_optimizer.h), the worst quad around it is better than before and
+// no more of its patch corners lie outside 1-170 degrees at the node itself
+// (the layout's final check; in a tangled neighbourhood the worst quad can
+// rise while a ring node is left the corner of one quad on a straight coast,
+// which no node move mends); inner nodes keep valence >= 3, and no edge is
+// doubled.
 #include <atomic>
 #include <cstddef>
 #include <functional>

@@ -9,7 +9,8 @@
 // `max_deviation` times the chord (a deep inlet, a sharp tip or a peninsula
 // inside one side would cost the patch its quality; wiggles small against the
 // side do not), at the ring's corners (a turn of more than 40 degrees on the
-// scale of a quarter piece), and then at equal arc length while the chord is
+// scale of a quarter piece, or of more than 150 degrees at the vertex itself:
+// the tip of a spike or a crack of any size), and then at equal arc length while the chord is
 // longer than the local patch size (size_field.h). Features smaller than `min_size` are
 // not resolved: they stay inside one side and the patch's T-mesh follows them.
 #include <Eigen/Core>
@@ -65,6 +66,10 @@ struct RingNodeOptions {
   /// Vertices where the ring turns by more than this (radians) on the scale of
   /// a quarter of the local piece size are nodes (corners of the domain).
   double corner_turn = 40.0 * 3.14159265358979323846 / 180.0;
+  /// Vertices where the ring turns by more than this at the vertex itself (an
+  /// inner angle below 30 or above 330 degrees: a spike, a crack) are nodes,
+  /// whatever the scale of the feature.
+  double sharp_turn = 150.0 * 3.14159265358979323846 / 180.0;
 };
 
 /// Nodes of one ring as arc lengths in [0, length), increasing, at ring vertices
