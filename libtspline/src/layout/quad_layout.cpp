@@ -199,6 +199,7 @@ QuadLayout build_quad_layout(const Domain& d, const QuadLayoutOptions& o) {
   int meshes = 0;  // made by the mesher (rounds that only add ring nodes make none)
   int level = 2;
   int repairs = 0;  // rounds that added nodes (dropping an optimization level is not one)
+  std::vector<Eigen::Vector2d> repaired_at;  // where a rejected layout got a ring node more
   for (int round = 0;; ++round) {
     throw_if_cancelled(o.cancel);
     if (repairs > o.max_repair_rounds)
@@ -460,11 +461,17 @@ QuadLayout build_quad_layout(const Domain& d, const QuadLayoutOptions& o) {
       // last try (its cuts may cross where the true rings are far from their chords).
       const std::string what = e.what();
       const std::size_t at = what.find("near (");
-      if (at != std::string::npos && repairs < o.max_repair_rounds) {
+      Eigen::Vector2d place(0.0, 0.0);
+      bool again = false;  // this place failed a repair before: a node more there did not mend it
+      if (at != std::string::npos) {
         char* end = nullptr;
-        const double px = std::strtod(what.c_str() + at + 6, &end);
-        const double py = end && *end == ',' ? std::strtod(end + 1, nullptr) : 0.0;
-        mark_nearest_piece(Eigen::Vector2d(px, py));
+        place.x() = std::strtod(what.c_str() + at + 6, &end);
+        place.y() = end && *end == ',' ? std::strtod(end + 1, nullptr) : 0.0;
+        for (const Eigen::Vector2d& p : repaired_at) again = again || (p - place).norm() <= std::max(1e-6 * diam, 2e-6);  // (the message prints 6 decimals)
+      }
+      if (at != std::string::npos && repairs < o.max_repair_rounds && !again) {
+        repaired_at.push_back(place);
+        mark_nearest_piece(place);
         note("mesh " + std::to_string(meshes) + ": " + what + "; a ring node more there, meshing again");
         split_marked();
         out.stats.repair_rounds = ++repairs;
@@ -472,6 +479,11 @@ QuadLayout build_quad_layout(const Domain& d, const QuadLayoutOptions& o) {
         continue;
       }
       if (level == 1) {
+        // (Also where the same place failed after a node more there: each
+        // further round would cost a mesh and its optimization, to the same end.)
+        if (again)
+          note("mesh " + std::to_string(meshes) + ": " + what +
+               " again after a ring node more there; the mesher's own nodes instead");
         out.stats.optimization_level = level = 0;
         continue;
       }
