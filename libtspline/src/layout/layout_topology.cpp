@@ -47,14 +47,20 @@ double region_figure(const LayoutMesh& m, const LayoutTopology& t, const LayoutQ
   return f;
 }
 
-// The patch corners at the given nodes that the layout's final check rejects
-// (quad_layout.cpp: outside 1-170 degrees where the map sees it, at the node
-// itself: the ring's own edge, or the straight cut).
+// The patch corners of the quads at the given nodes that the layout's final
+// check rejects (quad_layout.cpp: outside 1-170 degrees where the map sees
+// it, at the node itself: the ring's own edge, or the straight cut). All four
+// corners of each quad: a node's move turns its neighbours' corners too.
 int rejected_corners(const LayoutMesh& m, const LayoutTopology& t, const LayoutQuality& Q,
                      const std::vector<int>& nodes) {
-  int count = 0;
+  std::vector<int> quads;
   for (const int n : nodes)
-    for (const auto& [q, j] : t.corners_of(n)) {
+    for (const auto& [q, j] : t.corners_of(n)) quads.push_back(q);
+  std::sort(quads.begin(), quads.end());
+  quads.erase(std::unique(quads.begin(), quads.end()), quads.end());
+  int count = 0;
+  for (const int q : quads)
+    for (int j = 0; j < 4; ++j) {
       const auto [a, b] = Q.corner_vectors(m, t, q, j, 0.0);
       const double l = a.norm() * b.norm();
       const double sn = l > 0.0 ? (a.x() * b.y() - a.y() * b.x()) / l : -1.0;
