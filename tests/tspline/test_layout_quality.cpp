@@ -100,6 +100,22 @@ TEST_SUITE("layout_quality") {
     CHECK(RQ.quad(r, rt, 0).mean_ratio == doctest::Approx(s60));
   }
 
+  TEST_CASE("patch corners in range: 1 to 170 degrees, counter-clockwise from the first side") {
+    auto at = [](double degrees) {
+      const double a = degrees * std::numbers::pi / 180.0;
+      return tspline::patch_corner_in_range(V(2, 0), V(3 * std::cos(a), 3 * std::sin(a)));
+    };
+    CHECK(at(90.0));
+    CHECK(at(1.5));
+    CHECK(at(165.0));
+    CHECK_FALSE(at(0.5));    // a needle
+    CHECK_FALSE(at(175.0));  // nearly flat: det J ~ 0 at the corner
+    CHECK_FALSE(at(180.0));
+    CHECK_FALSE(at(200.0));  // reflex
+    CHECK_FALSE(at(270.0));
+    CHECK_FALSE(tspline::patch_corner_in_range(V(0, 0), V(1, 0)));  // a side of length 0
+  }
+
   TEST_CASE("side kinks: a ring vertex inside a side with domain angle phi gives sin^2(phi / 2)") {
     // The bottom of a 2 x 1 rectangle bent down at (1, -d): the domain's angle there is
     // 180 - 2 atan(d), so sin^2(phi / 2) = cos^2(atan d) = 1 / (1 + d^2).

@@ -77,6 +77,12 @@ std::pair<Eigen::Vector2d, Eigen::Vector2d> LayoutQuality::corner_vectors(const 
   return {e1, e2};
 }
 
+bool patch_corner_in_range(const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
+  const double l = a.norm() * b.norm();
+  const double sn = l > 0.0 ? cross(a, b) / l : -1.0;
+  return sn > 0.0175 && (a.dot(b) > 0.0 || sn > 0.174);
+}
+
 LayoutCornerQuality LayoutQuality::corner(const LayoutMesh& m, const LayoutTopology& t, int q, int j) const {
   LayoutCornerQuality w{1.0, 1.0};
   for (const double scale : corner_scales) {

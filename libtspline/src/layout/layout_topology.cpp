@@ -48,9 +48,9 @@ double region_figure(const LayoutMesh& m, const LayoutTopology& t, const LayoutQ
 }
 
 // The patch corners of the quads at the given nodes that the layout's final
-// check rejects (quad_layout.cpp: outside 1-170 degrees where the map sees
-// it, at the node itself: the ring's own edge, or the straight cut). All four
-// corners of each quad: a node's move turns its neighbours' corners too.
+// check rejects (patch_corner_in_range, at the node itself: the ring's own
+// edge, or the straight cut). All four corners of each quad: a node's move
+// turns its neighbours' corners too.
 int rejected_corners(const LayoutMesh& m, const LayoutTopology& t, const LayoutQuality& Q,
                      const std::vector<int>& nodes) {
   std::vector<int> quads;
@@ -62,9 +62,7 @@ int rejected_corners(const LayoutMesh& m, const LayoutTopology& t, const LayoutQ
   for (const int q : quads)
     for (int j = 0; j < 4; ++j) {
       const auto [a, b] = Q.corner_vectors(m, t, q, j, 0.0);
-      const double l = a.norm() * b.norm();
-      const double sn = l > 0.0 ? (a.x() * b.y() - a.y() * b.x()) / l : -1.0;
-      if (!(sn > 0.0175 && (a.dot(b) > 0.0 || sn > 0.174))) ++count;
+      if (!patch_corner_in_range(a, b)) ++count;
     }
   return count;
 }

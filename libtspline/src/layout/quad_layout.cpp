@@ -14,6 +14,7 @@
 #include "tspline/errors.h"
 #include "tspline/layout/layout_kstar.h"
 #include "tspline/layout/layout_optimizer.h"
+#include "tspline/layout/layout_quality.h"
 #include "tspline/layout/layout_topology.h"
 #include "tspline/layout/quad_mesher.h"
 #include "tspline/layout/ring_geometry.h"
@@ -431,17 +432,15 @@ QuadLayout build_quad_layout(const Domain& d, const QuadLayoutOptions& o) {
       if (m.ring[n] >= 0 && t.valence(static_cast<int>(n)) == 1) out.ring_corners.push_back(m.x[n]);
     try {
       out.layout = build_patch_layout(d, std::move(cuts), out.ring_corners);
-      // Every patch corner convex where the map sees it (at the vertex itself):
-      // between 1 and 170 degrees (sin 1 deg = 0.0175, sin 10 deg = 0.174); a
-      // corner near 180 degrees leaves the patch map det J ~ 0 there. (The
-      // mesher's own layout, level 0, only needs convex corners.)
+      // Every patch corner where the map sees it (at the vertex itself)
+      // between 1 and 170 degrees (patch_corner_in_range). (The mesher's own
+      // layout, level 0, only needs convex corners.)
       for (const Patch& p : out.layout.patches)
         for (int k = 0; k < 4; ++k) {
           const auto& v = p.polygon.vertices;
           const std::size_t c = p.corners[k], n = v.size();
           const Eigen::Vector2d a = v[(c + 1) % n] - v[c], b = v[(c + n - 1) % n] - v[c];
-          const double sn = cross(a, b) / (a.norm() * b.norm());
-          const bool fine = level == 0 ? sn > 1e-3 : sn > 0.0175 && (a.dot(b) > 0.0 || sn > 0.174);
+          const bool fine = level == 0 ? cross(a, b) / (a.norm() * b.norm()) > 1e-3 : patch_corner_in_range(a, b);
           if (!fine)
             throw InputError("a patch corner outside 1-170 degrees near (" + std::to_string(v[c].x()) + ", " +
                              std::to_string(v[c].y()) + ")");
@@ -467,7 +466,9 @@ QuadLayout build_quad_layout(const Domain& d, const QuadLayoutOptions& o) {
         char* end = nullptr;
         place.x() = std::strtod(what.c_str() + at + 6, &end);
         place.y() = end && *end == ',' ? std::strtod(end + 1, nullptr) : 0.0;
-        for (const Eigen::Vector2d& p : repaired_at) again = again || (p - place).norm() <= std::max(1e-6 * diam, 2e-6);  // (the message prints 6 decimals)
+        // (The message gives 6 decimals.)
+        const double same = std::max(1e-6 * diam, 2e-6);
+        for (const Eigen::Vector2d& p : repaired_at) again = again || (p - place).norm() <= same;
       }
       if (at != std::string::npos && repairs < o.max_repair_rounds && !again) {
         repaired_at.push_back(place);

@@ -164,7 +164,8 @@ std::vector<double> ring_nodes(const RingCurve& ring, const RingNodeOptions& o,
       // quarter piece) is a node too, ahead of every other: inside a side it
       // leaves the patch map J_r about sin^2(phi / 2) there (layout_quality.h),
       // 0.003 for a tip of 6 degrees, where a patch corner has sin(phi) = 0.1.
-      if (std::abs(ring.turn(i)) > o.sharp_turn) turns.push_back({std::numbers::pi + std::abs(ring.turn(i)), ring.arc(i)});
+      const double sharp = std::abs(ring.turn(i));
+      if (sharp > o.sharp_turn) turns.push_back({std::numbers::pi + sharp, ring.arc(i)});
       else if (turn > o.corner_turn) turns.push_back({turn, ring.arc(i)});
     }
     std::sort(turns.begin(), turns.end(), std::greater<>());

@@ -28,6 +28,14 @@ struct LayoutCornerQuality {
   double scaled_jacobian = 1.0;  ///< sin of the corner angle (negative: reflex or inverted)
 };
 
+/// Whether a patch corner with sides leaving along a and b (counter-clockwise
+/// from a to b) is one a patch map can take: between 1 and 170 degrees (sin 1
+/// deg = 0.0175, sin 10 deg = 0.174); near 180 degrees det J ~ 0 there, since
+/// det J at a corner of the square is the cross product of the two side
+/// tangents. The layout's final check (quad_layout.cpp) and the edge
+/// rotations (layout_topology.cpp) hold the layout to it.
+bool patch_corner_in_range(const Eigen::Vector2d& a, const Eigen::Vector2d& b);
+
 class LayoutQuality {
  public:
   explicit LayoutQuality(const LayoutRings& rings);

@@ -10,9 +10,10 @@
 // inside one side would cost the patch its quality; wiggles small against the
 // side do not), at the ring's corners (a turn of more than 40 degrees on the
 // scale of a quarter piece, or of more than 150 degrees at the vertex itself:
-// the tip of a spike or a crack of any size), and then at equal arc length while the chord is
-// longer than the local patch size (size_field.h). Features smaller than `min_size` are
-// not resolved: they stay inside one side and the patch's T-mesh follows them.
+// the tip of a spike or a crack of any size), and then at equal arc length
+// while the chord is longer than the local patch size (size_field.h). Other
+// features smaller than `min_size` are not resolved: they stay inside one
+// side and the patch's T-mesh follows them.
 #include <Eigen/Core>
 #include <cstddef>
 #include <functional>
