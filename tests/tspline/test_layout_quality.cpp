@@ -323,6 +323,81 @@ TEST_SUITE("layout_quality") {
     }
   }
 
+  TEST_CASE("opening: a crack tip split into two 169-degree corners gets a third quad, no rotation could") {
+    // The square [-2, 2]^2 with a notch from the top down to its tip N = (0, 0)
+    // between F = (0.4, 2) and G = (-0.4, 2): domain angle at N 360 - 2 atan(0.2)
+    // = 337.4 degrees, split by the mesh into two corners of 168.7. The inner
+    // node c below N has valence 4, its other neighbours X and Y valence 3, so
+    // no edge rotation gives N a third quad (each would leave X or Y with 2).
+    const std::vector<V> ring_points = {V(-2, -2), V(0, -2), V(2, -2), V(2, 2),
+                                        V(0.4, 2), V(0, 0),  V(-0.4, 2), V(-2, 2)};
+    const tspline::LayoutRings ring = one_ring(ring_points);
+    const tspline::LayoutQuality Q(ring);
+    enum { A, B, C, E, F, N, G, H, c, X, Y };
+    tspline::LayoutMesh m = ring_mesh(ring.curves[0], ring_points, {V(0, -1), V(1.0, 0.2), V(-1.0, 0.2)},
+                                      {{N, c, X, F}, {N, G, Y, c}, {c, B, C, X}, {X, C, E, F}, {Y, A, B, c}, {G, H, A, Y}});
+    auto degrees_at = [&](const tspline::LayoutMesh& mesh, int node) {
+      const tspline::LayoutTopology t(mesh);
+      std::vector<double> d;
+      for (const auto& [q, j] : t.corners_of(node)) {
+        const auto [a, b] = Q.corner_vectors(mesh, t, q, j, 0.0);
+        double deg = std::atan2(a.x() * b.y() - a.y() * b.x(), a.dot(b)) * 180.0 / std::numbers::pi;
+        d.push_back(deg < 0.0 ? deg + 360.0 : deg);
+      }
+      return d;
+    };
+    const double tip = 360.0 - 2.0 * std::atan(0.2) * 180.0 / std::numbers::pi;
+    const std::vector<double> before = degrees_at(m, N);
+    REQUIRE(before.size() == 2);
+    CHECK(before[0] + before[1] == doctest::Approx(tip));
+    CHECK(*std::max_element(before.begin(), before.end()) > 160.0);
+    // No rotation is possible (and none kept).
+    tspline::LayoutMesh rotated = m;
+    CHECK(tspline::rotate_layout_edges(rotated, Q, anywhere).kept == 0);
+
+    const tspline::LayoutOpeningReport r = tspline::open_wide_ring_corners(m, Q, anywhere);
+    CHECK(r.kept == 1);
+    REQUIRE(m.size() == 12);
+    REQUIRE(m.quads.size() == 7);
+    const std::vector<double> after = degrees_at(m, N);
+    REQUIRE(after.size() == 3);
+    double sum = 0.0;
+    for (const double d : after) {
+      sum += d;
+      CHECK(d < 150.0);
+      CHECK(d > 60.0);
+    }
+    CHECK(sum == doctest::Approx(tip));
+    // Still a quad mesh of the domain: counter-clockwise quads, each edge on
+    // the ring or shared by two quads, the ring's 8 pieces each covered once,
+    // Euler's count for a disk (quads = inner nodes + ring nodes / 2 - 1),
+    // inner nodes of valence >= 3.
+    const tspline::LayoutTopology t(m);
+    for (const auto& q : m.quads) {
+      double a = 0.0;
+      for (int k = 0; k < 4; ++k) {
+        const V &p = m.x[q[k]], &s = m.x[q[(k + 1) % 4]];
+        a += p.x() * s.y() - p.y() * s.x();
+      }
+      CHECK(a > 0.0);
+    }
+    int on_ring = 0, inner = 0;
+    for (int q = 0; q < static_cast<int>(m.quads.size()); ++q)
+      for (int j = 0; j < 4; ++j) {
+        on_ring += t.on_ring(q, j) ? 1 : 0;
+        CHECK((t.on_ring(q, j) || t.across(q, j).first >= 0));
+      }
+    CHECK(on_ring == 8);
+    for (int n = 0; n < static_cast<int>(m.size()); ++n)
+      if (m.ring[n] < 0) {
+        ++inner;
+        CHECK(t.valence(n) >= 3);
+      }
+    CHECK(static_cast<int>(m.quads.size()) == inner + 8 / 2 - 1);
+    // Nothing wide is left: a second pass keeps nothing.
+    CHECK(tspline::open_wide_ring_corners(m, Q, anywhere).kept == 0);
+  }
+
   TEST_CASE("a flat single-quad corner marks its ring, and the pillow layer gives it two quads") {
     // A right triangle as one quad whose fourth corner is the hypotenuse's midpoint (180 degrees).
     const tspline::LayoutRings ring = one_ring({V(0, 0), V(2, 0), V(0, 2)});

@@ -6,6 +6,7 @@
 #include <utility>
 #include <vector>
 
+#include "layout_local.h"
 #include "tspline/detail/thread_pool.h"
 #include "tspline/layout/layout_optimizer.h"
 
@@ -17,7 +18,7 @@ double layout_quad_figure(const LayoutMesh& m, const LayoutTopology& t, const La
   return f;
 }
 
-namespace {
+namespace layout_local {
 
 bool has_edge(const LayoutMesh& m, const LayoutTopology& t, int a, int b) {
   for (const auto& [q, j] : t.corners_of(a))
@@ -73,7 +74,27 @@ double corner_sj(const Eigen::Vector2d& p, const Eigen::Vector2d& next, const Ei
   return l > 0.0 ? (e1.x() * e2.y() - e1.y() * e2.x()) / l : -1.0;
 }
 
-}  // namespace
+LocalLayout local_layout(const LayoutMesh& m, const LayoutTopology& t, const std::vector<int>& reach) {
+  LocalLayout l;
+  for (const int n : reach)
+    for (const auto& [q, j] : t.corners_of(n)) l.quad.push_back(q);
+  std::sort(l.quad.begin(), l.quad.end());
+  l.quad.erase(std::unique(l.quad.begin(), l.quad.end()), l.quad.end());
+  for (const int q : l.quad) l.node.insert(l.node.end(), m.quads[q].begin(), m.quads[q].end());
+  std::sort(l.node.begin(), l.node.end());
+  l.node.erase(std::unique(l.node.begin(), l.node.end()), l.node.end());
+  for (const int n : l.node) l.mesh.x.push_back(m.x[n]), l.mesh.ring.push_back(m.ring[n]), l.mesh.arc.push_back(m.arc[n]);
+  for (const int q : l.quad) {
+    std::array<int, 4> c;
+    for (int j = 0; j < 4; ++j) c[j] = LocalLayout::local(l.node, m.quads[q][j]);
+    l.mesh.quads.push_back(c);
+  }
+  return l;
+}
+
+}  // namespace layout_local
+
+using namespace layout_local;
 
 std::vector<char> rings_with_flat_corners(const LayoutMesh& m, const LayoutQuality& Q) {
   const LayoutTopology t(m);
@@ -204,39 +225,6 @@ struct RotationTry {
   std::vector<double> arc;
   bool blocked = false;  ///< an edge was not tried: the quad across it already rotated this round
 };
-
-// The quads at the nodes a rotation try reads (try_reach) as a layout of
-// their own, nodes and quads in the order of the whole layout: every quad at a
-// node the try may move is there with all its neighbours, so the try's
-// topology, figures and moves are exactly those on the whole layout, for a
-// cost that does not grow with the layout (a copy of the whole layout and of
-// its topology per try made rotations quadratic in the number of quads).
-struct LocalLayout {
-  LayoutMesh mesh;
-  std::vector<int> node;  ///< local -> global, increasing
-  std::vector<int> quad;  ///< local -> global, increasing
-  static int local(const std::vector<int>& ids, int global) {
-    return static_cast<int>(std::lower_bound(ids.begin(), ids.end(), global) - ids.begin());
-  }
-};
-
-LocalLayout local_layout(const LayoutMesh& m, const LayoutTopology& t, const std::vector<int>& reach) {
-  LocalLayout l;
-  for (const int n : reach)
-    for (const auto& [q, j] : t.corners_of(n)) l.quad.push_back(q);
-  std::sort(l.quad.begin(), l.quad.end());
-  l.quad.erase(std::unique(l.quad.begin(), l.quad.end()), l.quad.end());
-  for (const int q : l.quad) l.node.insert(l.node.end(), m.quads[q].begin(), m.quads[q].end());
-  std::sort(l.node.begin(), l.node.end());
-  l.node.erase(std::unique(l.node.begin(), l.node.end()), l.node.end());
-  for (const int n : l.node) l.mesh.x.push_back(m.x[n]), l.mesh.ring.push_back(m.ring[n]), l.mesh.arc.push_back(m.arc[n]);
-  for (const int q : l.quad) {
-    std::array<int, 4> c;
-    for (int j = 0; j < 4; ++j) c[j] = LocalLayout::local(l.node, m.quads[q][j]);
-    l.mesh.quads.push_back(c);
-  }
-  return l;
-}
 
 // The best rotation around quad q of the layout (which is not changed), tried
 // on the local layout of the nodes it reads: the new corners of q and of the

@@ -97,6 +97,7 @@ void optimize_layout(LayoutMesh& m, LayoutMesh& start, const LayoutRings& R, con
                      const LayoutAdmissible& admissible, int level, QuadLayoutStats& st,
                      const std::atomic<bool>* cancel) {
   st.rotations = 0;
+  st.openings = 0;
   st.optimization_sweeps = 0;
   st.pillowed_rings = 0;
   // Every sweep and rotation batch checks the cancel flag.
@@ -129,6 +130,15 @@ void optimize_layout(LayoutMesh& m, LayoutMesh& start, const LayoutRings& R, con
   }
   if (level < 1) return;
   report_optimization(optimize_layout_nodes(m, Q, admissible, {}, full), st);
+  if (level >= 2) {
+    // Wide ring corners that rotations cannot split (valence-3 neighbours).
+    LayoutOpeningOptions opening;
+    opening.cancel = cancel;
+    const LayoutOpeningReport op = open_wide_ring_corners(m, Q, admissible, opening);
+    st.openings = op.kept;
+    if (debugging()) std::fprintf(stderr, "layout openings: %zu tried, %zu kept, %.2f s\n", op.tried, op.kept, lap());
+    if (op.kept > 0) report_optimization(optimize_layout_nodes(m, Q, admissible, op.moved, full), st);
+  }
   for (int pass = 0; pass < 2 && level >= 2; ++pass) {
     // Around the rotations kept (the rest of the layout is as optimized as it gets).
     const LayoutRotationReport rr = rotate();

@@ -71,6 +71,35 @@ std::size_t pillow_rings(LayoutMesh& m, const std::vector<char>& rings);
 /// The figure of quad q used to rank layouts: min(J_r, side shape) over its corners and sides.
 double layout_quad_figure(const LayoutMesh& m, const LayoutTopology& t, const LayoutQuality& Q, int q);
 
+struct LayoutOpeningOptions {
+  /// Ring nodes with a patch corner wider than this (degrees, at the node
+  /// itself) are where openings are tried.
+  double wide_corner_degrees = 150.0;
+  int local_sweeps = 12;  ///< optimizer sweeps over the nodes around a tried opening
+  const std::atomic<bool>* cancel = nullptr;  ///< as LayoutOptimizationOptions::cancel, checked per node
+};
+
+struct LayoutOpeningReport {
+  std::size_t tried = 0, kept = 0;
+  std::vector<int> moved;  ///< the nodes re-optimized around kept openings (new nodes included)
+};
+
+/// Gives a ring node one quad more where one of its patch corners is wide: a
+/// reflex tip of the coast with interior angle phi split into k corners gets
+/// phi / k each (SJ <= sin(phi / k): 328 degrees in two quads is 164 each, SJ
+/// 0.28; in three, 109). An edge rotation cannot do it where the inner nodes
+/// next to the tip have valence 3. The opening ("quad open", Kinney 1997):
+/// an inner neighbour c of the ring node n, of valence >= 4, is split in two
+/// along a path n - c - y through the fan of quads around c; the quads on
+/// one side keep c, the others take a copy c', and the new quad (n, c, y, c')
+/// fills the gap (n and y gain one quad each, c and c' have valence >= 3).
+/// The best opening by the figure of the quads around it after their nodes
+/// are optimized again is kept if it raises that figure and adds no corner
+/// outside 1-170 degrees (as the rotations).
+LayoutOpeningReport open_wide_ring_corners(LayoutMesh& m, const LayoutQuality& Q,
+                                           const std::function<bool(const LayoutMesh&, const LayoutTopology&, int)>& admissible,
+                                           const LayoutOpeningOptions& options = {});
+
 /// \param admissible as for optimize_layout_nodes.
 LayoutRotationReport rotate_layout_edges(LayoutMesh& m, const LayoutQuality& Q,
                                          const std::function<bool(const LayoutMesh&, const LayoutTopology&, int)>& admissible,

@@ -13,7 +13,8 @@
 //  4. the layout optimized for its patch maps: K* untangling of the inner
 //     nodes (layout_kstar.h), then every node moved to raise the worst patch
 //     corners as the maps see them (layout_optimizer.h, layout_quality.h), and
-//     edge rotations where quads stay poor (layout_topology.h);
+//     openings of wide ring corners and edge rotations where quads stay poor
+//     (layout_topology.h);
 //  5. checks on the true geometry: every inner node inside the domain, no inner
 //     quad edge crossing a ring, the straight rings simple; where one fails,
 //     the ring pieces involved get a node more and the mesh is made again;
@@ -71,6 +72,7 @@ struct QuadLayoutStats {
   /// at level 2 again; level 0 is the last try once the repair rounds are used up.
   int optimization_level = 2;
   std::size_t rotations = 0;       ///< edge rotations kept
+  std::size_t openings = 0;        ///< wide ring corners given a quad more (open_wide_ring_corners)
   int optimization_sweeps = 0;     ///< node optimization sweeps, all passes
   /// The worst patch corner as the patch maps see it (layout_quality.h): J_r
   /// and the scaled Jacobian there. A prediction, not a bound: the certified
