@@ -150,6 +150,13 @@ std::vector<ParamOption> make_table() {
       "tolerance's area is (it lies below the tolerance), a larger one is an input error naming its edges",
       [](ParamSettings& s, const std::string&) { s.repair_crossing_holes = true; },
       [](const ParamSettings& s) { return json(s.repair_crossing_holes); }));
+  t.push_back(number<double>(
+      "blunt-tips",
+      "Cut off every tip of the domain sharper than this many degrees (a patch corner of angle theta has "
+      "scaled Jacobian sin(theta) in any map) by a chord removing at most the boundary tolerance's area, "
+      "with a note per tip; 0 keeps every tip (and --from always does)",
+      [](auto& s) -> auto& { return s.blunt_tips_degrees; }));
+  t.back().range = {{0.0, 90.0}};
   t.push_back(option(
       "corners", OptionKind::Text,
       "Four vertex indices i,j,k,l (0-based, the file's own numbering, in cyclic file order) mapped to "
@@ -291,6 +298,7 @@ std::vector<ParamOption> make_table() {
       {"max-adapt", {"max_adapt"}},
       {"max-cells", {"max_cells"}},
       {"repair-crossings", {"repair_crossing_holes"}},
+      {"blunt-tips", {"blunt_tips_below_degrees"}},
       {"cert-depth", {"certification.max_depth"}},
       {"optimizer", {"untangling.optimizer"}},
       {"samples", {"samples"}},

@@ -32,6 +32,10 @@ struct ParamSettings {
   std::string cuts_file;  ///< polylines, one cut per blank-line-separated block ("" for none)
   /// Holes that cross themselves become their convex hulls (DomainCleaningOptions).
   bool repair_crossing_holes = false;
+  /// Tips of the domain sharper than this (degrees) are cut off within the
+  /// boundary tolerance (DomainCleaningOptions::blunt_tips_below_degrees): 17.5
+  /// degrees, where sin(theta) = 0.3, the scaled Jacobian a good map keeps.
+  double blunt_tips_degrees = 17.5;
   /// A previous map (tspline.json) of the same boundary before it moved: warm start ("" for none).
   std::string from_file;
   int samples = 4;        ///< surface.vtu: k x k sub-quads per cell

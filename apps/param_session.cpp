@@ -1,5 +1,6 @@
 #include "param_session.h"
 
+#include <cmath>
 #include <string_view>
 
 #include "toolkit/io/atomic_file.h"
@@ -41,6 +42,7 @@ json multipatch_report(const ParamRun& run) {
                                 {"pillowed_rings", s.pillowed_rings},
                                 {"optimization_level", s.optimization_level},
                                 {"rotations", s.rotations},
+                                {"openings", s.openings},
                                 {"optimization_sweeps", s.optimization_sweeps},
                                 {"corner_mean_ratio", s.corner_mean_ratio},
                                 {"corner_scaled_jacobian", s.corner_scaled_jacobian},
@@ -58,6 +60,15 @@ json multipatch_report(const ParamRun& run) {
 json single_report(const ParamRun& run) {
   json report = tspline::io::param_report(*run.result.single, run.source);
   report["input_geometry"] = run.domain.description;  // format, layer, CRS, projection (gis_reader.h)
+  // What the session cleaned before the pipeline (sharp tips cut off, needles
+  // removed), then what the pipeline's own cleaning found.
+  if (!run.cleaning_notes.empty()) {
+    nlohmann::json& notes = report["input_cleaning"]["notes"];
+    nlohmann::json all = run.cleaning_notes;
+    if (notes.is_array())
+      for (const auto& n : notes) all.push_back(n);
+    notes = std::move(all);
+  }
   report["layout"] = {{"chosen", run.result.layout}, {"reason", run.result.reason}};
   return report;
 }
@@ -156,25 +167,48 @@ ParamRun run_param(tspline::io::DomainInput domain, std::string source, const Pa
   // cleaned ring); the pipeline's own validate_domain then finds nothing more.
   // (One ring is cleaned by the single-patch pipeline itself.)
   tspline::Domain rings{in.outer, in.holes};
-  if (!in.holes.empty()) {
+  // Sharp tips are cut off here too (one ring or several), except for a warm
+  // start, whose vertices must match the previous map's one to one.
+  const bool blunt = settings.blunt_tips_degrees > 0.0 && !previous && settings.from_file.empty();
+  if (!in.holes.empty() || blunt) {
     tspline::DomainCleaningOptions how;
-    how.needle_width =
-        tspline::needle_width_for_ring(in.outer, opt.tolerance_absolute, opt.tolerance_relative);
+    const double width = tspline::needle_width_for_ring(in.outer, opt.tolerance_absolute, opt.tolerance_relative);
+    how.needle_width = width;
     how.notes = &run.cleaning_notes;
-    const double diagonal = tspline::bounding_box_diagonal(in.outer);
-    how.crossing_repair_area =
-        opt.tolerance_absolute ? *opt.tolerance_absolute : opt.tolerance_relative * diagonal * diagonal;
+    // The tolerance's area epsilon on the ring's diagonal as the needle width
+    // measures it (width = r d): a typo vertex 4e9 km out must not make every
+    // tip and islet "below the tolerance".
+    how.crossing_repair_area = opt.tolerance_absolute ? *opt.tolerance_absolute
+                               : opt.tolerance_relative > 0.0 && std::isfinite(width)
+                                   ? width * width / opt.tolerance_relative
+                                   : 0.0;
     how.repair_crossing_holes = settings.repair_crossing_holes;
+    if (blunt) how.blunt_tips_below_degrees = settings.blunt_tips_degrees;
     auto report_notes = [&] {
       for (const std::string& note : run.cleaning_notes)
         tspline::report_step(opt.progress, "cleaning", "note: " + note, -1,
                              tspline::ProgressEvent::Kind::Note);
     };
-    try {
-      rings = tspline::validate_domain(rings, how);
-    } catch (const tspline::InputError&) {
-      report_notes();  // what was cleaned before the ring that stopped the run
-      throw;
+    if (in.holes.empty()) {
+      // One ring: the single-patch pipeline cleans and validates it itself
+      // (its messages and report); here only its sharp tips are cut, and the
+      // ring cleaned here goes on only if some were.
+      std::size_t tips = 0;
+      how.blunted_tips = &tips;
+      try {
+        tspline::Domain blunted = tspline::validate_domain(rings, how);
+        if (tips > 0) rings = std::move(blunted);
+        else run.cleaning_notes.clear();
+      } catch (const tspline::InputError&) {
+        run.cleaning_notes.clear();  // the pipeline names the problem
+      }
+    } else {
+      try {
+        rings = tspline::validate_domain(rings, how);
+      } catch (const tspline::InputError&) {
+        report_notes();  // what was cleaned before the ring that stopped the run
+        throw;
+      }
     }
     report_notes();
   }

@@ -138,6 +138,30 @@ TEST_SUITE("app") {
     CHECK(rep["optimized"]["inverted_cells"] == 0);
   }
 
+  TEST_CASE("a sharp tip is cut off within the boundary tolerance by default, kept with --blunt-tips 0") {
+    const fs::path d = scratch("tips");
+    // An arrow: tip (20, 0) of 2 atan(1/20) = 5.72 degrees, vertex 2.
+    const fs::path in = write_file(d, "arrow.txt", "-4 -1\n0 -1\n20 0\n0 1\n-4 1\n");
+    const RunResult cut = run("param --layout single --init-level 1 '" + in.string() + "' --out '" + (d / "cut").string() + "'", d);
+    CAPTURE(cut.err);
+    REQUIRE(cut.exit_code == 0);
+    CHECK(cut.out.find("note: the outer ring: blunted the tip at vertex 2 (5.72 degrees") != std::string::npos);
+    const auto rep = nlohmann::json::parse(slurp(d / "cut" / "report.json"));
+    REQUIRE(rep["input_cleaning"]["notes"].size() == 1);
+    CHECK(rep["input_cleaning"]["notes"][0].get<std::string>().find("new corners 92.9 and 92.9 degrees") !=
+          std::string::npos);
+    CHECK(rep["counts"]["polygon_vertices"] == 6);  // the tip became two cut points
+    const RunResult kept =
+        run("param --layout single --init-level 1 '" + in.string() + "' --blunt-tips 0 --out '" + (d / "kept").string() + "'", d);
+    REQUIRE(kept.exit_code == 0);
+    CHECK(kept.out.find("blunted") == std::string::npos);
+    CHECK(nlohmann::json::parse(slurp(d / "kept" / "report.json"))["counts"]["polygon_vertices"] == 5);
+    const RunResult wrong = run("param '" + in.string() + "' --blunt-tips 95 --out '" + (d / "x").string() + "'", d);
+    CHECK(wrong.exit_code == 1);
+    CHECK(wrong.err.find("--blunt-tips") != std::string::npos);
+    CHECK_FALSE(fs::exists(d / "x" / "report.json"));
+  }
+
   TEST_CASE("real data is cleaned, not rejected: repeated vertices and zero-area spikes, with notes in file numbering") {
     const fs::path d = scratch("cleaning");
     // A 4 x 4 square (CW in the file) with a repeated vertex (2 = 1) and a spike

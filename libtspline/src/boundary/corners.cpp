@@ -154,7 +154,8 @@ Corners corners_from_file_indices(const Polygon& p, const std::array<long long, 
                        " is out of range" + range + "; indices are 0-based, in the file's own numbering");
     if (pos[static_cast<std::size_t>(f[k])] == kNone)
       throw InputError("corner " + std::to_string(k + 1) + ": vertex " + std::to_string(f[k]) +
-                       " was removed from the input (a repeated vertex or the tip of a zero-area spike); "
+                       " was removed from the input (a repeated vertex, the tip of a zero-area spike or part of a sharp tip "
+                       "cut off: see the notes); "
                        "choose a neighbouring vertex");
     for (int j = 0; j < k; ++j)
       if (f[j] == f[k])

@@ -16,6 +16,7 @@
 #include "tspline/boundary/domain.h"
 #include "tspline/errors.h"
 #include "tspline/boundary/polygon_validation.h"
+#include "tspline/boundary/sharp_tips.h"
 
 namespace tspline {
 namespace {
@@ -117,6 +118,26 @@ Polygon convex_hull_of(const Polygon& p) {
   return h;
 }
 
+// The rings of a domain whose rings are each valid: no two meet, every hole
+// inside the outer ring and outside every other hole. number[r]: ring r's
+// number in messages.
+void check_ring_relations(const Domain& d, const std::vector<std::size_t>& number) {
+  check_rings_disjoint(d, number);
+  // No ring meets another: each hole lies entirely on one side of every other ring.
+  for (std::size_t h = 0; h < d.holes.size(); ++h) {
+    const Eigen::Vector2d x = d.holes[h].vertices.front();
+    if (side_of(d.outer, x) != CGAL::ON_BOUNDED_SIDE)
+      throw InputError(ring_name(number[h + 1]) + " lies outside the outer ring (its vertex " +
+                       std::to_string(d.holes[h].file_index.front()) + " is not inside it)");
+    for (std::size_t g = 0; g < d.holes.size(); ++g) {
+      if (g == h) continue;
+      if (side_of(d.holes[g], x) == CGAL::ON_BOUNDED_SIDE)
+        throw InputError(ring_name(number[h + 1]) + " lies inside " + ring_name(number[g + 1]) +
+                         " (a hole in a hole is not part of the domain)");
+    }
+  }
+}
+
 }  // namespace
 
 Domain validate_domain(Domain d, const DomainCleaningOptions& cleaning) {
@@ -179,18 +200,31 @@ Domain validate_domain(Domain d, const DomainCleaningOptions& cleaning) {
       number.push_back(h + 1);
     }
   d.holes = std::move(holes);
-  check_rings_disjoint(d, number);
-  // No ring meets another: each hole lies entirely on one side of every other ring.
-  for (std::size_t h = 0; h < d.holes.size(); ++h) {
-    const Eigen::Vector2d x = d.holes[h].vertices.front();
-    if (side_of(d.outer, x) != CGAL::ON_BOUNDED_SIDE)
-      throw InputError(ring_name(number[h + 1]) + " lies outside the outer ring (its vertex " +
-                       std::to_string(d.holes[h].file_index.front()) + " is not inside it)");
-    for (std::size_t g = 0; g < d.holes.size(); ++g) {
-      if (g == h) continue;
-      if (side_of(d.holes[g], x) == CGAL::ON_BOUNDED_SIDE)
-        throw InputError(ring_name(number[h + 1]) + " lies inside " + ring_name(number[g + 1]) +
-                         " (a hole in a hole is not part of the domain)");
+  check_ring_relations(d, number);
+  if (cleaning.blunted_tips) *cleaning.blunted_tips = 0;
+  if (cleaning.blunt_tips_below_degrees > 0.0) {
+    // Sharp tips cut off within the boundary tolerance (sharp_tips.h); kept
+    // all if a cut would make two rings meet.
+    const double area = cleaning.blunt_tip_area ? *cleaning.blunt_tip_area : repair_area;
+    Domain blunted = d;
+    std::vector<std::string> notes;
+    auto blunt = [&](Polygon& ring, bool hole, std::size_t r) {
+      TipBlunting t = blunt_sharp_tips(std::move(ring), hole, cleaning.blunt_tips_below_degrees, area,
+                                       std::isfinite(width) ? width : 0.0, ring_name(r));
+      ring = std::move(t.polygon);
+      notes.insert(notes.end(), t.notes.begin(), t.notes.end());
+    };
+    blunt(blunted.outer, false, 0);
+    for (std::size_t h = 0; h < blunted.holes.size(); ++h) blunt(blunted.holes[h], true, number[h + 1]);
+    if (!notes.empty()) {
+      try {
+        check_ring_relations(blunted, number);
+        d = std::move(blunted);
+        for (const std::string& s : notes) note(s);
+        if (cleaning.blunted_tips) *cleaning.blunted_tips = notes.size();
+      } catch (const InputError& e) {
+        note(std::string("sharp tips kept as they are: cutting them would make two rings meet (") + e.what() + ")");
+      }
     }
   }
   return d;

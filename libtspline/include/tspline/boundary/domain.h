@@ -3,6 +3,7 @@
 // whole (every ring simple, holes strictly inside the outer ring, no two rings
 // crossing or touching, no hole inside another).
 #include <Eigen/Core>
+#include <cstddef>
 #include <optional>
 #include <string>
 #include <vector>
@@ -45,6 +46,17 @@ struct DomainCleaningOptions {
   /// its size. Off: a crossing hole larger than crossing_repair_area is an
   /// input error naming the ring and edges. The outer ring is never repaired.
   bool repair_crossing_holes = false;
+  /// Tips of the domain sharper than this (degrees; a patch corner of angle
+  /// theta has scaled Jacobian sin(theta) in every map) are cut off by a chord
+  /// that removes at most blunt_tip_area each, with a note per tip
+  /// (blunt_sharp_tips, sharp_tips.h); 0 keeps every tip. If a cut would make
+  /// two rings meet, no tip is cut (one note says so).
+  double blunt_tips_below_degrees = 0.0;
+  /// The area each tip's cut may remove. Unset: as crossing_repair_area (the
+  /// boundary tolerance's epsilon).
+  std::optional<double> blunt_tip_area;
+  /// If set, receives the number of tips cut off.
+  std::size_t* blunted_tips = nullptr;
 };
 
 /// Cleans (clean_polygon: repeated vertices, needles and spikes narrower than
