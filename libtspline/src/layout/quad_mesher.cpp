@@ -202,9 +202,18 @@ bool read_vector(int fd, std::vector<T>& v) {
 // regions, which terminates the process whatever the caller catches. So the
 // mesh is made in a child process (fork) and sent back through a pipe; a
 // child that fails or dies is a NumericalError here, and the caller goes on.
+//
+// Under AddressSanitizer the mesh is made in this process instead: the
+// sanitizer's allocator (GCC 12) takes no locks around fork, so a child forked
+// while another thread (auto's single-patch try) held one of them waits for
+// it forever in its first malloc (a sanitized test run hung so). glibc's
+// malloc takes its arena locks around fork, so the child is safe there.
 PlanarQuadMesh quad_mesh(const std::vector<std::vector<Eigen::Vector2d>>& rings,
                          const std::function<double(const Eigen::Vector2d&)>& size) {
   std::lock_guard<std::mutex> lock(gmsh_mutex);
+#if defined(__SANITIZE_ADDRESS__)
+  return quad_mesh_here(rings, size);
+#endif
   int fds[2];
   if (::pipe(fds) != 0) throw NumericalError("the quad mesher could not open a pipe");
   std::cout.flush();
