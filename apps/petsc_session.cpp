@@ -28,10 +28,11 @@ PetscSession::~PetscSession() {
 // Open MPI, hwloc and PETSc keep allocations to the end of the process (and
 // Open MPI's plugins are dlopen'ed; sanitizer_keep_plugins.cpp keeps them
 // mapped); so do GDAL/PROJ (driver registry, PROJ contexts) and
-// Cairo/fontconfig (font caches). LeakSanitizer would report them. Leaks whose
+// Cairo/fontconfig (font caches), and Gmsh (the quad layouts' mesher, run in
+// this process under the sanitizer: quad_mesher.cpp). LeakSanitizer would report them. Leaks whose
 // stack passes through these libraries are suppressed; ours are not.
 extern "C" const char* __lsan_default_suppressions() {
-  return "leak:libgdal\nleak:libproj\nleak:libcairo\nleak:libfontconfig\n"
+  return "leak:libgdal\nleak:libproj\nleak:libcairo\nleak:libfontconfig\nleak:libgmsh\n"
          "leak:libmpi\nleak:libopen-pal\nleak:libopen-rte\nleak:libhwloc\nleak:libpetsc\nleak:libHYPRE\n"
          "leak:mca_\nleak:libpmix\nleak:libevent\n"
          // One string of Open MPI's set-up (opal_asprintf): the fast unwinder
