@@ -1,22 +1,42 @@
 // Automatic quad layouts (layout/quad_layout.h) of domains: patches, nodes,
-// valences, straight-sided quality and time. Usage: bench_layout FILE...
+// valences, straight-sided quality and time.
+// Usage: bench_layout [--blunt-tips DEG] FILE...
+// --blunt-tips cuts sharp tips as `tspline param` does by default (17.5), with
+// the default boundary tolerance (1e-5 relative); without it the rings are taken
+// as they are.
 #include <chrono>
 #include <cmath>
 #include <iomanip>
 #include <iostream>
+#include <string>
 
 #include "tspline/boundary/domain.h"
 #include "tspline/errors.h"
 #include "tspline/io/gis_reader.h"
+#include "tspline/boundary/polygon_validation.h"
 #include "tspline/layout/quad_layout.h"
 #include "toolkit/timing.h"
 
 int main(int argc, char** argv) {
   std::cout << std::setprecision(4);
+  double blunt_degrees = 0.0;
   for (int i = 1; i < argc; ++i) {
+    if (std::string(argv[i]) == "--blunt-tips" && i + 1 < argc) {
+      blunt_degrees = std::stod(argv[++i]);
+      continue;
+    }
     try {
       const tspline::io::DomainInput in = tspline::io::read_domain(argv[i]);
-      const tspline::Domain d = tspline::validate_domain({in.outer, in.holes});
+      tspline::DomainCleaningOptions how;
+      if (blunt_degrees > 0.0) {
+        // As apps/param_session.cpp does with the default tolerance.
+        constexpr double relative = 1e-5;
+        const double width = tspline::needle_width_for_ring(in.outer, std::nullopt, relative);
+        how.needle_width = width;
+        how.crossing_repair_area = std::isfinite(width) ? width * width / relative : 0.0;
+        how.blunt_tips_below_degrees = blunt_degrees;
+      }
+      const tspline::Domain d = tspline::validate_domain({in.outer, in.holes}, how);
       const auto t0 = std::chrono::steady_clock::now();
       const tspline::QuadLayout L = tspline::build_quad_layout(d);
       const double s = toolkit::seconds_since(t0);

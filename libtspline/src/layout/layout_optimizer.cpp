@@ -21,9 +21,15 @@ double power(double x, double p) {
 }
 
 // The energy of one quad: its corners and side kinks, each E^p; eps_rel: the
-// regularization relative to |e1| |e2|.
+// regularization relative to |e1| |e2|. With `barrier` (the quality phase: no
+// corner is inverted) a corner with det <= 0 makes it infinite. The regularized
+// corner term alone is not a barrier: an inverted corner costs about
+// 8 sin / eps_rel (1e9 at eps_rel = 1e-4), less than a pinched side's
+// 2 / 1e-9, so a quality sweep could trade a pinched side for a fold, which
+// the untangling then could not undo (Corsica: the worst corner fell from 0.27
+// to -0.95 in one sweep, and 60 sweeps of untangling left it at -0.86).
 double quad_energy(const LayoutMesh& m, const LayoutTopology& t, const LayoutQuality& Q, int q, double p,
-                   double eps_rel) {
+                   double eps_rel, bool barrier) {
   double sum = 0.0;
   for (int j = 0; j < 4; ++j) {
     double e = 0.0;  // the worst over the scales
@@ -32,7 +38,7 @@ double quad_energy(const LayoutMesh& m, const LayoutTopology& t, const LayoutQua
       const double det = cross(e1, e2);
       const double n1 = e1.norm(), n2 = e2.norm();
       const double s = n1 + n2;
-      if (!(n1 > 0.0 && n2 > 0.0)) return std::numeric_limits<double>::infinity();
+      if (!(n1 > 0.0 && n2 > 0.0) || (barrier && !(det > 0.0))) return std::numeric_limits<double>::infinity();
       const double eps = eps_rel * n1 * n2;
       const double chi = 0.5 * (det + std::sqrt(eps * eps + det * det));
       e = std::max(e, s * s / (2.0 * chi));
@@ -163,9 +169,10 @@ LayoutOptimizationReport optimize_layout_nodes(LayoutMesh& m, const LayoutQualit
   // energy moderate, so that every corner can move), with the plain sum (p = 1);
   // then eps = 1e-4 and p = power, close to the worst corner.
   double p = o.power, eps_rel = 1e-4;
+  bool barrier = false;
   auto local = [&](int n) {
     double sum = 0.0;
-    for (const auto& [q, j] : t.corners_of(n)) sum += quad_energy(m, t, Q, q, p, eps_rel);
+    for (const auto& [q, j] : t.corners_of(n)) sum += quad_energy(m, t, Q, q, p, eps_rel, barrier);
     return sum;
   };
   auto worst_sin = [&]() {
@@ -220,6 +227,7 @@ LayoutOptimizationReport optimize_layout_nodes(LayoutMesh& m, const LayoutQualit
       if (sweep - last_rise >= 6) break;
     }
     p = tangled ? 1.0 : o.power;
+    barrier = !tangled;
     eps_rel = tangled ? std::max(1e-4, 2.0 * -w) : 1e-4;
     if (untangling && !tangled)  // the steps were made for the other energy
       for (const int n : active) step[n] = std::max(step[n], 0.25 * initial_step[n]);
