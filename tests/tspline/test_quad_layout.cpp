@@ -5,7 +5,12 @@
 
 #include <algorithm>
 #include <atomic>
+#include <chrono>
 #include <cmath>
+#include <functional>
+#include <mutex>
+#include <string>
+#include <thread>
 #include <numbers>
 
 #include "test_support.h"
@@ -272,6 +277,81 @@ TEST_SUITE("quad_layout") {
     for (const auto& r : R.patches) refined = refined || r.map->mesh().num_cells() > 16;
     CHECK(refined);
     for (const auto& i : R.interfaces) CHECK(i.same_knots);
+  }
+
+  TEST_CASE("the patches' run stops with MultiPatchCancelled once its cancel flag is set, before any patch") {
+    const tspline::Domain d = tspline::validate_domain({rectangle(0, 0, 3, 3), {rectangle(1, 1, 2, 2)}});
+    std::atomic<bool> cancel{true};
+    tspline::MultiPatchOptions mo;
+    mo.cancel = &cancel;
+    std::atomic<int> started{0};
+    const tspline::PatchCallback count = [&](std::size_t, int) { ++started; };
+    CHECK_THROWS_AS(tspline::run_multipatch_parameterization(d, std::nullopt, {}, {}, mo, count),
+                    tspline::MultiPatchCancelled);
+    CHECK(started == 0);
+    cancel = false;
+    CHECK(tspline::run_multipatch_parameterization(d, std::nullopt, {}, {}, mo, count).certified_valid());
+    CHECK(started >= 4);
+  }
+
+  TEST_CASE("auto: the patches run while one patch is tried are the patches run after it, reported once kept") {
+    if (!tspline::quad_mesher_available()) return;
+    // A 64-gon: one patch has corners of 174 degrees (poor); the layout's patches are run
+    // as soon as the layout is built, maybe before one patch is judged.
+    std::vector<Eigen::Vector2d> v;
+    for (int k = 0; k < 64; ++k) v.emplace_back(std::cos(k * std::numbers::pi / 32), std::sin(k * std::numbers::pi / 32));
+    const tspline::Domain disk{make_polygon(v), {}};
+    std::mutex lock;
+    std::vector<std::string> events;  // "stage: text", and "on_patch" for the patch callback
+    tspline::ParameterizationOptions po;
+    bool waited = false;
+    po.progress = [&](const tspline::ProgressEvent& e) {
+      {
+        std::lock_guard<std::mutex> hold(lock);
+        events.push_back(e.stage + ": " + e.text);
+      }
+      // The single patch's run ends only after a pause, long enough for the
+      // layout (about 0.2 s here) to be built and its patches to start: what
+      // they report must still come after the verdict.
+      if (e.stage == "stop" && e.text.rfind("patch ", 0) != 0 && !waited) {
+        waited = true;
+        std::this_thread::sleep_for(std::chrono::milliseconds(1500));
+      }
+    };
+    const tspline::PatchCallback on_patch = [&](std::size_t, int) {
+      std::lock_guard<std::mutex> hold(lock);
+      events.push_back("on_patch");
+    };
+    const tspline::AdaptiveOptions ad;
+    const tspline::DomainParameterization A = tspline::parameterize_domain(disk, po, ad, {}, {}, on_patch);
+    REQUIRE(A.layout == "quad");
+    REQUIRE(A.patches);
+    // In order: the verdict on one patch, the layout, then the patches' lines.
+    auto first = [&](const std::function<bool(const std::string&)>& is) {
+      return std::find_if(events.begin(), events.end(), is) - events.begin();
+    };
+    const auto verdict = first([](const std::string& e) { return contains(e, "poor over the whole map"); });
+    const auto layout = first([](const std::string& e) { return e.rfind("layout: quad layout: ", 0) == 0; });
+    const auto patches = first([](const std::string& e) {
+      return e == "on_patch" || e.rfind("patches: ", 0) == 0 || contains(e, ": patch ");
+    });
+    const auto patch_lines = std::count_if(events.begin(), events.end(), [](const std::string& e) {
+      return contains(e, ": patch ");
+    });
+    CHECK(verdict < layout);
+    CHECK(layout < patches);
+    CHECK(patch_lines > 0);
+    CHECK(std::count(events.begin(), events.end(), "on_patch") >= static_cast<long>(A.patches->patches.size()));
+    // The same map as the patches of layout quad (run after the layout, nothing ahead).
+    tspline::DomainParameterizationOptions quad;
+    quad.layout = tspline::LayoutMode::Quad;
+    const tspline::DomainParameterization Q = tspline::parameterize_domain(disk, {}, ad, quad);
+    REQUIRE(Q.patches);
+    REQUIRE(Q.patches->patches.size() == A.patches->patches.size());
+    for (std::size_t p = 0; p < Q.patches->patches.size(); ++p) {
+      CHECK(Q.patches->patches[p].map->control_points() == A.patches->patches[p].map->control_points());
+      CHECK(Q.patches->patches[p].dense_quality.min_mean_ratio == A.patches->patches[p].dense_quality.min_mean_ratio);
+    }
   }
 
   TEST_CASE("layout choice: single keeps the one-patch run, auto keeps one patch where it is good") {

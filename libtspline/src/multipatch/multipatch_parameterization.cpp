@@ -84,6 +84,7 @@ bool MultiPatchResult::valid() const {
 
 namespace {
 
+
 /// The least of value(r) over the patches' results (+infinity for none).
 template <class Value>
 double min_over_patches(const std::vector<ParameterizationResult>& patches, Value value) {
@@ -233,12 +234,17 @@ MultiPatchResult run_multipatch_parameterization(const Domain& domain, PatchLayo
   std::vector<BorderParams> required(P);
   std::vector<char> stale(P, 1);
   R.patches.reserve(P);
+  auto check_cancel = [&multi] {
+    if (multi.cancel && multi.cancel->load(std::memory_order_relaxed)) throw MultiPatchCancelled();
+  };
   for (int round = 0;; ++round) {
+    check_cancel();
     std::vector<std::size_t> todo;
     for (std::size_t p = 0; p < P; ++p)
       if (stale[p]) todo.push_back(p);
     std::vector<std::optional<ParameterizationResult>> runs(todo.size());
     for_each_patch(todo.size(), threads, [&](std::size_t i) {
+      check_cancel();
       const std::size_t p = todo[i];
       if (on_patch) {
         std::lock_guard<std::mutex> lock(progress_mutex);

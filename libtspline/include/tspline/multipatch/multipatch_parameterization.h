@@ -11,6 +11,7 @@
 // interpolation points alone; later refinement reproduces it exactly), so the
 // two images of an interface agree to round-off.
 #include <Eigen/Core>
+#include <atomic>
 #include <functional>
 #include <mutex>
 #include <optional>
@@ -31,6 +32,14 @@ struct MultiPatchOptions {
   double gap_tolerance = 1e-12;
   /// Patches run concurrently on this many threads (0: one per core).
   int threads = 0;
+  /// Checked before each patch and each interface round: once set (by another
+  /// thread), MultiPatchCancelled is thrown.
+  const std::atomic<bool>* cancel = nullptr;
+};
+
+/// Thrown where MultiPatchOptions::cancel was set.
+struct MultiPatchCancelled : std::exception {
+  const char* what() const noexcept override { return "the patches' run was cancelled"; }
 };
 
 struct InterfaceReport {
