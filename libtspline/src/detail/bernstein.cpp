@@ -17,18 +17,6 @@ static_assert(kMax <= kMaxSplitDegree, "bernstein_subdivide splits rows of up to
 
 }  // namespace
 
-double binomial(int n, int k) {
-  static const auto table = [] {
-    std::array<std::array<double, kMaxBinomial + 1>, kMaxBinomial + 1> t{};
-    for (int i = 0; i <= kMaxBinomial; ++i) {  // Pascal's triangle
-      t[i][0] = t[i][i] = 1.0;
-      for (int j = 1; j < i; ++j) t[i][j] = t[i - 1][j - 1] + t[i - 1][j];
-    }
-    return t;
-  }();
-  return table[n][k];
-}
-
 // Bernstein basis values B_i^deg(s), i = 0..deg.
 void bernstein_values(int deg, double s, double* out) {
   // Powers by repeated multiplication (no pow calls): s^i and r^(deg-i).

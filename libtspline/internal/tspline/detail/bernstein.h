@@ -65,6 +65,16 @@ void bernstein_values(int deg, double s, double* out);
 /// The binomial coefficient C(n, k), 0 <= k <= n <= kMaxBinomial, from a table
 /// (every such C(n, k) is below 2^53, so exact in double).
 inline constexpr int kMaxBinomial = 24;
-double binomial(int n, int k);
+/// Pascal's triangle, made at compile time (inline lookups in the Bernstein
+/// products of the certification, the hottest loop after the energy's).
+inline constexpr auto kBinomials = [] {
+  std::array<std::array<double, kMaxBinomial + 1>, kMaxBinomial + 1> t{};
+  for (int i = 0; i <= kMaxBinomial; ++i) {
+    t[i][0] = t[i][i] = 1.0;
+    for (int j = 1; j < i; ++j) t[i][j] = t[i - 1][j - 1] + t[i - 1][j];
+  }
+  return t;
+}();
+inline double binomial(int n, int k) { return kBinomials[n][k]; }
 
 }  // namespace tspline::detail
