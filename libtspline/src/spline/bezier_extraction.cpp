@@ -4,6 +4,9 @@
 
 #include <Eigen/LU>
 #include <algorithm>
+#include <array>
+#include <utility>
+#include <vector>
 
 #include "tspline/validity/map_quality.h"
 
@@ -90,11 +93,23 @@ std::vector<BezierElement> extract_cell(const TSplineBasis& basis, int c) {
           e.functions.push_back(a);
       }
       e.C.resize(static_cast<Eigen::Index>(e.functions.size()), 16);
+      // The functions of an element share few knot vectors per direction (four
+      // each on a regular grid, for sixteen functions): each one's univariate
+      // coefficients are computed once.
+      using Knots = std::array<double, 5>;
+      std::vector<std::pair<Knots, std::array<double, 4>>> seen_x, seen_y;
+      auto univariate = [](std::vector<std::pair<Knots, std::array<double, 4>>>& seen, const Knots& k, double a,
+                           double b) {
+        for (const auto& [known, c] : seen)
+          if (known == k) return c;
+        seen.emplace_back(k, bspline_bernstein(k, a, b));
+        return seen.back().second;
+      };
       for (std::size_t r = 0; r < e.functions.size(); ++r) {
         const BlendingFunction& f = basis.function(e.functions[r]);
         // Tensor product: the coefficients are products of the univariate ones.
-        const std::array<double, 4> bx = bspline_bernstein(f.knots_xi, e.lo.x(), e.hi.x());
-        const std::array<double, 4> by = bspline_bernstein(f.knots_eta, e.lo.y(), e.hi.y());
+        const std::array<double, 4> bx = univariate(seen_x, f.knots_xi, e.lo.x(), e.hi.x());
+        const std::array<double, 4> by = univariate(seen_y, f.knots_eta, e.lo.y(), e.hi.y());
         for (int q = 0; q < 4; ++q)
           for (int p = 0; p < 4; ++p) e.C(static_cast<Eigen::Index>(r), p + 4 * q) = bx[p] * by[q];
       }
