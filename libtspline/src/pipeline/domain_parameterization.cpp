@@ -119,6 +119,7 @@ DomainParameterization parameterize_domain(const Domain& input, const Parameteri
   // What the patches run ahead report is held back until their run is kept
   // (declared before `ahead`: destroyed after the run ahead is waited for).
   HeldEvents held;
+  std::atomic<bool> cancel{false};  // the run ahead's: set where it is not wanted
   std::future<LayoutAhead> ahead;
   auto run_quad = [&](const std::string& reason) {
     LayoutAhead a;
@@ -207,9 +208,9 @@ DomainParameterization parameterize_domain(const Domain& input, const Parameteri
                                                         on_patch));
     return out;
   }
-  std::atomic<bool> cancel{false};
   // Declared after `ahead`, so destroyed before it: whatever way this function
-  // leaves, the layout still running is told to stop before it is waited for.
+  // leaves, the layout (and its patches) still running are told to stop before
+  // they are waited for; the flag itself outlives the wait.
   struct CancelOnExit {
     std::atomic<bool>& flag;
     ~CancelOnExit() { flag = true; }
