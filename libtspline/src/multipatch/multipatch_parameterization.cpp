@@ -84,7 +84,6 @@ bool MultiPatchResult::valid() const {
 
 namespace {
 
-
 /// The least of value(r) over the patches' results (+infinity for none).
 template <class Value>
 double min_over_patches(const std::vector<ParameterizationResult>& patches, Value value) {

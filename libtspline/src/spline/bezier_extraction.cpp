@@ -100,8 +100,8 @@ std::vector<BezierElement> extract_cell(const TSplineBasis& basis, int c) {
       std::vector<std::pair<Knots, std::array<double, 4>>> seen_x, seen_y;
       auto univariate = [](std::vector<std::pair<Knots, std::array<double, 4>>>& seen, const Knots& k, double a,
                            double b) {
-        for (const auto& [known, c] : seen)
-          if (known == k) return c;
+        for (const auto& [known, coefficients] : seen)
+          if (known == k) return coefficients;
         seen.emplace_back(k, bspline_bernstein(k, a, b));
         return seen.back().second;
       };
