@@ -9,14 +9,19 @@
 #include <atomic>
 #include <cmath>
 #include <numbers>
+#include <tuple>
 
 #include "test_support.h"
+#include "tspline/boundary/domain.h"
+#include "tspline/errors.h"
+#include "tspline/layout/layout_energy.h"
 #include "tspline/layout/layout_mesh.h"
 #include "tspline/layout/layout_optimizer.h"
 #include "tspline/layout/layout_quality.h"
 #include "tspline/layout/layout_topology.h"
 #include "tspline/layout/ring_geometry.h"
 #include "tspline/layout/ring_nodes.h"
+#include "tspline/multipatch/patch_layout.h"
 
 namespace {
 
@@ -165,6 +170,54 @@ TEST_SUITE("layout_quality") {
         ring_mesh(outward.curves[0], {V(0, 0), V(2, 0), V(2, 1), V(0, 1)}, {}, {{0, 1, 2, 3}});
     CHECK(tspline::LayoutQuality(outward).side_shape(o, tspline::LayoutTopology(o), 0, 0) ==
           doctest::Approx(1.0 - 0.5 * 0.5 / 2.0));
+  }
+
+  TEST_CASE("layout energy: a node's moving part differs from its whole energy by a constant") {
+    // The 2 x 2 square with a kinked, bulging bottom coast (kinks and shapes in
+    // play): wherever a node goes (inner: in the plane; ring: along its ring),
+    // its energy minus its moving part stays the same, in both phases.
+    const tspline::LayoutRings ring =
+        one_ring({V(0, 0), V(0.2, 0.05), V(0.35, 0.0), V(0.7, 0.12), V(1, 0), V(1, 1), V(0.4, 0.93), V(0, 1)});
+    const tspline::LayoutQuality Q(ring);
+    const tspline::RingCurve& c = ring.curves[0];
+    tspline::LayoutMesh m = square_2x2(c, V(0.55, 0.45), 0.5);
+    for (std::size_t n = 0; n < 8; ++n) m.x[n] = c.point(m.arc[n]);  // on the ring itself
+    const tspline::LayoutTopology t(m);
+    int finite_moves = 0;
+    for (const auto& [p, eps, barrier] : {std::tuple{1.0, 0.1, false}, std::tuple{4.0, 1e-4, true}}) {
+      for (int n = 0; n < static_cast<int>(m.size()); ++n) {
+        CAPTURE(n);
+        CAPTURE(p);
+        const tspline::LayoutMesh keep = m;
+        // The whole energy and its part that stays (whole - moving).
+        auto parts = [&] {
+          const double whole = tspline::layout_node_energy(m, t, Q, n, p, eps, barrier);
+          return std::pair{whole, whole - tspline::layout_moving_energy(m, t, Q, n, p, eps, barrier)};
+        };
+        const auto [w0, r0] = parts();
+        REQUIRE(std::isfinite(w0));
+        CHECK(r0 > 0.0);  // the opposite corners are never in the moving part
+        for (const double u : {-0.05, -0.02, 0.03, 0.06}) {
+          if (m.ring[n] < 0) {
+            m.x[n] = keep.x[n] + V(u, 0.6 * u);
+          } else {
+            m.arc[n] = std::fmod(keep.arc[n] + u + c.length(), c.length());
+            m.x[n] = c.point(m.arc[n]);
+          }
+          const auto [w, r] = parts();
+          if (!std::isfinite(w)) {  // a corner inverted (the barrier), by the move: in the moving part
+            CHECK(std::isinf(tspline::layout_moving_energy(m, t, Q, n, p, eps, barrier)));
+            continue;
+          }
+          ++finite_moves;
+          CHECK(w != doctest::Approx(w0));  // the move changed the energy
+          // Equal to round-off in the sums (of terms up to w).
+          CHECK(std::abs(r - r0) <= 1e-13 * std::max(w, w0));
+        }
+        m = keep;
+      }
+    }
+    CHECK(finite_moves >= 50);  // of 72 (57: the rest invert a corner)
   }
 
   TEST_CASE("node optimization: a displaced centre and a displaced ring node go back to the square grid") {
@@ -512,6 +565,19 @@ TEST_SUITE("layout_quality") {
     CHECK(g.crosses(V(0.5, 1.5), V(3, 1.5), false, false, 1e-9));        // through the hole
     CHECK_FALSE(g.crosses(V(0.5, 3), V(3, 3), false, false, 1e-9));      // above it
     CHECK_FALSE(g.crosses(V(0, 3), V(1, 1.5), true, true, 1e-9));        // from ring to ring
+    // A cut that ends on a ring vertex and goes on along an edge's line there
+    // makes a flat patch corner: a crossing, as the patch layout has it; one
+    // that leaves the vertex at an angle does not cross.
+    CHECK(g.crosses(V(1, 1), V(0.5, 1), true, false, 1e-9));
+    CHECK(g.crosses(V(0.5, 1), V(1, 1), false, true, 1e-9));
+    CHECK_FALSE(g.crosses(V(1, 1), V(0.5, 0.5), true, false, 1e-9));
+    CHECK_FALSE(g.crosses(V(1, 1), V(0.5, 1.000001), true, false, 1e-9));
+    tspline::Domain d;
+    d.outer = test_support::make_polygon({{0, 0}, {4, 0}, {4, 4}, {0, 4}});
+    d.holes = {test_support::make_polygon({{1, 1}, {2, 1}, {2, 2}, {1, 2}})};
+    d = tspline::validate_domain(d);
+    CHECK_THROWS_AS(tspline::validate_cuts(d, {{V(1, 1), V(0, 1)}}), tspline::InputError);
+    CHECK_NOTHROW(tspline::validate_cuts(d, {{V(1, 1), V(0, 0)}}));
     const int e = g.nearest(V(2.2, 1.5));
     CHECK(g.edge(e).ring == 1);
     CHECK(g.edge(e).a.x() == 2.0);

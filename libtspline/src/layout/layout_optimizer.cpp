@@ -1,57 +1,15 @@
 #include "tspline/layout/layout_optimizer.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <numbers>
 #include "tspline/boundary/plane.h"
+#include "tspline/layout/layout_energy.h"
 
 namespace tspline {
 namespace {
-
-
-// x^p, by multiplication for the powers used (std::pow was a seventh of the layout's time).
-double power(double x, double p) {
-  if (p == 1.0) return x;
-  if (p == 4.0) {
-    const double x2 = x * x;
-    return x2 * x2;
-  }
-  return std::pow(x, p);
-}
-
-// The energy of one quad: its corners and side kinks, each E^p; eps_rel: the
-// regularization relative to |e1| |e2|. With `barrier` (the quality phase: no
-// corner is inverted) a corner with det <= 0 makes it infinite. The regularized
-// corner term alone is not a barrier: an inverted corner costs about
-// 8 sin / eps_rel (1e9 at eps_rel = 1e-4), less than a pinched side's
-// 2 / 1e-9, so a quality sweep could trade a pinched side for a fold, which
-// the untangling then could not undo (Corsica: the worst corner fell from 0.27
-// to -0.95 in one sweep, and 60 sweeps of untangling left it at -0.86).
-double quad_energy(const LayoutMesh& m, const LayoutTopology& t, const LayoutQuality& Q, int q, double p,
-                   double eps_rel, bool barrier) {
-  double sum = 0.0;
-  for (int j = 0; j < 4; ++j) {
-    double e = 0.0;  // the worst over the scales
-    for (const double scale : LayoutQuality::corner_scales) {
-      const auto [e1, e2] = Q.corner_vectors(m, t, q, j, scale);
-      const double det = cross(e1, e2);
-      const double n1 = e1.norm(), n2 = e2.norm();
-      const double s = n1 + n2;
-      if (!(n1 > 0.0 && n2 > 0.0) || (barrier && !(det > 0.0))) return std::numeric_limits<double>::infinity();
-      const double eps = eps_rel * n1 * n2;
-      const double chi = 0.5 * (det + std::sqrt(eps * eps + det * det));
-      e = std::max(e, s * s / (2.0 * chi));
-      if (m.ring[m.quads[q][j]] < 0) break;  // cuts only: one scale
-    }
-    sum += power(e, p);
-    const double k = Q.side_kinks(m, t, q, j);
-    if (k < 1.0) sum += power(2.0 / std::max(k, 1e-9), p);
-    const double g = Q.side_shape(m, t, q, j);
-    if (g < 1.0) sum += power(2.0 / std::max(g, 1e-9), p);
-  }
-  return sum;
-}
 
 // Ring node n slid along its ring, between its two ring neighbours, to where
 // `local` (its energy) is least: every ring vertex in reach (where the corner
@@ -125,6 +83,13 @@ void slide_ring_node(LayoutMesh& m, const LayoutTopology& t, const LayoutQuality
   else place(best_u);
 }
 
+// The pattern search's eight directions.
+const std::array<Eigen::Vector2d, 8> kDirections = [] {
+  std::array<Eigen::Vector2d, 8> d;
+  for (int k = 0; k < 8; ++k) d[k] = Eigen::Vector2d(std::cos(k * std::numbers::pi / 4.0), std::sin(k * std::numbers::pi / 4.0));
+  return d;
+}();
+
 }  // namespace
 
 LayoutCornerQuality worst_layout_quality(const LayoutMesh& m, const LayoutTopology& t, const LayoutQuality& q) {
@@ -170,11 +135,7 @@ LayoutOptimizationReport optimize_layout_nodes(LayoutMesh& m, const LayoutQualit
   // then eps = 1e-4 and p = power, close to the worst corner.
   double p = o.power, eps_rel = 1e-4;
   bool barrier = false;
-  auto local = [&](int n) {
-    double sum = 0.0;
-    for (const auto& [q, j] : t.corners_of(n)) sum += quad_energy(m, t, Q, q, p, eps_rel, barrier);
-    return sum;
-  };
+  auto local = [&](int n) { return layout_node_energy(m, t, Q, n, p, eps_rel, barrier); };
   auto worst_sin = [&]() {
     double w = 1.0;
     for (const int q : region)
@@ -242,7 +203,16 @@ LayoutOptimizationReport optimize_layout_nodes(LayoutMesh& m, const LayoutQualit
       // ring node across a fold only drags the fold along the coast.
       if (tangled && m.ring[n] >= 0) continue;
       const double f0 = local(n);
-      double best = f0;
+      // Only the terms that move with n are evaluated (layout_moving_energy):
+      // the energy differs from local(n) by a constant. Where that part is
+      // not finite, the whole energy is.
+      const double v0 = layout_moving_energy(m, t, Q, n, p, eps_rel, barrier);
+      if (!std::isfinite(f0) && std::isfinite(v0)) continue;  // infinite wherever n goes
+      const bool incremental = std::isfinite(f0) && std::isfinite(v0);
+      auto energy = [&](int v) {
+        return incremental ? layout_moving_energy(m, t, Q, v, p, eps_rel, barrier) : local(v);
+      };
+      double best_v = incremental ? v0 : f0;
       if (m.ring[n] < 0) {
         const bool was_admissible = admissible(m, t, n);
         // Inner node: pattern search, the best of eight directions per step.
@@ -250,18 +220,18 @@ LayoutOptimizationReport optimize_layout_nodes(LayoutMesh& m, const LayoutQualit
           const Eigen::Vector2d start = m.x[nn];
           Eigen::Vector2d best_x = start;
           for (int k = 0; k < 8; ++k) {
-            const double a = k * std::numbers::pi / 4.0;
-            m.x[nn] = start + step[nn] * Eigen::Vector2d(std::cos(a), std::sin(a));
-            const double f = local(n);
-            if (f < best && (!was_admissible || admissible(m, t, n))) best = f, best_x = m.x[nn];
+            m.x[nn] = start + step[nn] * kDirections[k];
+            const double f = energy(n);
+            if (f < best_v && (!was_admissible || admissible(m, t, n))) best_v = f, best_x = m.x[nn];
           }
           m.x[nn] = best_x;
           if (best_x == start) step[nn] *= 0.5;
           else step[nn] *= 1.5;
         }
       } else {
-        slide_ring_node(m, t, Q, n, local, admissible, o, best);
+        slide_ring_node(m, t, Q, n, energy, admissible, o, best_v);
       }
+      const double best = incremental ? f0 - (v0 - best_v) : best_v;
       if (best < f0) {
         ++report.moves;
         gain = std::max(gain, (f0 - best) / f0);

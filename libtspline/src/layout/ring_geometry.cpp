@@ -98,7 +98,10 @@ int RingGeometry::crossing(const Eigen::Vector2d& a, const Eigen::Vector2d& b, b
     const bool b_on = b_on_ring && segment_distance(b, f.a, f.b) <= tol;
     if (a_on && b_on) return g;  // along the edge
     if (a_on != b_on) {
-      // Allowed: the segment's end on this edge, the rest of it off the edge.
+      // Allowed: the segment's end on this edge, the rest of it off the edge
+      // and off its line (a cut that goes on along the edge's line makes a
+      // flat patch corner there; the patch layout refuses it as a crossing).
+      if (CGAL::orientation(cp(f.a), cp(f.b), cp(a_on ? b : a)) == CGAL::COLLINEAR) return g;
       const Eigen::Vector2d from = a_on ? Eigen::Vector2d(a + 1e-6 * (b - a)) : a;
       const Eigen::Vector2d to = b_on ? Eigen::Vector2d(b + 1e-6 * (a - b)) : b;
       if (!segments_intersect(from, to, f.a, f.b)) continue;

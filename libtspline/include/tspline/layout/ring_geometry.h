@@ -36,7 +36,9 @@ class RingGeometry {
   /// Whether p is inside the region the edges bound (parity of a ray's crossings).
   bool inside(const Eigen::Vector2d& p) const;
   /// Whether the segment from a to b meets an edge anywhere but at its own ends
-  /// where they lie on a ring (a_on_ring, b_on_ring: within tol of an edge).
+  /// where they lie on a ring (a_on_ring, b_on_ring: within tol of an edge),
+  /// or ends on an edge with its other end on that edge's line (a flat
+  /// corner: the rule of the patch layout's validate_cuts).
   bool crosses(const Eigen::Vector2d& a, const Eigen::Vector2d& b, bool a_on_ring, bool b_on_ring, double tol) const {
     return crossing(a, b, a_on_ring, b_on_ring, tol) >= 0;
   }

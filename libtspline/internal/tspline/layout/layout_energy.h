@@ -1,0 +1,37 @@
+#pragma once
+// The energy the layout's node optimizer minimizes (layout_optimizer.h), per
+// quad and per node.
+//
+// A quad's energy is the sum over its corners of (|e1| + |e2|)^2 / (2 chi(det))
+// (the corner's inverse mean ratio, regularized by chi(d, eps) =
+// (d + sqrt(eps^2 + d^2)) / 2 as in Garanzha et al. 2021, eps = eps_rel |e1| |e2|),
+// the worst over LayoutQuality::corner_scales at ring nodes, plus 2 / k for
+// each ring side with kinks k < 1 and 2 / g for each side with shape g < 1
+// (layout_quality.h), every term to the power p. With `barrier` an inverted
+// corner makes it infinite.
+#include "tspline/layout/layout_quality.h"
+#include "tspline/layout/layout_topology.h"
+
+namespace tspline {
+
+/// The energy of quad q.
+double layout_quad_energy(const LayoutMesh& m, const LayoutTopology& t, const LayoutQuality& Q, int q, double p,
+                          double eps_rel, bool barrier);
+
+/// The energy of the quads around node n.
+double layout_node_energy(const LayoutMesh& m, const LayoutTopology& t, const LayoutQuality& Q, int n, double p,
+                          double eps_rel, bool barrier);
+
+/// The part of layout_node_energy that moves with node n (the rest is the
+/// same wherever n goes on its ring, or inside): in each quad, with n its
+/// corner j, the corners j and j +- 1 (their sides end at n; along a ring,
+/// their lengths and directions too), the shapes of the sides j + 1 and j + 2
+/// (n is a corner of the side opposite them), and for a ring node the kinks
+/// and shapes of the sides j - 1 and j (their arcs end at n). The opposite
+/// corner's sides do not end at n, and an inner node's sides are cuts.
+/// Where it is finite but the node's energy is not, no move of n makes that
+/// finite (an inverted or degenerate opposite corner).
+double layout_moving_energy(const LayoutMesh& m, const LayoutTopology& t, const LayoutQuality& Q, int n, double p,
+                            double eps_rel, bool barrier);
+
+}  // namespace tspline
