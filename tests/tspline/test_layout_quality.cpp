@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <cstdint>
 #include <numbers>
 #include <tuple>
 
@@ -551,6 +552,52 @@ TEST_SUITE("layout_quality") {
       area += a;
     }
     CHECK(area == doctest::Approx(9.0));
+  }
+
+  TEST_CASE("ring geometry on its grid: inside and the first edge crossed, as by every edge in turn") {
+    // A star of 60 spikes (edges across many grid cells) and a hole: points and
+    // segments all over, against the even-odd rule and the lowest-numbered
+    // crossed edge found by testing every edge.
+    std::vector<V> star;
+    for (int k = 0; k < 120; ++k) {
+      const double a = 2.0 * std::numbers::pi * k / 120.0, r = k % 2 ? 0.35 : 1.0;
+      star.push_back(V(r * std::cos(a), r * std::sin(a)));
+    }
+    const std::vector<tspline::RingCurve> rings = {
+        tspline::RingCurve(star), tspline::RingCurve({V(-0.1, -0.1), V(-0.1, 0.1), V(0.1, 0.1), V(0.1, -0.1)})};
+    const tspline::RingGeometry g = tspline::RingGeometry::of_rings(rings);
+    auto brute_inside = [&](const V& p) {
+      bool in = false;
+      for (std::size_t e = 0; e < g.size(); ++e) {
+        const V &a = g.edge(static_cast<int>(e)).a, &b = g.edge(static_cast<int>(e)).b;
+        if ((a.y() > p.y()) != (b.y() > p.y()) && a.x() + (p.y() - a.y()) / (b.y() - a.y()) * (b.x() - a.x()) > p.x())
+          in = !in;
+      }
+      return in;
+    };
+    std::uint64_t state = 12345;
+    auto uniform = [&] {  // in [-1.1, 1.1)
+      state = state * 6364136223846793005ULL + 1442695040888963407ULL;
+      return -1.1 + 2.2 * static_cast<double>(state >> 11) / 9007199254740992.0;
+    };
+    int inside = 0, crossed = 0;
+    for (int k = 0; k < 2000; ++k) {
+      const V p(uniform(), uniform()), q = p + 0.15 * V(uniform(), uniform());
+      CAPTURE(p);
+      CHECK(g.inside(p) == brute_inside(p));
+      inside += g.inside(p);
+      int first = -1;
+      for (std::size_t e = 0; e < g.size() && first < 0; ++e) {
+        const auto& f = g.edge(static_cast<int>(e));
+        if (tspline::segments_intersect(p, q, f.a, f.b)) first = static_cast<int>(e);
+      }
+      CHECK(g.crossing(p, q, false, false, 1e-9) == first);
+      crossed += first >= 0;
+    }
+    CHECK(inside > 200);  // both answers are common
+    CHECK(inside < 1800);
+    CHECK(crossed > 200);
+    CHECK(crossed < 1800);
   }
 
   TEST_CASE("ring geometry: inside a square with a hole, segments crossing a ring, the nearest edge") {

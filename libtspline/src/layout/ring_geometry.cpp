@@ -52,10 +52,7 @@ RingGeometry RingGeometry::of_rings(const std::vector<RingCurve>& rings) {
 
 template <class F>
 void RingGeometry::for_cells(const Eigen::Vector2d& lo, const Eigen::Vector2d& hi, F&& f) const {
-  const int i0 = std::clamp(static_cast<int>((lo.x() - lo_.x()) / cell_), 0, nx_ - 1);
-  const int i1 = std::clamp(static_cast<int>((hi.x() - lo_.x()) / cell_), 0, nx_ - 1);
-  const int j0 = std::clamp(static_cast<int>((lo.y() - lo_.y()) / cell_), 0, ny_ - 1);
-  const int j1 = std::clamp(static_cast<int>((hi.y() - lo_.y()) / cell_), 0, ny_ - 1);
+  const int i0 = column(lo.x()), i1 = column(hi.x()), j0 = row(lo.y()), j1 = row(hi.y());
   for (int j = j0; j <= j1; ++j)
     for (int i = i0; i <= i1; ++i) f(cells_[static_cast<std::size_t>(j) * nx_ + i]);
 }
@@ -68,47 +65,67 @@ std::vector<int> RingGeometry::near(const Eigen::Vector2d& lo, const Eigen::Vect
   return out;
 }
 
+int RingGeometry::column(double x) const { return std::clamp(static_cast<int>((x - lo_.x()) / cell_), 0, nx_ - 1); }
+
+int RingGeometry::row(double y) const { return std::clamp(static_cast<int>((y - lo_.y()) / cell_), 0, ny_ - 1); }
+
 bool RingGeometry::inside(const Eigen::Vector2d& p) const {
   // Crossings of the ray from p in +x with the edges of the cells in its row.
-  const int j = std::clamp(static_cast<int>((p.y() - lo_.y()) / cell_), 0, ny_ - 1);
-  const int i0 = std::clamp(static_cast<int>((p.x() - lo_.x()) / cell_), 0, nx_ - 1);
-  std::vector<int> row;
-  for (int i = i0; i < nx_; ++i) {
-    const std::vector<int>& c = cells_[static_cast<std::size_t>(j) * nx_ + i];
-    row.insert(row.end(), c.begin(), c.end());
-  }
-  std::sort(row.begin(), row.end());
-  row.erase(std::unique(row.begin(), row.end()), row.end());
+  // An edge is in every cell its box meets; its crossing is counted in the
+  // cell that holds it (the crossing's x taken within the edge's box, so that
+  // the edge is in that cell), once.
+  const int j = row(p.y()), i0 = column(p.x());
   int count = 0;
-  for (int e : row) {
+  for (int i = i0; i < nx_; ++i)
+    for (const int e : cells_[static_cast<std::size_t>(j) * nx_ + i]) {
       const Eigen::Vector2d &a = edges_[e].a, &b = edges_[e].b;
       if ((a.y() > p.y()) == (b.y() > p.y())) continue;
-      const double x = a.x() + (p.y() - a.y()) / (b.y() - a.y()) * (b.x() - a.x());
-      if (x > p.x()) ++count;
+      const double x = std::clamp(a.x() + (p.y() - a.y()) / (b.y() - a.y()) * (b.x() - a.x()), std::min(a.x(), b.x()),
+                                  std::max(a.x(), b.x()));
+      if (x > p.x() && column(x) == i) ++count;
     }
   return count % 2 == 1;
 }
 
 int RingGeometry::crossing(const Eigen::Vector2d& a, const Eigen::Vector2d& b, bool a_on_ring, bool b_on_ring,
                            double tol) const {
-  for (int g : near(a.cwiseMin(b), a.cwiseMax(b))) {
-    const Edge& f = edges_[g];
-    if (!segments_intersect(a, b, f.a, f.b)) continue;
-    const bool a_on = a_on_ring && segment_distance(a, f.a, f.b) <= tol;
-    const bool b_on = b_on_ring && segment_distance(b, f.a, f.b) <= tol;
-    if (a_on && b_on) return g;  // along the edge
-    if (a_on != b_on) {
-      // Allowed: the segment's end on this edge, the rest of it off the edge
-      // and off its line (a cut that goes on along the edge's line makes a
-      // flat patch corner there; the patch layout refuses it as a crossing).
-      if (CGAL::orientation(cp(f.a), cp(f.b), cp(a_on ? b : a)) == CGAL::COLLINEAR) return g;
-      const Eigen::Vector2d from = a_on ? Eigen::Vector2d(a + 1e-6 * (b - a)) : a;
-      const Eigen::Vector2d to = b_on ? Eigen::Vector2d(b + 1e-6 * (a - b)) : b;
-      if (!segments_intersect(from, to, f.a, f.b)) continue;
+  // The lowest-numbered edge crossed. An edge in several cells of the box is
+  // tested in the first of them only (row by row: the larger of the box's and
+  // the edge's first row and column).
+  const Eigen::Vector2d lo = a.cwiseMin(b), hi = a.cwiseMax(b);
+  const int i0 = column(lo.x()), j0 = row(lo.y());
+  int first = -1;
+  for_cells(lo, hi, [&](const std::vector<int>& cell) {
+    for (const int g : cell) {
+      if (first >= 0 && g >= first) continue;
+      const Edge& f = edges_[g];
+      const Eigen::Vector2d flo = f.a.cwiseMin(f.b), fhi = f.a.cwiseMax(f.b);
+      if (flo.x() > hi.x() || fhi.x() < lo.x() || flo.y() > hi.y() || fhi.y() < lo.y()) continue;  // boxes apart
+      // Tested once: in the first cell of the box that the edge is in.
+      const int fi = std::max(i0, column(flo.x())), fj = std::max(j0, row(flo.y()));
+      if (&cell != &cells_[static_cast<std::size_t>(fj) * nx_ + fi]) continue;
+      if (crosses_edge(a, b, f, a_on_ring, b_on_ring, tol)) first = g;
     }
-    return g;
+  });
+  return first;
+}
+
+bool RingGeometry::crosses_edge(const Eigen::Vector2d& a, const Eigen::Vector2d& b, const Edge& f, bool a_on_ring,
+                                bool b_on_ring, double tol) const {
+  if (!segments_intersect(a, b, f.a, f.b)) return false;
+  const bool a_on = a_on_ring && segment_distance(a, f.a, f.b) <= tol;
+  const bool b_on = b_on_ring && segment_distance(b, f.a, f.b) <= tol;
+  if (a_on && b_on) return true;  // along the edge
+  if (a_on != b_on) {
+    // Allowed: the segment's end on this edge, the rest of it off the edge
+    // and off its line (a cut that goes on along the edge's line makes a
+    // flat patch corner there; the patch layout refuses it as a crossing).
+    if (CGAL::orientation(cp(f.a), cp(f.b), cp(a_on ? b : a)) == CGAL::COLLINEAR) return true;
+    const Eigen::Vector2d from = a_on ? Eigen::Vector2d(a + 1e-6 * (b - a)) : a;
+    const Eigen::Vector2d to = b_on ? Eigen::Vector2d(b + 1e-6 * (a - b)) : b;
+    return segments_intersect(from, to, f.a, f.b);
   }
-  return -1;
+  return true;
 }
 
 int RingGeometry::nearest(const Eigen::Vector2d& p) const {

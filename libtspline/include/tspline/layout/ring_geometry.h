@@ -50,6 +50,11 @@ class RingGeometry {
  private:
   template <class F>
   void for_cells(const Eigen::Vector2d& lo, const Eigen::Vector2d& hi, F&& f) const;
+  int column(double x) const;  ///< the grid column of x, clamped
+  int row(double y) const;     ///< the grid row of y, clamped
+  /// Whether the segment crosses edge f, by the rule of crosses().
+  bool crosses_edge(const Eigen::Vector2d& a, const Eigen::Vector2d& b, const Edge& f, bool a_on_ring,
+                    bool b_on_ring, double tol) const;
   std::vector<Edge> edges_;
   std::vector<std::vector<int>> cells_;
   Eigen::Vector2d lo_;
