@@ -2,6 +2,7 @@
 #include "tspline/layout/layout_energy.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 
@@ -31,8 +32,10 @@ double power(double x, double p) {
 double corner_energy(const LayoutMesh& m, const LayoutTopology& t, const LayoutQuality& Q, int q, int j, double p,
                      double eps_rel, bool barrier) {
   double e = 0.0;  // the worst over the scales
-  for (const double scale : LayoutQuality::corner_scales) {
-    const auto [e1, e2] = Q.corner_vectors(m, t, q, j, scale);
+  std::array<std::pair<Eigen::Vector2d, Eigen::Vector2d>, LayoutQuality::corner_scales.size()> vectors;
+  const int scales = Q.corner_vectors_at(m, t, q, j, LayoutQuality::corner_scales, vectors.data());
+  for (int k = 0; k < scales; ++k) {
+    const auto& [e1, e2] = vectors[k];
     const double det = cross(e1, e2);
     const double n1 = e1.norm(), n2 = e2.norm();
     const double s = n1 + n2;
@@ -40,7 +43,6 @@ double corner_energy(const LayoutMesh& m, const LayoutTopology& t, const LayoutQ
     const double eps = eps_rel * n1 * n2;
     const double chi = 0.5 * (det + std::sqrt(eps * eps + det * det));
     e = std::max(e, s * s / (2.0 * chi));
-    if (m.ring[m.quads[q][j]] < 0) break;  // cuts only: one scale
   }
   return power(e, p);
 }

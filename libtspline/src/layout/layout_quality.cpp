@@ -1,6 +1,7 @@
 #include "tspline/layout/layout_quality.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <numbers>
 #include "tspline/boundary/plane.h"
@@ -60,21 +61,36 @@ double LayoutQuality::side_length(const LayoutMesh& m, const LayoutTopology& t, 
 std::pair<Eigen::Vector2d, Eigen::Vector2d> LayoutQuality::corner_vectors(const LayoutMesh& m,
                                                                           const LayoutTopology& t, int q, int j,
                                                                           double scale) const {
+  std::array<std::pair<Eigen::Vector2d, Eigen::Vector2d>, 1> out;
+  corner_vectors_at(m, t, q, j, std::span<const double>(&scale, 1), out.data());
+  return out[0];
+}
+
+int LayoutQuality::corner_vectors_at(const LayoutMesh& m, const LayoutTopology& t, int q, int j,
+                                     std::span<const double> scales,
+                                     std::pair<Eigen::Vector2d, Eigen::Vector2d>* out) const {
   const int v = m.quads[q][j], next = m.quads[q][(j + 1) % 4], prev = m.quads[q][(j + 3) % 4];
   const int r = m.ring[v];
-  Eigen::Vector2d e1 = m.x[next] - m.x[v], e2 = m.x[prev] - m.x[v];
+  const Eigen::Vector2d e1 = m.x[next] - m.x[v], e2 = m.x[prev] - m.x[v];
+  if (r < 0) {  // a cut corner: the same at every scale
+    out[0] = {e1, e2};
+    return 1;
+  }
   // The ring's direction from the node, going dir, on the scale of scale x len.
-  auto along = [&](double dir, double len) -> Eigen::Vector2d {
-    const RingCurve& c = rings_.curves[r];
+  const RingCurve& c = rings_.curves[r];
+  auto along = [&](double dir, double len, double scale) -> Eigen::Vector2d {
     if (scale <= 0.0) return c.direction(m.arc[v], dir) * len;
     const Eigen::Vector2d chord = c.point(m.arc[v] + dir * scale * len) - m.x[v];
     const double l = chord.norm();
     return l > 0.0 ? Eigen::Vector2d(chord * (len / l)) : Eigen::Vector2d(c.direction(m.arc[v], dir) * len);
   };
-  if (r >= 0 && t.on_ring(q, j) && m.ring[next] == r) e1 = along(rings_.direction(r), side_length(m, t, q, j));
   const int jp = (j + 3) % 4;
-  if (r >= 0 && t.on_ring(q, jp) && m.ring[prev] == r) e2 = along(-rings_.direction(r), side_length(m, t, q, jp));
-  return {e1, e2};
+  const bool ring_next = t.on_ring(q, j) && m.ring[next] == r, ring_prev = t.on_ring(q, jp) && m.ring[prev] == r;
+  const double len1 = ring_next ? side_length(m, t, q, j) : 0.0, len2 = ring_prev ? side_length(m, t, q, jp) : 0.0;
+  const double dir = rings_.direction(r);
+  for (std::size_t k = 0; k < scales.size(); ++k)
+    out[k] = {ring_next ? along(dir, len1, scales[k]) : e1, ring_prev ? along(-dir, len2, scales[k]) : e2};
+  return static_cast<int>(scales.size());
 }
 
 bool patch_corner_in_range(const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
@@ -85,13 +101,14 @@ bool patch_corner_in_range(const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
 
 LayoutCornerQuality LayoutQuality::corner(const LayoutMesh& m, const LayoutTopology& t, int q, int j) const {
   LayoutCornerQuality w{1.0, 1.0};
-  for (const double scale : corner_scales) {
-    const auto [e1, e2] = corner_vectors(m, t, q, j, scale);
+  std::array<std::pair<Eigen::Vector2d, Eigen::Vector2d>, corner_scales.size()> vectors;
+  const int scales = corner_vectors_at(m, t, q, j, corner_scales, vectors.data());
+  for (int k = 0; k < scales; ++k) {
+    const auto& [e1, e2] = vectors[k];
     const double det = cross(e1, e2), a = e1.squaredNorm(), b = e2.squaredNorm();
     if (!(a > 0.0 && b > 0.0)) return {-1.0, -1.0};
     w.mean_ratio = std::min(w.mean_ratio, 2.0 * det / (a + b));
     w.scaled_jacobian = std::min(w.scaled_jacobian, det / std::sqrt(a * b));
-    if (m.ring[m.quads[q][j]] < 0) break;  // cuts only: one scale
   }
   return w;
 }

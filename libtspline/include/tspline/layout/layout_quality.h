@@ -17,6 +17,7 @@
 #include <Eigen/Core>
 #include <array>
 #include <cstddef>
+#include <span>
 #include <vector>
 
 #include "tspline/layout/layout_mesh.h"
@@ -53,6 +54,11 @@ class LayoutQuality {
                                                              int j, double scale = 0.0) const;
   /// The scales at which corners are measured (corner, and the optimizer's energy).
   static constexpr std::array<double, 3> corner_scales{0.0, 0.05, 0.2};
+  /// corner_vectors at each of `scales` (ring sides measured once), into out;
+  /// returns how many were written: 1 at an inner node (a cut corner is the
+  /// same at every scale), scales.size() at a ring node.
+  int corner_vectors_at(const LayoutMesh& m, const LayoutTopology& t, int q, int j, std::span<const double> scales,
+                        std::pair<Eigen::Vector2d, Eigen::Vector2d>* out) const;
   /// The worst over corner_scales.
   LayoutCornerQuality corner(const LayoutMesh& m, const LayoutTopology& t, int q, int j) const;
   /// sin^2(phi / 2), phi the domain's inner angle, worst over the ring vertices
