@@ -198,6 +198,14 @@ TEST_SUITE("layout_quality") {
         const auto [w0, r0] = parts();
         REQUIRE(std::isfinite(w0));
         CHECK(r0 > 0.0);  // the opposite corners are never in the moving part
+        // A sum stopped at a bound: at least the bound and at most the whole;
+        // the whole where the bound is above it.
+        const double v0 = w0 - r0, full = tspline::layout_moving_energy(m, t, Q, n, p, eps, barrier);
+        const double stopped = tspline::layout_moving_energy(m, t, Q, n, p, eps, barrier, 0.5 * full);
+        CHECK(stopped >= 0.5 * full);
+        CHECK(stopped <= full);
+        CHECK(tspline::layout_moving_energy(m, t, Q, n, p, eps, barrier, 1.001 * full) == full);
+        CHECK(full == doctest::Approx(v0));
         for (const double u : {-0.05, -0.02, 0.03, 0.06}) {
           if (m.ring[n] < 0) {
             m.x[n] = keep.x[n] + V(u, 0.6 * u);

@@ -80,7 +80,8 @@ double layout_node_energy(const LayoutMesh& m, const LayoutTopology& t, const La
 }
 
 double layout_moving_energy(const LayoutMesh& m, const LayoutTopology& t, const LayoutQuality& Q, int n, double p,
-                            double eps_rel, bool barrier) {
+                            double eps_rel, bool barrier, double stop_at) {
+  // Every term is positive: the sum only grows.
   double sum = 0.0;
   const bool on_ring = m.ring[n] >= 0;
   for (const auto& [q, j] : t.corners_of(n)) {
@@ -88,10 +89,12 @@ double layout_moving_energy(const LayoutMesh& m, const LayoutTopology& t, const 
       const double e = corner_energy(m, t, Q, q, (j + k) % 4, p, eps_rel, barrier);
       if (!std::isfinite(e)) return e;
       sum += e;
+      if (sum >= stop_at) return sum;
     }
     sum += shape_energy(m, t, Q, q, (j + 1) % 4, p) + shape_energy(m, t, Q, q, (j + 2) % 4, p);
     if (on_ring)
       for (const int k : {0, 3}) sum += kink_energy(m, t, Q, q, (j + k) % 4, p) + shape_energy(m, t, Q, q, (j + k) % 4, p);
+    if (sum >= stop_at) return sum;
   }
   return sum;
 }

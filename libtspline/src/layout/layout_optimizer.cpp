@@ -12,7 +12,8 @@ namespace tspline {
 namespace {
 
 // Ring node n slid along its ring, between its two ring neighbours, to where
-// `local` (its energy) is least: every ring vertex in reach (where the corner
+// `local` (its energy, or a sum at least its second argument where the energy
+// is not below that) is least: every ring vertex in reach (where the corner
 // angles jump; the nearest max_ring_vertices), a uniform grid, then a local
 // refinement. `best` is the energy where it stands on entry, the energy
 // where it ends on return.
@@ -67,7 +68,7 @@ void slide_ring_node(LayoutMesh& m, const LayoutTopology& t, const LayoutQuality
   for (const double u : cand) {
     if (!(u > lo - 1e-12 && u < hi + 1e-12) || u == 0.0) continue;
     place(u);
-    const double f = local(n);
+    const double f = local(n, best);
     if (f < best && (!was_admissible || admissible(m, t, n))) best = f, best_u = u;
   }
   // Local refinement around the best (the energy is smooth between vertices).
@@ -76,7 +77,7 @@ void slide_ring_node(LayoutMesh& m, const LayoutTopology& t, const LayoutQuality
     for (const double u : {best_u - h, best_u + h}) {
       if (!(u > lo && u < hi)) continue;
       place(u);
-      const double f = local(n);
+      const double f = local(n, best);
       if (f < best && (!was_admissible || admissible(m, t, n))) best = f, best_u = u;
     }
   if (best_u == 0.0) m.arc[nn] = s0, m.x[nn] = x0;
@@ -209,8 +210,9 @@ LayoutOptimizationReport optimize_layout_nodes(LayoutMesh& m, const LayoutQualit
       const double v0 = layout_moving_energy(m, t, Q, n, p, eps_rel, barrier);
       if (!std::isfinite(f0) && std::isfinite(v0)) continue;  // infinite wherever n goes
       const bool incremental = std::isfinite(f0) && std::isfinite(v0);
-      auto energy = [&](int v) {
-        return incremental ? layout_moving_energy(m, t, Q, v, p, eps_rel, barrier) : local(v);
+      // (A place's energy only counts if it beats the best so far: its sum may stop there.)
+      auto energy = [&](int v, double best_so_far) {
+        return incremental ? layout_moving_energy(m, t, Q, v, p, eps_rel, barrier, best_so_far) : local(v);
       };
       double best_v = incremental ? v0 : f0;
       if (m.ring[n] < 0) {
@@ -221,7 +223,7 @@ LayoutOptimizationReport optimize_layout_nodes(LayoutMesh& m, const LayoutQualit
           Eigen::Vector2d best_x = start;
           for (int k = 0; k < 8; ++k) {
             m.x[nn] = start + step[nn] * kDirections[k];
-            const double f = energy(n);
+            const double f = energy(n, best_v);
             if (f < best_v && (!was_admissible || admissible(m, t, n))) best_v = f, best_x = m.x[nn];
           }
           m.x[nn] = best_x;

@@ -9,6 +9,8 @@
 // each ring side with kinks k < 1 and 2 / g for each side with shape g < 1
 // (layout_quality.h), every term to the power p. With `barrier` an inverted
 // corner makes it infinite.
+#include <limits>
+
 #include "tspline/layout/layout_quality.h"
 #include "tspline/layout/layout_topology.h"
 
@@ -31,7 +33,11 @@ double layout_node_energy(const LayoutMesh& m, const LayoutTopology& t, const La
 /// corner's sides do not end at n, and an inner node's sides are cuts.
 /// Where it is finite but the node's energy is not, no move of n makes that
 /// finite (an inverted or degenerate opposite corner).
+/// With stop_at: the sum stops once it reaches stop_at (a search that only
+/// asks whether a place beats its best so far), and that partial sum is
+/// returned (>= stop_at; every term is positive).
 double layout_moving_energy(const LayoutMesh& m, const LayoutTopology& t, const LayoutQuality& Q, int n, double p,
-                            double eps_rel, bool barrier);
+                            double eps_rel, bool barrier,
+                            double stop_at = std::numeric_limits<double>::infinity());
 
 }  // namespace tspline
