@@ -173,7 +173,7 @@ TEST_SUITE("layout_quality") {
           doctest::Approx(1.0 - 0.5 * 0.5 / 2.0));
   }
 
-  TEST_CASE("layout energy: a node's moving part differs from its whole energy by a constant") {
+  TEST_CASE("layout energy: a node's moving part differs from its whole energy by a constant, prepared or not") {
     // The 2 x 2 square with a kinked, bulging bottom coast (kinks and shapes in
     // play): wherever a node goes (inner: in the plane; ring: along its ring),
     // its energy minus its moving part stays the same, in both phases.
@@ -206,6 +206,9 @@ TEST_SUITE("layout_quality") {
         CHECK(stopped <= full);
         CHECK(tspline::layout_moving_energy(m, t, Q, n, p, eps, barrier, 1.001 * full) == full);
         CHECK(full == doctest::Approx(v0));
+        // Prepared for a search of n where it stands: the same sums, bit for bit, wherever n goes.
+        const tspline::LayoutMovingEnergy prepared(m, t, Q, n, p, eps, barrier);
+        CHECK(prepared() == full);
         for (const double u : {-0.05, -0.02, 0.03, 0.06}) {
           if (m.ring[n] < 0) {
             m.x[n] = keep.x[n] + V(u, 0.6 * u);
@@ -219,6 +222,9 @@ TEST_SUITE("layout_quality") {
             continue;
           }
           ++finite_moves;
+          const double moved = tspline::layout_moving_energy(m, t, Q, n, p, eps, barrier);
+          CHECK(prepared() == moved);
+          CHECK(prepared(0.5 * moved) == tspline::layout_moving_energy(m, t, Q, n, p, eps, barrier, 0.5 * moved));
           CHECK(w != doctest::Approx(w0));  // the move changed the energy
           // Equal to round-off in the sums (of terms up to w).
           CHECK(std::abs(r - r0) <= 1e-13 * std::max(w, w0));

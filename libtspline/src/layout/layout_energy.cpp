@@ -29,11 +29,10 @@ double power(double x, double p) {
 // could trade a pinched side for a fold, which the untangling then could not
 // undo (Corsica: the worst corner fell from 0.27 to -0.95 in one sweep, and 60
 // sweeps of untangling left it at -0.86).
-double corner_energy(const LayoutMesh& m, const LayoutTopology& t, const LayoutQuality& Q, int q, int j, double p,
-                     double eps_rel, bool barrier) {
+using CornerVectors = std::array<std::pair<Eigen::Vector2d, Eigen::Vector2d>, LayoutQuality::corner_scales.size()>;
+
+double corner_term(const CornerVectors& vectors, int scales, double p, double eps_rel, bool barrier) {
   double e = 0.0;  // the worst over the scales
-  std::array<std::pair<Eigen::Vector2d, Eigen::Vector2d>, LayoutQuality::corner_scales.size()> vectors;
-  const int scales = Q.corner_vectors_at(m, t, q, j, LayoutQuality::corner_scales, vectors.data());
   for (int k = 0; k < scales; ++k) {
     const auto& [e1, e2] = vectors[k];
     const double det = cross(e1, e2);
@@ -45,6 +44,13 @@ double corner_energy(const LayoutMesh& m, const LayoutTopology& t, const LayoutQ
     e = std::max(e, s * s / (2.0 * chi));
   }
   return power(e, p);
+}
+
+double corner_energy(const LayoutMesh& m, const LayoutTopology& t, const LayoutQuality& Q, int q, int j, double p,
+                     double eps_rel, bool barrier) {
+  CornerVectors vectors;
+  const int scales = Q.corner_vectors_at(m, t, q, j, LayoutQuality::corner_scales, vectors.data());
+  return corner_term(vectors, scales, p, eps_rel, barrier);
 }
 
 // The term of side j's kinks (0 for a cut or a side without kinks).
@@ -94,6 +100,52 @@ double layout_moving_energy(const LayoutMesh& m, const LayoutTopology& t, const 
     sum += shape_energy(m, t, Q, q, (j + 1) % 4, p) + shape_energy(m, t, Q, q, (j + 2) % 4, p);
     if (on_ring)
       for (const int k : {0, 3}) sum += kink_energy(m, t, Q, q, (j + k) % 4, p) + shape_energy(m, t, Q, q, (j + k) % 4, p);
+    if (sum >= stop_at) return sum;
+  }
+  return sum;
+}
+
+LayoutMovingEnergy::LayoutMovingEnergy(const LayoutMesh& m, const LayoutTopology& t, const LayoutQuality& Q, int n,
+                                       double p, double eps_rel, bool barrier)
+    : m_(m), t_(t), Q_(Q), n_(n), p_(p), eps_rel_(eps_rel), barrier_(barrier) {
+  if (m.ring[n] >= 0) return;  // a ring node: every term computed afresh
+  // Inner node: at corners j +- 1 the side away from n is the same wherever
+  // n goes (as corner_vectors_at gives it, at each scale); the side to n is a
+  // cut, x[n] - x[v] at every scale.
+  for (const auto& [q, j] : t.corners_of(n))
+    for (const int k : {1, 3}) {
+      CornerVectors v;
+      Neighbour c;
+      c.node = m.quads[q][(j + k) % 4];
+      c.scales = Q.corner_vectors_at(m, t, q, (j + k) % 4, LayoutQuality::corner_scales, v.data());
+      c.n_is_next = k == 3;  // corner j - 1's next corner is n
+      for (int s = 0; s < c.scales; ++s) c.fixed[s] = c.n_is_next ? v[s].second : v[s].first;
+      neighbours_.push_back(c);
+    }
+}
+
+double LayoutMovingEnergy::operator()(double stop_at) const {
+  if (m_.ring[n_] >= 0) return layout_moving_energy(m_, t_, Q_, n_, p_, eps_rel_, barrier_, stop_at);
+  // The terms of layout_moving_energy, in its order (the same sums).
+  double sum = 0.0;
+  std::size_t at = 0;
+  CornerVectors v;
+  for (const auto& [q, j] : t_.corners_of(n_)) {
+    for (const int k : {0, 1, 3}) {
+      double e;
+      if (k == 0) {
+        e = corner_energy(m_, t_, Q_, q, j, p_, eps_rel_, barrier_);
+      } else {
+        const Neighbour& c = neighbours_[at++];
+        const Eigen::Vector2d to_n = m_.x[n_] - m_.x[c.node];
+        for (int s = 0; s < c.scales; ++s) v[s] = c.n_is_next ? std::pair{to_n, c.fixed[s]} : std::pair{c.fixed[s], to_n};
+        e = corner_term(v, c.scales, p_, eps_rel_, barrier_);
+      }
+      if (!std::isfinite(e)) return e;
+      sum += e;
+      if (sum >= stop_at) return sum;
+    }
+    sum += shape_energy(m_, t_, Q_, q, (j + 1) % 4, p_) + shape_energy(m_, t_, Q_, q, (j + 2) % 4, p_);
     if (sum >= stop_at) return sum;
   }
   return sum;

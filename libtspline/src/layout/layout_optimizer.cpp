@@ -207,12 +207,13 @@ LayoutOptimizationReport optimize_layout_nodes(LayoutMesh& m, const LayoutQualit
       // Only the terms that move with n are evaluated (layout_moving_energy):
       // the energy differs from local(n) by a constant. Where that part is
       // not finite, the whole energy is.
-      const double v0 = layout_moving_energy(m, t, Q, n, p, eps_rel, barrier);
+      const LayoutMovingEnergy moving_part(m, t, Q, n, p, eps_rel, barrier);
+      const double v0 = moving_part();
       if (!std::isfinite(f0) && std::isfinite(v0)) continue;  // infinite wherever n goes
       const bool incremental = std::isfinite(f0) && std::isfinite(v0);
       // (A place's energy only counts if it beats the best so far: its sum may stop there.)
       auto energy = [&](int v, double best_so_far) {
-        return incremental ? layout_moving_energy(m, t, Q, v, p, eps_rel, barrier, best_so_far) : local(v);
+        return incremental ? moving_part(best_so_far) : local(v);
       };
       double best_v = incremental ? v0 : f0;
       if (m.ring[n] < 0) {

@@ -9,7 +9,9 @@
 // each ring side with kinks k < 1 and 2 / g for each side with shape g < 1
 // (layout_quality.h), every term to the power p. With `barrier` an inverted
 // corner makes it infinite.
+#include <array>
 #include <limits>
+#include <vector>
 
 #include "tspline/layout/layout_quality.h"
 #include "tspline/layout/layout_topology.h"
@@ -39,5 +41,31 @@ double layout_node_energy(const LayoutMesh& m, const LayoutTopology& t, const La
 double layout_moving_energy(const LayoutMesh& m, const LayoutTopology& t, const LayoutQuality& Q, int n, double p,
                             double eps_rel, bool barrier,
                             double stop_at = std::numeric_limits<double>::infinity());
+
+/// layout_moving_energy of one node, prepared for a search that moves only
+/// that node (the mesh is read where the node stands at each call): at an
+/// inner node's neighbouring corners, the side away from it is measured once.
+class LayoutMovingEnergy {
+ public:
+  LayoutMovingEnergy(const LayoutMesh& m, const LayoutTopology& t, const LayoutQuality& Q, int n, double p,
+                     double eps_rel, bool barrier);
+  /// layout_moving_energy(m, t, Q, n, p, eps_rel, barrier, stop_at), bit for bit.
+  double operator()(double stop_at = std::numeric_limits<double>::infinity()) const;
+
+ private:
+  struct Neighbour {
+    int node = -1;           ///< the corner's node (corner j + 1 or j - 1 of a quad at n's corner j)
+    int scales = 1;          ///< as corner_vectors_at
+    bool n_is_next = false;  ///< n is the corner's next corner (its first side), else its previous
+    std::array<Eigen::Vector2d, LayoutQuality::corner_scales.size()> fixed;  ///< the other side, per scale
+  };
+  const LayoutMesh& m_;
+  const LayoutTopology& t_;
+  const LayoutQuality& Q_;
+  int n_;
+  double p_, eps_rel_;
+  bool barrier_;
+  std::vector<Neighbour> neighbours_;  ///< per quad at n, corners j + 1 and j - 1 (inner n only)
+};
 
 }  // namespace tspline
