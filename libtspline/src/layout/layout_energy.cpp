@@ -99,7 +99,10 @@ double layout_moving_energy(const LayoutMesh& m, const LayoutTopology& t, const 
     }
     sum += shape_energy(m, t, Q, q, (j + 1) % 4, p) + shape_energy(m, t, Q, q, (j + 2) % 4, p);
     if (on_ring)
-      for (const int k : {0, 3}) sum += kink_energy(m, t, Q, q, (j + k) % 4, p) + shape_energy(m, t, Q, q, (j + k) % 4, p);
+      for (const int k : {0, 3}) {
+        const int side = (j + k) % 4;
+        sum += kink_energy(m, t, Q, q, side, p) + shape_energy(m, t, Q, q, side, p);
+      }
     if (sum >= stop_at) return sum;
   }
   return sum;
@@ -138,7 +141,8 @@ double LayoutMovingEnergy::operator()(double stop_at) const {
       } else {
         const Neighbour& c = neighbours_[at++];
         const Eigen::Vector2d to_n = m_.x[n_] - m_.x[c.node];
-        for (int s = 0; s < c.scales; ++s) v[s] = c.n_is_next ? std::pair{to_n, c.fixed[s]} : std::pair{c.fixed[s], to_n};
+        for (int s = 0; s < c.scales; ++s)
+          v[s] = c.n_is_next ? std::pair{to_n, c.fixed[s]} : std::pair{c.fixed[s], to_n};
         e = corner_term(v, c.scales, p_, eps_rel_, barrier_);
       }
       if (!std::isfinite(e)) return e;

@@ -87,7 +87,10 @@ void slide_ring_node(LayoutMesh& m, const LayoutTopology& t, const LayoutQuality
 // The pattern search's eight directions.
 const std::array<Eigen::Vector2d, 8> kDirections = [] {
   std::array<Eigen::Vector2d, 8> d;
-  for (int k = 0; k < 8; ++k) d[k] = Eigen::Vector2d(std::cos(k * std::numbers::pi / 4.0), std::sin(k * std::numbers::pi / 4.0));
+  for (int k = 0; k < 8; ++k) {
+    const double a = k * std::numbers::pi / 4.0;
+    d[k] = Eigen::Vector2d(std::cos(a), std::sin(a));
+  }
   return d;
 }();
 
