@@ -614,6 +614,49 @@ TEST_SUITE("layout_quality") {
     CHECK(crossed < 1800);
   }
 
+  TEST_CASE("layout cut checks agree with the patch layout's on every chord between ring points") {
+    // A stepped outer ring (cuts can go on along an edge's line, or leave the
+    // domain through the notch touching the ring only at their ends) with a
+    // hole; the ring points are the vertices and the edge midpoints. Every
+    // chord between two of them: the layout's test (admits_cut: no crossing,
+    // midpoint inside) says yes exactly where the patch layout's validate_cuts
+    // takes the chord as a cut; crossings alone miss the chords outside.
+    tspline::Domain d;
+    d.outer = test_support::make_polygon({{0, 0}, {4, 0}, {4, 2}, {2, 2}, {2, 4}, {0, 4}});
+    d.holes = {test_support::make_polygon({{0.5, 0.5}, {1.5, 0.5}, {1.5, 1.5}, {0.5, 1.5}})};
+    d = tspline::validate_domain(d);
+    std::vector<tspline::RingCurve> rings = {tspline::RingCurve(d.outer.vertices)};
+    for (const auto& h : d.holes) rings.emplace_back(h.vertices);
+    const tspline::RingGeometry g = tspline::RingGeometry::of_rings(rings);
+    std::vector<V> points;
+    for (const auto& r : rings)
+      for (std::size_t i = 0; i < r.size(); ++i) {
+        points.push_back(r.vertex(i));
+        points.push_back(0.5 * (r.vertex(i) + r.vertex(i + 1)));
+      }
+    const double tol = 1e-9 * 4.0 * std::sqrt(2.0);
+    int accepted = 0, refused = 0;
+    for (std::size_t i = 0; i < points.size(); ++i)
+      for (std::size_t j = i + 1; j < points.size(); ++j) {
+        const V a = points[i], b = points[j];
+        CAPTURE(a);
+        CAPTURE(b);
+        const bool layout_ok = g.admits_cut(a, b, true, true, tol);
+        bool patch_ok = true;
+        try {
+          tspline::validate_cuts(d, {{a, b}});
+        } catch (const tspline::InputError&) {
+          patch_ok = false;
+        }
+        CHECK(layout_ok == patch_ok);
+        (patch_ok ? accepted : refused) += 1;
+      }
+    CHECK(accepted > 50);
+    CHECK(refused > 50);
+    CHECK_FALSE(g.crosses(V(4, 2), V(2, 4), true, true, tol));  // through the notch, outside
+    CHECK_FALSE(g.admits_cut(V(4, 2), V(2, 4), true, true, tol));
+  }
+
   TEST_CASE("ring geometry: inside a square with a hole, segments crossing a ring, the nearest edge") {
     const std::vector<tspline::RingCurve> rings = {
         tspline::RingCurve({V(0, 0), V(4, 0), V(4, 4), V(0, 4)}),

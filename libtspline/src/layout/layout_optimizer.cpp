@@ -263,7 +263,7 @@ LayoutAdmissible admissible_in(const RingGeometry& geometry, double tol) {
       for (const int k : {1, 3}) {
         if (t.on_ring(q, k == 1 ? j : (j + 3) % 4)) continue;
         const int other = m.quads[q][(j + k) % 4];
-        if (geometry.crosses(m.x[n], m.x[other], m.ring[n] >= 0, m.ring[other] >= 0, tol)) return false;
+        if (!geometry.admits_cut(m.x[n], m.x[other], m.ring[n] >= 0, m.ring[other] >= 0, tol)) return false;
       }
     return true;
   };

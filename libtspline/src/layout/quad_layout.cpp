@@ -396,7 +396,13 @@ QuadLayout build_quad_layout(const Domain& d, const QuadLayoutOptions& o) {
           const int a = lm.quads[q][j], b = lm.quads[q][(j + 1) % 4];
           if (t.on_ring(static_cast<int>(q), j) || a > b) continue;  // each cut once
           const int g = geometry.crossing(lm.x[a], lm.x[b], lm.ring[a] >= 0, lm.ring[b] >= 0, tol);
-          if (g < 0) continue;
+          if (g < 0) {
+            // Between two ring nodes, wholly outside (geometry.admits_cut).
+            if (geometry.admits_cut(lm.x[a], lm.x[b], lm.ring[a] >= 0, lm.ring[b] >= 0, tol)) continue;
+            involved.insert(a), involved.insert(b);
+            if (mark) mark_nearest_piece(0.5 * (lm.x[a] + lm.x[b]));
+            continue;
+          }
           involved.insert(a), involved.insert(b);
           if (mark) {
             const RingGeometry::Edge& f = geometry.edge(g);

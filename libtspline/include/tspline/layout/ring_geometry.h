@@ -42,6 +42,15 @@ class RingGeometry {
   bool crosses(const Eigen::Vector2d& a, const Eigen::Vector2d& b, bool a_on_ring, bool b_on_ring, double tol) const {
     return crossing(a, b, a_on_ring, b_on_ring, tol) >= 0;
   }
+  /// Whether a cut from a to b may lie where it lies: it crosses no edge
+  /// (crosses()) and, if both ends are on rings, its midpoint is inside (with
+  /// no crossing the whole cut is then inside; between two ring points it may
+  /// also lie wholly outside, touching the rings at its ends only). The rule
+  /// of the patch layout's validate_cuts.
+  bool admits_cut(const Eigen::Vector2d& a, const Eigen::Vector2d& b, bool a_on_ring, bool b_on_ring,
+                  double tol) const {
+    return !crosses(a, b, a_on_ring, b_on_ring, tol) && !(a_on_ring && b_on_ring && !inside(0.5 * (a + b)));
+  }
   /// The first edge crossed as by crosses(), or -1.
   int crossing(const Eigen::Vector2d& a, const Eigen::Vector2d& b, bool a_on_ring, bool b_on_ring, double tol) const;
   /// The edge nearest to p (brute force over the grid cells around it, widening).
