@@ -5,6 +5,7 @@
 #include <doctest/doctest.h>
 
 #include <atomic>
+#include <cmath>
 
 #include <array>
 #include <functional>
@@ -87,6 +88,42 @@ TEST_SUITE("parameterization_run") {
     CHECK(r.good() == (r.valid() && r.quality.min_mean_ratio >= 0.35));
   }
 
+  TEST_CASE("the polish: run where the map is certified and below polish_below, skipped below polish_skip_*") {
+    // The L-shape's map (J_r 0.47) is polished once polish_below is above it;
+    // with the skip thresholds above its figures the polish is skipped and the
+    // map is the one without any polish, control point for control point.
+    const tspline::Polygon poly = tspline::io::read_polygon(test_support::polygon_file("lshape_cw.txt"));
+    auto run = [&](double skip_scaled, double skip_mean_ratio, int stages, std::string* polish_line) {
+      tspline::ParameterizationOptions opt;
+      opt.corner_trials = 1;
+      opt.progress = [&](const ProgressEvent& e) {
+        if (polish_line && e.stage == "polish") *polish_line = e.text;
+      };
+      tspline::AdaptiveOptions ad;
+      ad.max_adapt = 1;
+      ad.polish_below = 1.1;
+      ad.polish_stages = stages;
+      ad.polish_skip_scaled = skip_scaled;
+      ad.polish_skip_mean_ratio = skip_mean_ratio;
+      return tspline::run_parameterization(poly, opt, ad);
+    };
+    std::string ran, skipped_sj, skipped_jr;
+    const tspline::ParameterizationResult polished = run(0.0, 0.0, 12, &ran);
+    CHECK(test_support::contains(ran, "more quality stages"));
+    const tspline::ParameterizationResult none = run(0.0, 0.0, 0, nullptr);
+    REQUIRE(none.map);
+    REQUIRE(none.dense_quality.min_scaled < 0.99);
+    REQUIRE(none.dense_quality.min_mean_ratio < 0.99);
+    const tspline::ParameterizationResult by_sj = run(0.99, 0.0, 12, &skipped_sj);
+    const tspline::ParameterizationResult by_jr = run(0.0, 0.99, 12, &skipped_jr);
+    CHECK(test_support::contains(skipped_sj, "polish: skipped"));
+    CHECK(test_support::contains(skipped_jr, "polish: skipped"));
+    CHECK(by_sj.map->control_points() == none.map->control_points());
+    CHECK(by_jr.map->control_points() == none.map->control_points());
+    // Where it ran and was kept, the map moved.
+    if (!test_support::contains(ran, "not kept")) CHECK(polished.map->control_points() != none.map->control_points());
+  }
+
   TEST_CASE("options out of range are input errors that name the option's field, before any work") {
     const tspline::Polygon poly = tspline::io::read_polygon(test_support::polygon_file("square.txt"));
     auto message = [&](const tspline::ParameterizationOptions& o, const tspline::AdaptiveOptions& a) -> std::string {
@@ -104,7 +141,8 @@ TEST_SUITE("parameterization_run") {
               {"`initial_level`", [](auto& o, auto&) { o.initial_level = 11; }},
               {"`min_jacobian`", [](auto&, auto& a) { a.min_jacobian = 0.0; }},
               {"`certification.max_depth`", [](auto&, auto& a) { a.certification.max_depth = 21; }},
-              {"`untangling.quality_power`", [](auto&, auto& a) { a.untangling.quality_power = 0.5; }}};
+              {"`untangling.quality_power`", [](auto&, auto& a) { a.untangling.quality_power = 0.5; }},
+              {"`polish_skip_scaled`", [](auto&, auto& a) { a.polish_skip_scaled = std::nan(""); }}};
     for (const auto& name_spoil : cases) {
       const std::string& name = name_spoil.first;
       const auto& spoil = name_spoil.second;

@@ -341,6 +341,13 @@ class AdaptiveRun {
     // A warm start's optimization already ran at the polish power (untangling_options).
     if (warm_ && warm_->reference_mean_ratio < ad_.polish_below) return;
     if (ad_.certify && !b.certification.certified_valid()) return;
+    if (b.dense.min_scaled < ad_.polish_skip_scaled || b.dense.min_mean_ratio < ad_.polish_skip_mean_ratio) {
+      std::ostringstream s;
+      s << "polish: skipped, whole-map scaled Jacobian " << b.dense.min_scaled << " and J_r " << b.dense.min_mean_ratio
+        << " (below " << ad_.polish_skip_scaled << " or " << ad_.polish_skip_mean_ratio << ")";
+      log("polish", s.str());
+      return;
+    }
     const auto t1 = std::chrono::steady_clock::now();
     MapUntanglingOptions uo = untangling_options();
     uo.max_quality_stages = ad_.polish_stages;
@@ -356,7 +363,7 @@ class AdaptiveRun {
     t_check_ += seconds_since(t2);
     std::ostringstream s;
     s << "polish: " << u.stages << " more quality stages, whole-map J_r " << b.dense.min_mean_ratio << " -> "
-      << dense.min_mean_ratio;
+      << dense.min_mean_ratio << ", scaled Jacobian " << b.dense.min_scaled << " -> " << dense.min_scaled;
     if (!(dense.min_mean_ratio > b.dense.min_mean_ratio && quality.nonpositive_det == 0)) {
       log("polish", s.str() + ": not kept");
       return;
