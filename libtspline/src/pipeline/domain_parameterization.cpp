@@ -260,7 +260,7 @@ DomainParameterization parameterize_domain(const Domain& input, const Parameteri
   // No polish where it cannot make the try good (AdaptiveOptions::polish_skip_scaled):
   // a try whose polish is skipped is poor, so no kept map lacks its polish.
   first.polish_skip_scaled = std::max(first.polish_skip_scaled, 0.5 * c.good_scaled_jacobian);
-  first.polish_skip_mean_ratio = std::max(first.polish_skip_mean_ratio, 0.5 * c.good_mean_ratio);
+  first.polish_skip_mean_ratio = std::max(first.polish_skip_mean_ratio, 0.25 * c.good_mean_ratio);
   ParameterizationResult single = run_parameterization(domain.outer, serial, first, on_iteration);
   const DenseMapQuality& q = single.dense_quality;
   const bool certified = !adaptive.certify || single.certified_valid();
