@@ -21,16 +21,17 @@ double power(double x, double p) {
   return std::pow(x, p);
 }
 
-// The term of corner j of quad q: the worst over the scales of
-// (|e1| + |e2|)^2 / (2 chi(det)), to the power p; infinite for a degenerate
-// corner, and with `barrier` for an inverted one. The regularized term alone
-// is not a barrier: an inverted corner costs about 8 sin / eps_rel (1e9 at
-// eps_rel = 1e-4), less than a pinched side's 2 / 1e-9, so a quality sweep
-// could trade a pinched side for a fold, which the untangling then could not
-// undo (Corsica: the worst corner fell from 0.27 to -0.95 in one sweep, and 60
-// sweeps of untangling left it at -0.86).
+// A corner's side vectors (e1, e2) at each of LayoutQuality::corner_scales.
 using CornerVectors = std::array<std::pair<Eigen::Vector2d, Eigen::Vector2d>, LayoutQuality::corner_scales.size()>;
 
+// The term of a corner with the given vectors at its first `scales` scales:
+// the worst over the scales of (|e1| + |e2|)^2 / (2 chi(det)), to the power p;
+// infinite for a degenerate corner, and with `barrier` for an inverted one.
+// The regularized term alone is not a barrier: an inverted corner costs about
+// 8 sin / eps_rel (1e9 at eps_rel = 1e-4), less than a pinched side's
+// 2 / 1e-9, so a quality sweep could trade a pinched side for a fold, which
+// the untangling then could not undo (Corsica: the worst corner fell from 0.27
+// to -0.95 in one sweep, and 60 sweeps of untangling left it at -0.86).
 double corner_term(const CornerVectors& vectors, int scales, double p, double eps_rel, bool barrier) {
   double e = 0.0;  // the worst over the scales
   for (int k = 0; k < scales; ++k) {
@@ -46,6 +47,7 @@ double corner_term(const CornerVectors& vectors, int scales, double p, double ep
   return power(e, p);
 }
 
+// The term of corner j of quad q.
 double corner_energy(const LayoutMesh& m, const LayoutTopology& t, const LayoutQuality& Q, int q, int j, double p,
                      double eps_rel, bool barrier) {
   CornerVectors vectors;
