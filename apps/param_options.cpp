@@ -186,7 +186,7 @@ std::vector<ParamOption> make_table() {
       [](auto& s) -> auto& { return s.opt.tolerance_relative; }));
   t.push_back(option(
       "init-level", OptionKind::Integer,
-      "Initial uniform level L in [0, 10]: 2^L x 2^L cells (patches of a quad layout: 2 unless given)",
+      "Initial uniform level L in [0, 10]: 2^L x 2^L cells (patches of a quad layout: 2 unless given; at 0 the boundary must refine the cell: a map needs 2 x 2 cells)",
       [](ParamSettings& s, const std::string& v) {
         s.opt.initial_level = parse_int(v);
         s.choice.patch_initial_level = s.opt.initial_level;  // given: the patches' too

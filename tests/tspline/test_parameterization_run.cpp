@@ -154,6 +154,30 @@ TEST_SUITE("parameterization_run") {
     }
   }
 
+  TEST_CASE("initial level 0: a map where the boundary refines the cell, an input error naming initial_level where not") {
+    // A single cell gives the four corner-extra functions one interpolation
+    // point (the cell's centre): Eq. 8 would be singular. The square needs no
+    // boundary refinement, so level 0 leaves it one cell; the L-shape's
+    // reflex corner refines it, and level 0 maps it.
+    tspline::ParameterizationOptions o;
+    o.initial_level = 0;
+    tspline::AdaptiveOptions a;
+    a.max_adapt = 0;
+    const tspline::Polygon square = tspline::io::read_polygon(test_support::polygon_file("square.txt"));
+    std::string message;
+    try {
+      tspline::run_parameterization(square, o, a);
+    } catch (const tspline::InputError& e) {
+      message = e.what();
+    }
+    CHECK(test_support::contains(message, "initial_level"));
+    CHECK(test_support::contains(message, "single cell"));
+    const tspline::Polygon lshape = tspline::io::read_polygon(test_support::polygon_file("lshape_cw.txt"));
+    const tspline::ParameterizationResult r = tspline::run_parameterization(lshape, o, a);
+    CHECK(r.map->mesh().num_cells() >= 4);
+    CHECK(r.certified_valid());
+  }
+
   TEST_CASE("a callback that throws during the concurrent corner trials stops them (Ctrl-C in the program)") {
     const tspline::Polygon poly = tspline::io::read_polygon(test_support::polygon_file("flower.txt"));
     tspline::ParameterizationOptions opt;

@@ -114,6 +114,12 @@ class AdaptiveRun {
       const auto t0 = std::chrono::steady_clock::now();
       round_ = it;
       AdaptIteration rec;
+      // A single cell gives every corner the same corner-extra interpolation
+      // point (the corner cell's centre) and each side's two edge extras the
+      // same one: the interpolation (Eq. 8) has no solution.
+      if (it == 0 && !warm_ && f_.mesh.num_cells() == 1)
+        throw InputError("initial_level 0 left the T-mesh a single cell (the boundary needed no refinement): a "
+                         "cubic T-spline map needs at least 2 x 2 cells; use initial_level >= 1");
       TSplineMap map = it > 0   ? transfer_map(*previous_, f_.mesh, &rec.fit)
                        : warm_ ? std::move(warm_->map)
                                : fit_tspline(f_.mesh, f_.optimized, f_.boundary, &rec.fit);
