@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <optional>
 
 #include "arguments.h"
 #include "param_options.h"
@@ -20,6 +21,7 @@
 #include "tspline/io/param_output.h"
 #include "tspline/io/render.h"
 #include "tspline/io/tspline_file.h"
+#include "tspline/multipatch/map_check.h"
 #include "tspline/multipatch/multipatch_parameterization.h"
 #include "tspline/validity/map_certification.h"
 #include "tspline/validity/map_quality_bounds.h"
@@ -195,50 +197,51 @@ py::dict check(const Map& m, int depth, std::size_t max_listed) {
   if (depth < 0 || depth > 20)
     throw tspline::InputError("depth: " + std::to_string(depth) + " is not in [0, 20]");
   json patches = json::array();
-  bool all = true;
-  double gap = 0.0;
+  tspline::MapCheckOptions o;
+  o.certification.max_depth = depth;
+  o.quality = tspline::io::report_quality_bound_options();
+  std::optional<tspline::MapCheck> checked;
   {
     py::gil_scoped_release release;
-    tspline::CertificationOptions opt;
-    opt.max_depth = depth;
-    const tspline::QualityBoundOptions qo = tspline::io::report_quality_bound_options();
-    for (const tspline::TSplineMap* map : m.maps) {
-      const tspline::MapCertification c = tspline::certify_map(*map, opt);
-      json failures = json::array();
-      for (std::size_t k = 0; k < c.failures.size() && k < max_listed; ++k) {
-        const tspline::CertificationFailure& f = c.failures[k];
-        const bool invalid = f.certificate.status == tspline::ElementStatus::Invalid;
-        failures.push_back(
-            {{"cell", f.cell},
-             {"element", f.element},
-             {"lo", {f.lo.x(), f.lo.y()}},
-             {"hi", {f.hi.x(), f.hi.y()}},
-             {"status", invalid ? "invalid" : "undecided"},
-             {"negative_at",
-              invalid ? json{f.certificate.negative_at.x(), f.certificate.negative_at.y()} : json()},
-             {"negative_det", invalid ? json(f.certificate.negative_det) : json()}});
-      }
-      auto finite = [](double v) { return std::isfinite(v) ? json(v) : json(); };
-      patches.push_back(
-          {{"cells", map->mesh().num_cells()},
-           {"elements", c.elements},
-           {"certified", c.certified},
-           {"invalid", c.invalid},
-           {"undecided", c.undecided},
-           {"certified_valid", c.certified_valid()},
-           {"min_relative_det_lower_bound", finite(c.min_relative_lower_bound)},
-           {"min_det_lower_bound", finite(c.min_det_lower_bound)},
-           {"max_depth_used", c.max_depth_used},
-           {"whole_map", tspline::io::whole_map_quality_json(tspline::certified_map_quality(*map, qo), qo)},
-           {"failures", std::move(failures)},
-           {"seconds", c.seconds}});
-      all = all && c.certified_valid();
-    }
-    for (const tspline::Interface& f : m.interfaces)
-      gap = std::max(gap, tspline::interface_gap(*m.maps[f.patch_a], f.side_a, *m.maps[f.patch_b], f.side_b));
+    checked.emplace(tspline::check_map(m.maps, m.interfaces, o));
   }
-  return to_python(
-      json{{"certified_valid", all}, {"patches", std::move(patches)}, {"max_interface_gap", gap}});
+  const tspline::MapCheck& mc = *checked;
+  auto finite = [](double v) { return std::isfinite(v) ? json(v) : json(); };
+  for (const tspline::PatchCheck& p : mc.patches) {
+    const tspline::MapCertification& c = p.certification;
+    json failures = json::array();
+    for (std::size_t k = 0; k < c.failures.size() && k < max_listed; ++k) {
+      const tspline::CertificationFailure& f = c.failures[k];
+      const bool invalid = f.certificate.status == tspline::ElementStatus::Invalid;
+      failures.push_back({{"cell", f.cell},
+                          {"element", f.element},
+                          {"lo", {f.lo.x(), f.lo.y()}},
+                          {"hi", {f.hi.x(), f.hi.y()}},
+                          {"status", invalid ? "invalid" : "undecided"},
+                          {"negative_at", invalid ? json{f.certificate.negative_at.x(), f.certificate.negative_at.y()}
+                                                  : json()},
+                          {"negative_det", invalid ? json(f.certificate.negative_det) : json()}});
+    }
+    patches.push_back({{"cells", p.cells},
+                       {"elements", c.elements},
+                       {"certified", c.certified},
+                       {"invalid", c.invalid},
+                       {"undecided", c.undecided},
+                       {"certified_valid", c.certified_valid()},
+                       {"min_relative_det_lower_bound", finite(c.min_relative_lower_bound)},
+                       {"min_det_lower_bound", finite(c.min_det_lower_bound)},
+                       {"max_depth_used", c.max_depth_used},
+                       {"whole_map", tspline::io::whole_map_quality_json(p.quality, o.quality)},
+                       {"failures", std::move(failures)},
+                       {"seconds", c.seconds}});
+  }
+  return to_python(json{{"certified_valid", mc.certified_valid()},
+                        {"patches", std::move(patches)},
+                        {"elements", mc.elements},
+                        {"certified", mc.certified},
+                        {"min_relative_det_lower_bound", finite(mc.min_relative_det_lower_bound)},
+                        {"whole_map", tspline::io::whole_map_quality_json(mc.quality, o.quality)},
+                        {"max_interface_gap", mc.max_interface_gap}});
 }
 
 /// The T-spline file alone: version 1 for a single-patch map, 2 for a layout.
@@ -385,7 +388,9 @@ void bind_maps(py::module_& m) {
           "element "
           "(de Casteljau subdivision, at most `depth` levels), per patch ('patches': elements, certified, "
           "invalid, undecided, bounds of det J, 'whole_map' certified bounds of J_r and the scaled Jacobian, "
-          "'failures' (at most max_listed)); 'certified_valid'; 'max_interface_gap'.")
+          "'failures' (at most max_listed)); over the whole map: 'certified_valid', 'elements', 'certified', "
+          "'min_relative_det_lower_bound', 'whole_map' (the certified bounds over every patch) and "
+          "'max_interface_gap'.")
       .def("save", &save, py::arg("dir"),
            "save(dir): writes the files of `tspline param` into the folder dir (created if missing): "
            "tspline.json, surface.vtu, surface_bezier.vtu, control_net.vtu, parametric_tmesh.vtu, "

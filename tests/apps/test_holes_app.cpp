@@ -95,6 +95,30 @@ TEST_SUITE("holes_app") {
     const auto check = test_support::run_app("check " + quoted(out / "tspline.json"), d);
     CHECK(check.exit_code == 0);
     CHECK(contains(check.out, "result: every patch certified valid"));
+    // check recomputes the certified whole-map bounds from the file: the
+    // report's (made from the map in memory) to the 6 digits it prints; the
+    // worst patch listed first is the report's patch of the J_r bound.
+    {
+      auto printed = [&](const std::string& key) {
+        const std::size_t at = check.out.find(key);
+        REQUIRE(at != std::string::npos);
+        return std::stod(check.out.substr(at + key.size()));
+      };
+      const auto& w = rep["totals"]["whole_map"];
+      for (const auto& [key, q] : {std::pair<std::string, const char*>{"whole map: J_r >= ", "mean_ratio"},
+                                   {"whole map: scaled Jacobian >= ", "scaled_jacobian"}}) {
+        CAPTURE(key);
+        const double bound = w[q]["certified_lower_bound"].get<double>();
+        CHECK(printed(key) == doctest::Approx(bound).epsilon(1e-5));
+      }
+      CHECK(printed("bezier elements: ") == rep["totals"]["bezier_elements"].get<double>());
+      CHECK(contains(check.out, "certified: " + std::to_string(rep["totals"]["bezier_elements"].get<std::size_t>()) +
+                                    " of " + std::to_string(rep["totals"]["bezier_elements"].get<std::size_t>()) +
+                                    " elements, " + std::to_string(patches) + " of " + std::to_string(patches) +
+                                    " patches"));
+      CHECK(printed("worst patches (by the certified J_r bound):\n  patch ") ==
+            w["mean_ratio"]["certified_lower_bound_patch"].get<double>());
+    }
     const auto info = test_support::run_app("info " + quoted(out / "tspline.json"), d);
     CHECK(info.exit_code == 0);
     CHECK(contains(info.out, "format: tspline version 2"));

@@ -74,12 +74,20 @@ def test_check_is_the_certificate_of_tspline_check(plate):
     m, out = plate
     c = m.check()
     assert c["certified_valid"] is True and len(c["patches"]) == m.patches
-    printed = run_app("check", out / "cli" / "tspline.json").stdout
+    printed = run_app("check", out / "cli" / "tspline.json", "--per-patch").stdout
     elements = [int(n) for n in re.findall(r"^bezier elements: (\d+)$", printed, re.M)]
-    assert [p["elements"] for p in c["patches"]] == elements
+    # Every patch's block, then the whole map's.
+    assert [p["elements"] for p in c["patches"]] + [c["elements"]] == elements
+    assert c["elements"] == sum(p["elements"] for p in c["patches"]) == c["certified"]
     for p in c["patches"]:
         assert p["certified"] == p["elements"] and p["failures"] == [] and p["min_det_lower_bound"] > 0
         assert 0 < p["whole_map"]["mean_ratio"]["certified_lower_bound"] <= 1
+    for q in ["mean_ratio", "scaled_jacobian"]:
+        assert c["whole_map"][q]["certified_lower_bound"] == min(
+            p["whole_map"][q]["certified_lower_bound"] for p in c["patches"])
+    jr = float(re.search(r"^whole map: J_r >= (\S+)", printed, re.M).group(1))
+    assert c["whole_map"]["mean_ratio"]["certified_lower_bound"] == pytest.approx(jr, rel=1e-5)
+    assert c["min_relative_det_lower_bound"] == min(p["min_relative_det_lower_bound"] for p in c["patches"])
     gap = float(re.search(r"largest gap between the two images of a cut: (\S+)", printed).group(1))
     assert c["max_interface_gap"] == pytest.approx(gap, rel=1e-5, abs=1e-15)
 

@@ -527,10 +527,18 @@ MapQualityBounds certified_map_quality(const BezierExtraction& extraction, const
 
 MapQualityBounds certified_map_quality(const std::vector<const TSplineMap*>& maps, const QualityBoundOptions& opt) {
   check_options(opt);
-  MapQualityBounds m;
+  std::vector<MapQualityBounds> parts;
+  parts.reserve(maps.size());
+  for (const TSplineMap* map : maps) parts.push_back(certified_map_quality(*map, opt));
+  MapQualityBounds m = merge_map_quality(std::move(parts));
   m.samples_per_edge = opt.samples_per_edge;
-  for (const TSplineMap* map : maps) {
-    MapQualityBounds b = certified_map_quality(*map, opt);
+  return m;
+}
+
+MapQualityBounds merge_map_quality(std::vector<MapQualityBounds>&& parts) {
+  MapQualityBounds m;
+  if (!parts.empty()) m.samples_per_edge = parts.front().samples_per_edge;
+  for (MapQualityBounds& b : parts) {
     merge_into(m.mean_ratio, b.mean_ratio, m.elements, true);
     merge_into(m.scaled, b.scaled, m.elements, true);
     m.elements += b.elements;

@@ -164,5 +164,8 @@ MapQualityBounds certified_map_quality(const BezierExtraction& extraction, const
 /// the patch holding the element.
 MapQualityBounds certified_map_quality(const std::vector<const TSplineMap*>& maps,
                                        const QualityBoundOptions& options = {});
+/// The figures of several maps' bounds (parts, in patch order) as
+/// certified_map_quality of the maps gives them (moves the per_element lists).
+MapQualityBounds merge_map_quality(std::vector<MapQualityBounds>&& parts);
 
 }  // namespace tspline
