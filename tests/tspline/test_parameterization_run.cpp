@@ -178,6 +178,27 @@ TEST_SUITE("parameterization_run") {
     CHECK(r.certified_valid());
   }
 
+  TEST_CASE("a tolerance that needs more than max_cells: an input error naming the tolerance given, no stage optimized") {
+    // The last stage's T-mesh is built before the nested stages: the error
+    // names the tolerance asked for (not a coarser stage's), and no sweep ran.
+    const tspline::Polygon poly = tspline::io::read_polygon(test_support::polygon_file("fjords.txt"));
+    tspline::ParameterizationOptions o;
+    o.tolerance_absolute = 1e-12;
+    o.max_cells = 30000;
+    o.corner_trials = 1;
+    int sweeps = 0;
+    o.progress = [&](const ProgressEvent& e) { sweeps += e.kind == ProgressEvent::Kind::Sweep; };
+    std::string message;
+    try {
+      tspline::run_parameterization(poly, o, tspline::AdaptiveOptions{});
+    } catch (const tspline::InputError& e) {
+      message = e.what();
+    }
+    CHECK(test_support::contains(message, "more than 30000 cells"));
+    CHECK(test_support::contains(message, "tolerance 1e-12"));
+    CHECK(sweeps == 0);
+  }
+
   TEST_CASE("a callback that throws during the concurrent corner trials stops them (Ctrl-C in the program)") {
     const tspline::Polygon poly = tspline::io::read_polygon(test_support::polygon_file("flower.txt"));
     tspline::ParameterizationOptions opt;

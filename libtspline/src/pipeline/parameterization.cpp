@@ -164,6 +164,13 @@ FrontResult optimize_front(BoundaryMap boundary, const ParameterizationOptions& 
   // errors quickly but the smooth, domain-wide ones slowly; on the coarse stages
   // those are cheap, so the finest stage starts close to its optimum.
   const Stages st = nested_stages(opt.initial_level, r.tolerance_area, diag, opt.nested_optimization);
+  // The last stage's T-mesh first (milliseconds: a test per cell), so that a
+  // tolerance that needs more than max_cells fails at once (refine_to_boundary
+  // throws), not after the optimization of every coarser stage.
+  if (st.level.size() > 1) {
+    TMesh last(opt.initial_level);
+    refine_to_boundary(last, r.boundary, {r.tolerance_area, opt.max_level, opt.max_cells});
+  }
   for (std::size_t k = 0; k < st.level.size(); ++k) {
     const bool last = k + 1 == st.level.size();
     TMesh coarse = k == 0 ? TMesh(st.level[0]) : r.mesh;
