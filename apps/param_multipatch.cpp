@@ -15,6 +15,7 @@ int write_multipatch_param(const ParamRun& run, const std::string& out_dir, Prog
   const tspline::AdaptiveOptions& adaptive = run.settings.adaptive;
   const nlohmann::json& report = run.report;
   const double seconds = run.seconds;
+  progress.log("writing the output files to " + out_dir);
   write_param_run(run, out_dir);
   progress.settle();
   const auto& totals = report["totals"];

@@ -244,6 +244,10 @@ ParamRun run_param(tspline::io::DomainInput domain, std::string source, const Pa
   }
   if (run.result.patches) run.iterations.clear();  // adapt.pvd is written for a single patch only
   run.seconds = toolkit::seconds_since(started);
+  if (run.result.patches)  // (seconds on a large layout: the user is told)
+    tspline::report_step(opt.progress, "report",
+                         "report: certified bounds of J_r and the scaled Jacobian on every Bezier element of " +
+                             std::to_string(run.result.patches->patches.size()) + " patches");
   run.report = run.result.patches ? multipatch_report(run) : single_report(run);
   return run;
 }

@@ -250,7 +250,7 @@ MultiPatchResult reparameterize_layout(const PreviousLayout& old, const Domain& 
   });
   R.patches.reserve(P);
   for (auto& r : runs) R.patches.push_back(std::move(*r));
-  finish_multipatch_result(R, adaptive, options.max_level);
+  finish_multipatch_result(R, adaptive, options.max_level, options.progress);
   return R;
 }
 

@@ -290,7 +290,7 @@ MultiPatchResult run_multipatch_parameterization(const Domain& domain, PatchLayo
     log("interfaces: re-running " + std::to_string(std::count(stale.begin(), stale.end(), 1)) +
         " patches with the union of the knots of their interfaces");
   }
-  finish_multipatch_result(R, adaptive, options.max_level);
+  finish_multipatch_result(R, adaptive, options.max_level, options.progress);
   return R;
 }
 
@@ -341,12 +341,24 @@ ProgressCallback patch_progress(const ProgressCallback& progress, std::size_t p)
   };
 }
 
-void finish_multipatch_result(MultiPatchResult& R, const AdaptiveOptions& adaptive, int max_level) {
+void finish_multipatch_result(MultiPatchResult& R, const AdaptiveOptions& adaptive, int max_level,
+                              const ProgressCallback& progress) {
   // Refining a patch to the knots of one interface can refine its others (the
   // T-mesh stays balanced): repeat until every interface has one set of knots.
-  for (int round = 0; round < 16 && equalize_interface_knots(R, adaptive, max_level) > 0; ++round) {
+  // (A large layout spends seconds here: the user is told.)
+  report_step(progress, "interfaces",
+              "interfaces: one set of knots on every interface (each patch refined to the knots of all its "
+              "interfaces, " + std::to_string(R.patches.size()) + " patches), then the gaps measured");
+  std::size_t refined = 0;
+  for (int round = 0; round < 16; ++round) {
+    const std::size_t n = equalize_interface_knots(R, adaptive, max_level);
+    if (n == 0) break;
+    refined += n;
   }
   measure_interfaces(R);
+  report_step(progress, "interfaces",
+              "interfaces: " + std::to_string(refined) + " patch refinement(s) to their interfaces' knots, " +
+                  std::to_string(R.interfaces.size()) + " interfaces measured");
   // The patches' areas on the pool's threads, summed in patch order.
   const std::size_t P = R.patches.size();
   std::vector<double> areas(P);

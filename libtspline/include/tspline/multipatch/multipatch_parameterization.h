@@ -100,8 +100,10 @@ ProgressCallback patch_progress(const ProgressCallback& progress, std::size_t p)
 /// The last steps of a multi-patch run once every patch has its map: each
 /// patch refined to the union of the knots of its interfaces (the map carried
 /// over, kept only if still certified), the interfaces measured
-/// (R.interfaces) and the map's area summed (R.map_area).
-void finish_multipatch_result(MultiPatchResult& R, const AdaptiveOptions& adaptive, int max_level);
+/// (R.interfaces) and the map's area summed (R.map_area). `progress` (may be
+/// empty) is told what each step did.
+void finish_multipatch_result(MultiPatchResult& R, const AdaptiveOptions& adaptive, int max_level,
+                              const ProgressCallback& progress = {});
 
 /// \param cuts the cuts, or nullopt for the automatic choice.
 /// \throw InputError for an invalid domain or cuts, or no automatic layout;

@@ -24,7 +24,9 @@ struct ProgressEvent {
   Kind kind = Kind::Step;
   /// Pipeline stage: "cleaning", "corners", "boundary", "tmesh", "coons",
   /// "optimization", "repair", "boundary_curve", "untangling", "map",
-  /// "refinement", "stop".
+  /// "refinement", "stop"; of a multi-patch run also "layout", "patches",
+  /// "interfaces" (the patches' steps have their own stages, the text begins
+  /// "patch P: ") and, from the apps, "report".
   std::string stage;
   std::string text;         ///< one human-readable line
   int iteration = -1;       ///< adaptive round of the map (-1 in the front half)
