@@ -76,6 +76,7 @@ struct Box {
     lo = lo.cwiseMin(p);
     hi = hi.cwiseMax(p);
   }
+  bool empty() const { return !(lo.x() <= hi.x()); }
 };
 
 void print_box(const char* label, const Box& b) {
@@ -114,13 +115,49 @@ int print_patch_info(const tspline::io::LoadedTSpline& t) {
   return 0;
 }
 
-int run_info(const std::string& file) {
-  const tspline::io::LoadedMaps maps = tspline::io::read_maps_file(file);
+struct InfoArgs {
+  std::string file;
+  bool per_patch = false;
+};
+
+// A map of several patches: the totals over every patch first; with
+// --per-patch the interfaces and every patch's own description.
+void print_totals(const tspline::io::LoadedMaps& maps) {
+  std::size_t cells = 0, vertices = 0, hanging = 0, functions = 0, by_kind[3] = {0, 0, 0};
+  std::size_t fewest = static_cast<std::size_t>(-1), most = 0;
+  int level = 0;
+  Box cp, bb;
+  for (const tspline::io::LoadedTSpline& t : maps.patches) {
+    const tspline::TMesh& mesh = t.map.mesh();
+    cells += mesh.num_cells();
+    fewest = std::min(fewest, mesh.num_cells());
+    most = std::max(most, mesh.num_cells());
+    vertices += mesh.num_vertices();
+    hanging += mesh.num_hanging_vertices();
+    functions += t.map.basis().size();
+    for (const tspline::BlendingFunction& f : t.map.basis().functions()) ++by_kind[static_cast<int>(f.kind)];
+    level = std::max(level, mesh.max_level());
+    for (const Eigen::Vector2d& p : t.map.control_points()) cp.add(p);
+    for (const Eigen::Vector2d& p : t.meta.boundary.vertices) bb.add(p);
+  }
+  std::printf("cells: %zu (per patch %zu to %zu)\n", cells, fewest, most);
+  std::printf("vertices: %zu (the patches' own: a vertex on a cut counts in both patches)\n", vertices);
+  std::printf("hanging vertices: %zu\n", hanging);
+  std::printf("functions: %zu (anchor %zu, edge %zu, corner %zu)\n", functions, by_kind[0], by_kind[1], by_kind[2]);
+  std::printf("max level: %d\n", level);
+  print_box("control points bounding box", cp);
+  if (!bb.empty()) print_box("boundary bounding box", bb);
+}
+
+int run_info(const InfoArgs& args) {
+  const tspline::io::LoadedMaps maps = tspline::io::read_maps_file(args.file);
   std::printf("format: tspline version %d (degree 3)\n", maps.version);
   std::printf("source: %s\n", maps.source.c_str());
   if (maps.version == 1) return print_patch_info(maps.patches.front());
   std::printf("patches: %zu\n", maps.patches.size());
   std::printf("interfaces: %zu (cuts %zu)\n", maps.interfaces.size(), maps.cuts.size());
+  print_totals(maps);
+  if (!args.per_patch) return 0;
   for (const tspline::Interface& f : maps.interfaces)
     std::printf("interface along cut %zu: patch %zu side %s = patch %zu side %s, reversed\n", f.cut, f.patch_a,
                 tspline::io::side_name(f.side_a), f.patch_b, tspline::io::side_name(f.side_b));
@@ -153,14 +190,17 @@ void add_tspline_file_commands(CLI::App& app, CommandAction& action) {
                  "Also print the Jacobian columns dS/du = (dx/du, dy/du), dS/dv = (dx/dv, dy/dv) and det J");
   run_when_parsed(eval, eval_args, action, run_eval);
 
-  const Subcommand<std::string> info_sub = add_subcommand<std::string>(
+  const Subcommand<InfoArgs> info_sub = add_subcommand<InfoArgs>(
       app, "info",
       "Describe a T-spline file: format version, source, T-mesh counts (cells, vertices, hanging vertices, max "
-      "level), blending functions by kind, bounding boxes of the control points and the boundary polygon, corners");
+      "level), blending functions by kind, bounding boxes of the control points and the boundary polygon, corners "
+      "(a multi-patch file: the totals over every patch; --per-patch: also the interfaces and each patch)");
   CLI::App* const info = info_sub.cmd;
-  const std::shared_ptr<std::string> info_file = info_sub.args;
-  add_tspline_file_argument(*info, *info_file);
-  run_when_parsed(info, info_file, action, run_info);
+  const std::shared_ptr<InfoArgs> info_args = info_sub.args;
+  add_tspline_file_argument(*info, info_args->file);
+  info->add_flag("--per-patch", info_args->per_patch,
+                 "A multi-patch file: also every interface and every patch's own description");
+  run_when_parsed(info, info_args, action, run_info);
 }
 
 }  // namespace tspline_app

@@ -123,6 +123,14 @@ TEST_SUITE("holes_app") {
     CHECK(info.exit_code == 0);
     CHECK(contains(info.out, "format: tspline version 2"));
     CHECK(contains(info.out, "patches: " + std::to_string(patches)));
+    // The totals over every patch are the report's; --per-patch adds each patch's block.
+    CHECK(contains(info.out, "cells: " + std::to_string(rep["totals"]["cells"].get<std::size_t>()) + " (per patch "));
+    CHECK(contains(info.out, "functions: " + std::to_string(rep["totals"]["functions"].get<std::size_t>()) + " ("));
+    CHECK_FALSE(contains(info.out, "patch 0:"));
+    const auto info_all = test_support::run_app("info " + quoted(out / "tspline.json") + " --per-patch", d);
+    CHECK(info_all.exit_code == 0);
+    CHECK(contains(info_all.out, "patch " + std::to_string(patches - 1) + ":\ncells: "));
+    CHECK(contains(info_all.out, "interface along cut 0: "));
     const auto eval = test_support::run_app("eval " + quoted(out / "tspline.json") + " --patch 3 --at 0 0", d);
     CHECK(eval.exit_code == 0);
     const auto no_patch = test_support::run_app("eval " + quoted(out / "tspline.json") + " --at 0 0", d);
