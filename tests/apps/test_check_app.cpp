@@ -13,6 +13,7 @@
 
 #include "separable_maps.h"
 #include "test_support.h"
+#include "tspline/io/multipatch_file.h"
 #include "tspline/io/tspline_file.h"
 
 namespace fs = std::filesystem;
@@ -83,6 +84,40 @@ TEST_SUITE("check_app") {
     CHECK(det < 0.0);
     CHECK(std::abs(u - 0.5) < 0.1);
     CHECK(det == doctest::Approx(map.jacobian({u, v}).determinant()).epsilon(1e-6));
+  }
+
+  TEST_CASE("check of a multi-patch file with a folded patch: the whole map's counts, the patch and its element") {
+    // Patch 0 the identity of the square (16 elements), patch 1 folded between
+    // its Gauss points (one element, det J < 0 proven).
+    const fs::path d = scratch("multi_fold");
+    const tspline::TSplineMap good = tspline::greville_identity_map(test_support::uniform_mesh(2));
+    const tspline::TSplineMap fold = test_support::fold_between_gauss_points();
+    std::vector<tspline::io::TSplineFileMeta> metas(2);
+    metas[0].source = metas[1].source = "two";
+    const fs::path file = d / "two.json";
+    tspline::io::write_multipatch_file(file.string(), {&good, &fold}, metas, {}, {}, "two");
+    const auto r = run_app("check '" + file.string() + "'", d);
+    CAPTURE(r.out);
+    CHECK(r.exit_code == 3);
+    CHECK(count_lines(r.err) == 1);
+    CHECK(contains(r.err, "not certified valid: 1 of 17 elements not certified (1 with det J < 0 proven"));
+    CHECK(contains(r.out, "patches: 2\n"));
+    CHECK(contains(r.out, "certified: 16 of 17 elements, 1 of 2 patches"));
+    CHECK(contains(r.out, "det J > 0 proven false: 1 elements\n"));
+    CHECK(contains(r.out, "patch 1: NOT certified valid (0 of 1 elements certified)\ncell 0 element [0, 1] x [0, 1]: det J = "));
+    CHECK_FALSE(contains(r.out, "patch 0: NOT"));
+    // The folded patch is the worst, and said to be uncertified; the identity's J_r is 1.
+    CHECK(contains(r.out, "worst patches (by the certified J_r bound):\n  patch 1: 1 cells, J_r >= -"));
+    CHECK(contains(r.out, "NOT certified\n  patch 0: 16 cells, J_r >= 1,"));
+    CHECK(contains(r.out, "result: NOT every patch certified valid"));
+    // --per-patch: both patches' own blocks, then the whole map's.
+    const auto all = run_app("check '" + file.string() + "' --per-patch --worst 0", d);
+    CHECK(all.exit_code == 3);
+    CHECK(contains(all.out, "patch 0:\ncells: 16\nbezier elements: 16\n"));
+    CHECK(contains(all.out, "patch 1:\ncells: 1\n"));
+    CHECK(contains(all.out, "result: NOT certified valid (1 cells affected)"));
+    CHECK(contains(all.out, "whole map:\npatches: 2\n"));
+    CHECK_FALSE(contains(all.out, "worst patches"));
   }
 
   TEST_CASE("check --depth: det J touching zero is undecided, not certified") {
