@@ -63,10 +63,10 @@ MapCheck check_map(const std::vector<const TSplineMap*>& patches, const std::vec
     m.undecided += z.undecided;
     if (z.certified_valid()) ++m.certified_patches;
     m.max_depth_used = std::max(m.max_depth_used, z.max_depth_used);
-    // (std::min keeps NaN out: a NaN bound never replaces a number.)
-    if (!(z.min_relative_lower_bound >= m.min_relative_det_lower_bound))
+    // (A NaN bound never replaces a number: the comparison is false.)
+    if (z.min_relative_lower_bound < m.min_relative_det_lower_bound)
       m.min_relative_det_lower_bound = z.min_relative_lower_bound;
-    if (!(z.min_det_lower_bound >= m.min_det_lower_bound)) m.min_det_lower_bound = z.min_det_lower_bound;
+    if (z.min_det_lower_bound < m.min_det_lower_bound) m.min_det_lower_bound = z.min_det_lower_bound;
     m.min_dense_mean_ratio = std::min(m.min_dense_mean_ratio, c.dense.min_mean_ratio);
     m.min_gauss_mean_ratio = std::min(m.min_gauss_mean_ratio, c.gauss.min_mean_ratio);
     if (c.corner && (!m.corner || c.corner->scaled_jacobian < m.corner->scaled_jacobian))
