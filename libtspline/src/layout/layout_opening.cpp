@@ -71,9 +71,7 @@ struct Opening {
 LayoutOpeningReport open_wide_ring_corners(LayoutMesh& m, const LayoutQuality& Q, const LayoutAdmissible& admissible,
                                            const LayoutOpeningOptions& o) {
   LayoutOpeningReport report;
-  LayoutOptimizationOptions lo;
-  lo.max_sweeps = o.local_sweeps;
-  lo.cancel = o.cancel;
+  const LayoutOptimizationOptions lo{.max_sweeps = o.local_sweeps, .cancel = o.cancel};
   LayoutTopology t(m);
   std::vector<std::pair<double, int>> wide;  // widest first
   for (int n = 0; n < static_cast<int>(m.size()); ++n)

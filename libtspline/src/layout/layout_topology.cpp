@@ -323,9 +323,7 @@ std::vector<int> try_reach(const LayoutMesh& m, const LayoutTopology& t, int q) 
 LayoutRotationReport rotate_layout_edges(LayoutMesh& m, const LayoutQuality& Q, const LayoutAdmissible& admissible,
                                          const LayoutRotationOptions& o) {
   LayoutRotationReport report;
-  LayoutOptimizationOptions lo;
-  lo.max_sweeps = o.local_sweeps;
-  lo.cancel = o.cancel;
+  const LayoutOptimizationOptions lo{.max_sweeps = o.local_sweeps, .cancel = o.cancel};
   std::vector<char> reached(m.size(), 0);
   // A try that found no better rotation (and was not blocked) is not made
   // again while no node it reads has moved or changed quads since: it would

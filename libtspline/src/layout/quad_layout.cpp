@@ -7,6 +7,7 @@
 #include <cstdlib>
 #include <limits>
 #include <numbers>
+#include <optional>
 #include <set>
 #include <unordered_map>
 #include <sstream>
@@ -23,7 +24,6 @@
 
 namespace tspline {
 namespace {
-
 
 // The piece (index into nodes) of ring arc length s.
 std::size_t piece_of(const std::vector<double>& nodes, double s) {
@@ -176,360 +176,489 @@ std::string QuadLayout::explanation() const {
   return s.str();
 }
 
-QuadLayout build_quad_layout(const Domain& d, const QuadLayoutOptions& o) {
-  const auto t0 = std::chrono::steady_clock::now();
-  if (!quad_mesher_available()) quad_mesh({}, {});  // throws the InputError that explains it
-  Eigen::Vector2d lo = d.outer.vertices.front(), hi = lo;
-  for (const auto& v : d.outer.vertices) lo = lo.cwiseMin(v), hi = hi.cwiseMax(v);
-  const double diam = (hi - lo).norm();
-  SizeFieldOptions so = o.size;
-  if (!(so.min_size > 0.0)) so.min_size = o.min_size_fraction * diam;
-  const SizeField h(d, so);
-  // Ring pieces are two quad edges long.
-  auto piece_size = [&h](const Eigen::Vector2d& x) { return 2.0 * h(x); };
+namespace {
 
+// The rounds of build_quad_layout and what they carry from one to the next:
+// the ring nodes, the optimization level, the repairs made. A round either
+// ends with the layout or changes what the next one starts from: ring nodes
+// more where something failed (a repair), or a lower optimization level.
+class QuadLayoutBuilder {
+ public:
+  QuadLayoutBuilder(const Domain& d, const QuadLayoutOptions& o);
+  QuadLayoutBuilder(const QuadLayoutBuilder&) = delete;
+  QuadLayoutBuilder& operator=(const QuadLayoutBuilder&) = delete;
+  QuadLayout build();
+
+ private:
+  const std::vector<RingCurve>& rings() const { return R_.curves; }
+  void note(const std::string& text) const {
+    if (o_.progress) o_.progress(text);
+  }
+  std::string mesh_name() const { return "mesh " + std::to_string(meshes_); }
+  void count_repair() { out_.stats.repair_rounds = ++repairs_; }
+
+  std::size_t marked() const;
+  bool split_marked();
+  void mark_piece_of_edge(const RingGeometry::Edge& e);
+  void mark_nearest_piece(const Eigen::Vector2d& p) { mark_piece_of_edge(geometry_.edge(geometry_.nearest(p))); }
+
+  std::vector<std::vector<Eigen::Vector2d>> straight_rings() const;
+  void mark_crossing_chords(const std::vector<std::vector<Eigen::Vector2d>>& straight);
+  void mark_blunted_tips(const std::vector<std::vector<Eigen::Vector2d>>& straight);
+  std::optional<PlanarQuadMesh> mesh(const std::vector<std::vector<Eigen::Vector2d>>& straight);
+  bool marked_untiled(const PlanarQuadMesh& qm);
+  LayoutMesh on_true_rings(const PlanarQuadMesh& qm) const;
+  std::set<int> violations(const LayoutMesh& lm, bool mark);
+  bool undo_violations(LayoutMesh& m, const LayoutMesh& start, int round);
+  void make_patch_layout(const LayoutMesh& m, const LayoutTopology& t);
+  void recover_from_rejected_layout(const std::string& what);
+  void fill_stats(const LayoutMesh& m, const LayoutTopology& t);
+
+  const Domain& d_;
+  const QuadLayoutOptions& o_;
+  const std::chrono::steady_clock::time_point t0_ = std::chrono::steady_clock::now();
+  const Eigen::Vector2d lo_, hi_;  // the bounding box of the outer ring
+  const double diam_;
+  const SizeFieldOptions size_options_;
+  const SizeField h_;
+  const LayoutRings R_;
+  const RingNodeOptions node_options_;
+  std::vector<std::vector<double>> nodes_;  // per ring: the arc lengths of its nodes, ascending
+  const RingGeometry geometry_;
+  const double tol_;
+  const LayoutQuality quality_;
+  // A node may stay where the optimizer moved it: inside the domain, its cuts off the rings.
+  const LayoutAdmissible admissible_;
+
+  QuadLayout out_;
+  int meshes_ = 0;  // made by the mesher (rounds that only add ring nodes make none)
+  int level_ = 2;
+  int repairs_ = 0;  // rounds that added nodes (dropping an optimization level is not one)
+  std::vector<Eigen::Vector2d> repaired_at_;  // where a rejected layout got a ring node more
+  std::vector<std::set<std::size_t>> to_split_;  // per ring: the pieces that get a node more this round
+};
+
+Eigen::Vector2d lower_corner(const Polygon& p) {
+  Eigen::Vector2d lo = p.vertices.front();
+  for (const auto& v : p.vertices) lo = lo.cwiseMin(v);
+  return lo;
+}
+
+Eigen::Vector2d upper_corner(const Polygon& p) {
+  Eigen::Vector2d hi = p.vertices.front();
+  for (const auto& v : p.vertices) hi = hi.cwiseMax(v);
+  return hi;
+}
+
+SizeFieldOptions absolute_sizes(SizeFieldOptions so, double min_size_fraction, double diam) {
+  if (!(so.min_size > 0.0)) so.min_size = min_size_fraction * diam;
+  return so;
+}
+
+LayoutRings rings_of(const Domain& d) {
   LayoutRings R;
   R.curves.emplace_back(d.outer.vertices);
   for (const Polygon& p : d.holes) R.curves.emplace_back(p.vertices);
-  const std::vector<RingCurve>& rings = R.curves;
-  RingNodeOptions no = o.nodes;
-  if (!(no.min_size > 0.0)) no.min_size = so.min_size;
-  std::vector<std::vector<double>> nodes;
-  for (const RingCurve& r : rings) nodes.push_back(ring_nodes(r, no, piece_size));
+  return R;
+}
 
-  const RingGeometry geometry = RingGeometry::of_rings(rings);
-  const double tol = 1e-9 * diam;
-  const LayoutQuality quality(R);
-  // A node may stay where the optimizer moved it: inside the domain, its cuts off the rings.
-  const LayoutAdmissible admissible = admissible_in(geometry, tol);
+RingNodeOptions with_min_size(RingNodeOptions no, double min_size) {
+  if (!(no.min_size > 0.0)) no.min_size = min_size;
+  return no;
+}
 
-  auto note = [&](const std::string& text) {
-    if (o.progress) o.progress(text);
-  };
-  QuadLayout out;
-  int meshes = 0;  // made by the mesher (rounds that only add ring nodes make none)
-  int level = 2;
-  int repairs = 0;  // rounds that added nodes (dropping an optimization level is not one)
-  std::vector<Eigen::Vector2d> repaired_at;  // where a rejected layout got a ring node more
+QuadLayoutBuilder::QuadLayoutBuilder(const Domain& d, const QuadLayoutOptions& o)
+    : d_(d),
+      o_(o),
+      lo_(lower_corner(d.outer)),
+      hi_(upper_corner(d.outer)),
+      diam_((hi_ - lo_).norm()),
+      size_options_(absolute_sizes(o.size, o.min_size_fraction, diam_)),
+      h_(d, size_options_),
+      R_(rings_of(d)),
+      node_options_(with_min_size(o.nodes, size_options_.min_size)),
+      geometry_(RingGeometry::of_rings(R_.curves)),
+      tol_(1e-9 * diam_),
+      quality_(R_),
+      admissible_(admissible_in(geometry_, tol_)) {
+  // Ring pieces are two quad edges long.
+  const auto piece_size = [this](const Eigen::Vector2d& x) { return 2.0 * h_(x); };
+  for (const RingCurve& r : rings()) nodes_.push_back(ring_nodes(r, node_options_, piece_size));
+}
+
+QuadLayout QuadLayoutBuilder::build() {
   for (int round = 0;; ++round) {
-    throw_if_cancelled(o.cancel);
-    if (repairs > o.max_repair_rounds)
+    throw_if_cancelled(o_.cancel);
+    if (repairs_ > o_.max_repair_rounds)
       throw NumericalError("no quad layout found: the layout still crosses the boundary after " +
-                           std::to_string(o.max_repair_rounds) + " rounds of adding nodes");
-    std::vector<std::set<std::size_t>> to_split(rings.size());
-    auto marked = [&]() {
-      std::size_t k = 0;
-      for (const auto& pieces : to_split) k += pieces.size();
-      return k;
-    };
-    auto split_marked = [&]() {
-      bool any = false;
-      for (std::size_t r = 0; r < rings.size(); ++r)
-        // From the last piece down: indices of earlier pieces stay valid.
-        for (auto it = to_split[r].rbegin(); it != to_split[r].rend(); ++it) {
-          split_piece(rings[r], nodes[r], *it);
-          any = true;
-        }
-      return any;
-    };
-    auto mark_nearest_piece = [&](const Eigen::Vector2d& p) {
-      const RingGeometry::Edge& e = geometry.edge(geometry.nearest(p));
-      to_split[e.ring].insert(piece_of(nodes[e.ring], rings[e.ring].arc(e.index)));
-    };
-    // The straight rings (chords between the nodes) must be simple and
-    // disjoint, and no chord may cut off a piece of another ring.
-    std::vector<std::vector<Eigen::Vector2d>> straight(rings.size());
-    std::vector<RingGeometry::Edge> chords;
-    for (std::size_t r = 0; r < rings.size(); ++r) {
-      for (double s : nodes[r]) straight[r].push_back(rings[r].point(s));
-      for (std::size_t k = 0; k < straight[r].size(); ++k)
-        chords.push_back({straight[r][k], straight[r][(k + 1) % straight[r].size()], static_cast<int>(r), k});
-    }
-    {
-      const RingGeometry cg(chords, lo, hi);
-      for (std::size_t c = 0; c < chords.size(); ++c) {
-        const auto& e = chords[c];
-        for (int o2 : cg.near(e.a.cwiseMin(e.b), e.a.cwiseMax(e.b))) {
-          if (o2 <= static_cast<int>(c)) continue;
-          const auto& f = cg.edge(o2);
-          const std::size_t n = straight[e.ring].size();
-          const bool adjacent = f.ring == e.ring && (f.index == (e.index + 1) % n || e.index == (f.index + 1) % n);
-          if (adjacent && n > 2) continue;
-          if (segments_intersect(e.a, e.b, f.a, f.b)) to_split[e.ring].insert(e.index), to_split[f.ring].insert(f.index);
-        }
-      }
-      for (const auto& e : chords)
-        for (int g : geometry.near(e.a.cwiseMin(e.b), e.a.cwiseMax(e.b))) {
-          const auto& f = geometry.edge(g);
-          if (f.ring != e.ring && segments_intersect(e.a, e.b, f.a, f.b)) {
-            to_split[e.ring].insert(e.index);
-            to_split[f.ring].insert(piece_of(nodes[f.ring], rings[f.ring].arc(f.index)));
-          }
-        }
-    }
-    // At a sharp tip of the coast (the domain's angle there below 60 or above
-    // 300 degrees on the scale of a fifth of the pieces next to the node) the
-    // straight ring must be as sharp: the chord to a neighbour and the ring's
-    // own direction within 35 degrees; else the mesher sees a blunt corner where
-    // the coast has a tip, and gives it too few quads (a reflex tip of 340
-    // degrees split in two corners of 170 degrees).
-    for (std::size_t r = 0; r < rings.size(); ++r) {
-      const std::size_t n = nodes[r].size();
-      if (n < 3) continue;
-      const double L = rings[r].length();
-      for (std::size_t k = 0; k < n; ++k) {
-        const double s = nodes[r][k];
-        const Eigen::Vector2d p = rings[r].point(s);
-        double len[2];
-        Eigen::Vector2d near[2], chord[2];
-        for (const int side : {0, 1}) {
-          const std::size_t other = side == 0 ? (k + 1) % n : (k + n - 1) % n;
-          len[side] = side == 0 ? nodes[r][other] - s : s - nodes[r][other];
-          if (len[side] <= 0.0) len[side] += L;
-          chord[side] = straight[r][other] - p;
-          near[side] = rings[r].point(s + (side == 0 ? 1.0 : -1.0) * 0.2 * len[side]) - p;
-        }
-        // The domain's angle at the node from the forward to the backward direction
-        // (the domain on the left of the outer ring, on the right of holes).
-        double phi = std::atan2(cross(near[0], near[1]), near[0].dot(near[1]));
-        if (R.direction(static_cast<int>(r)) < 0.0) phi = -phi;
-        if (phi < 0.0) phi += 2.0 * std::numbers::pi;
-        if (phi > std::numbers::pi / 3.0 && phi < 5.0 * std::numbers::pi / 3.0) continue;
-        for (const int side : {0, 1}) {
-          const double angle = std::abs(std::atan2(cross(chord[side], near[side]), chord[side].dot(near[side])));
-          if (angle > 35.0 * std::numbers::pi / 180.0 && len[side] > 2.0 * no.min_size)
-            to_split[r].insert(side == 0 ? k : (k + n - 1) % n);
-        }
-      }
-    }
+                           std::to_string(o_.max_repair_rounds) + " rounds of adding nodes");
+    to_split_.assign(rings().size(), {});
+    const std::vector<std::vector<Eigen::Vector2d>> straight = straight_rings();
+    mark_crossing_chords(straight);
+    mark_blunted_tips(straight);
     if (split_marked()) {
-      out.stats.repair_rounds = ++repairs;
+      count_repair();
       continue;
     }
-
-    PlanarQuadMesh qm;
-    try {
-      qm = quad_mesh(straight, h);
-    } catch (const NumericalError& e) {
-      // Gmsh could not recover a boundary segment ("... on curve N ..."): that
-      // piece and its neighbours get a node more, and the mesh is made again.
-      const std::string what = e.what();
-      const std::size_t at = what.find("on curve ");
-      if (at == std::string::npos) throw;
-      long long curve = std::atoll(what.c_str() + at + 9) - 1;  // line tags count the segments from 1
-      std::size_t r = 0;
-      while (r < straight.size() && curve >= static_cast<long long>(straight[r].size()))
-        curve -= static_cast<long long>(straight[r].size()), ++r;
-      if (r == straight.size() || curve < 0) throw;
-      const std::size_t n = straight[r].size(), k = static_cast<std::size_t>(curve);
-      for (const std::size_t j : {(k + n - 1) % n, k, (k + 1) % n}) to_split[r].insert(j);
-      note("mesh " + std::to_string(meshes + 1) + ": the quad mesher lost a piece of ring " + std::to_string(r) +
-           "; 3 ring nodes more there, meshing again");
+    const std::optional<PlanarQuadMesh> qm = mesh(straight);
+    if (!qm) {  // the mesher lost a piece of a ring: nodes more there
       split_marked();
-      out.stats.repair_rounds = ++repairs;
+      count_repair();
       continue;
     }
-    // The mesh must tile the straight domain: every edge used by two quads in
-    // opposite directions, or by one quad along a ring (between nodes of that
-    // ring). Gmsh can mesh a sliver inside a hole, or lose a ring node's curve
-    // where straight pieces nearly touch: more ring nodes there, and again.
-    {
-      std::unordered_map<unsigned long long, int> directed;
-      auto key = [](int a, int b) {
-        return (static_cast<unsigned long long>(static_cast<unsigned>(a)) << 32) | static_cast<unsigned>(b);
-      };
-      for (const auto& q : qm.quads)
-        for (int j = 0; j < 4; ++j) ++directed[key(q[j], q[(j + 1) % 4])];
-      bool broken = false;
-      for (const auto& q : qm.quads)
-        for (int j = 0; j < 4; ++j) {
-          const int a = q[j], b = q[(j + 1) % 4];
-          const bool twice = directed[key(a, b)] > 1;
-          const bool boundary = directed.find(key(b, a)) == directed.end();
-          if (twice || (boundary && !(qm.ring[a] >= 0 && qm.ring[a] == qm.ring[b]))) {
-            mark_nearest_piece(0.5 * (qm.nodes[a] + qm.nodes[b]));
-            broken = true;
-          }
-        }
-      if (broken && split_marked()) {
-        out.stats.repair_rounds = ++repairs;
-        continue;
-      }
-      if (broken) throw NumericalError("the quad mesher's quadrilaterals do not tile the domain");
+    if (marked_untiled(*qm)) {
+      if (!split_marked()) throw NumericalError("the quad mesher's quadrilaterals do not tile the domain");
+      count_repair();
+      continue;
     }
-    // The mesh with its boundary nodes on the true rings.
-    LayoutMesh m{qm.nodes, qm.ring, std::vector<double>(qm.nodes.size(), 0.0), qm.quads};
-    for (std::size_t n = 0; n < m.size(); ++n) {
-      if (m.ring[n] < 0) continue;
-      const auto& nr = nodes[m.ring[n]];
-      const double L = rings[m.ring[n]].length();
-      const std::size_t k = static_cast<std::size_t>(qm.segment[n]);
-      const double a = nr[k], b = k + 1 < nr.size() ? nr[k + 1] : nr.front() + L;
-      m.arc[n] = rings[m.ring[n]].snap_to_vertex(a + qm.t[n] * (b - a), 0.01 * (b - a));
-      m.x[n] = rings[m.ring[n]].point(m.arc[n]);
-    }
-    LayoutMesh start = m;  // the mesher's nodes, on the true rings
-    ++meshes;
-    note("mesh " + std::to_string(meshes) + ": " + std::to_string(m.quads.size()) + " quads from the mesher; optimizing them" +
-         (level == 2 ? "" : " without edge rotations"));
+    LayoutMesh start = on_true_rings(*qm);  // the mesher's nodes, on the true rings
+    LayoutMesh m = start;
+    ++meshes_;
+    note(mesh_name() + ": " + std::to_string(m.quads.size()) + " quads from the mesher; optimizing them" +
+         (level_ == 2 ? "" : " without edge rotations"));
     const auto t_opt = std::chrono::steady_clock::now();
-    optimize_layout(m, start, R, quality, admissible, level, out.stats, o.cancel);
+    optimize_layout(m, start, R_, quality_, admissible_, level_, out_.stats, o_.cancel);
     if (debugging())
       std::fprintf(stderr, "layout round %d: mesh %zu quads at %.2f s, optimized in %.2f s\n", round, m.quads.size(),
-                   std::chrono::duration<double>(t_opt - t0).count(),
-                   toolkit::seconds_since(t_opt));
-
-    // Checks on the true geometry: inner nodes inside, cuts off the rings. The
-    // nodes involved in a violation go back where the mesher put them (with the
-    // quads of the mesher, if rotations changed them); what still fails gets
-    // ring nodes more near it, and the mesh is made again.
-    auto violations = [&](const LayoutMesh& lm, bool mark) {
-      std::set<int> involved;
-      const LayoutTopology t(lm);
-      for (std::size_t n = 0; n < lm.size(); ++n)
-        if (lm.ring[n] < 0 && t.valence(static_cast<int>(n)) > 0 && !geometry.inside(lm.x[n])) {
-          involved.insert(static_cast<int>(n));
-          if (mark) mark_nearest_piece(lm.x[n]);
-        }
-      for (std::size_t q = 0; q < lm.quads.size(); ++q)
-        for (int j = 0; j < 4; ++j) {
-          const int a = lm.quads[q][j], b = lm.quads[q][(j + 1) % 4];
-          if (t.on_ring(static_cast<int>(q), j) || a > b) continue;  // each cut once
-          const int g = geometry.crossing(lm.x[a], lm.x[b], lm.ring[a] >= 0, lm.ring[b] >= 0, tol);
-          if (g < 0) {
-            // Between two ring nodes, wholly outside (geometry.admits_cut).
-            if (geometry.admits_cut(lm.x[a], lm.x[b], lm.ring[a] >= 0, lm.ring[b] >= 0, tol)) continue;
-            involved.insert(a), involved.insert(b);
-            if (mark) mark_nearest_piece(0.5 * (lm.x[a] + lm.x[b]));
-            continue;
-          }
-          involved.insert(a), involved.insert(b);
-          if (mark) {
-            const RingGeometry::Edge& f = geometry.edge(g);
-            to_split[f.ring].insert(piece_of(nodes[f.ring], rings[f.ring].arc(f.index)));
-          }
-        }
-      return involved;
-    };
-    if (debugging())
-      std::fprintf(stderr, "layout round %d: %zu nodes in violations at the start, %zu after optimization\n", round,
-                   violations(start, false).size(), violations(m, false).size());
-    if (!violations(m, false).empty() && m.quads != start.quads) m = start;  // rotations undone
-    for (int pass = 0; pass < 3; ++pass) {
-      bool changed = false;
-      for (int n : violations(m, false))
-        if (m.x[n] != start.x[n]) m.x[n] = start.x[n], m.arc[n] = start.arc[n], changed = true;
-      if (!changed) break;
-    }
-    if (debugging()) std::fprintf(stderr, "  %zu nodes still in violation\n", violations(m, false).size());
-    {
-      const std::size_t bad = violations(m, true).size();
-      if (bad > 0)
-        note("mesh " + std::to_string(meshes) + ": " + std::to_string(bad) +
-             " node(s) outside the domain or with cuts across its boundary; " + std::to_string(marked()) +
-             " ring node(s) more there, meshing again");
-    }
-    if (split_marked()) {
-      out.stats.repair_rounds = ++repairs;
-      out.stats.optimization_level = level = 2;  // the new mesh is optimized in full
+                   std::chrono::duration<double>(t_opt - t0_).count(), toolkit::seconds_since(t_opt));
+    if (undo_violations(m, start, round)) {
+      count_repair();
+      out_.stats.optimization_level = level_ = 2;  // the new mesh is optimized in full
       continue;
     }
-
-    // The layout: inner edges are cuts, ring nodes of one quad are ring corners.
     const LayoutTopology t(m);
-    std::vector<Cut> cuts;
-    out.ring_corners.clear();
-    for (std::size_t q = 0; q < m.quads.size(); ++q)
-      for (int j = 0; j < 4; ++j) {
-        const int a = m.quads[q][j], b = m.quads[q][(j + 1) % 4];
-        if (!t.on_ring(static_cast<int>(q), j) && a < b) cuts.push_back({m.x[a], m.x[b]});
-      }
-    for (std::size_t n = 0; n < m.size(); ++n)
-      if (m.ring[n] >= 0 && t.valence(static_cast<int>(n)) == 1) out.ring_corners.push_back(m.x[n]);
     try {
-      out.layout = build_patch_layout(d, std::move(cuts), out.ring_corners);
-      // Every patch corner where the map sees it (at the vertex itself)
-      // between 1 and 170 degrees (patch_corner_in_range). (The mesher's own
-      // layout, level 0, only needs convex corners.)
-      for (const Patch& p : out.layout.patches)
-        for (int k = 0; k < 4; ++k) {
-          const auto& v = p.polygon.vertices;
-          const std::size_t c = p.corners[k], n = v.size();
-          const Eigen::Vector2d a = v[(c + 1) % n] - v[c], b = v[(c + n - 1) % n] - v[c];
-          const bool fine = level == 0 ? cross(a, b) / (a.norm() * b.norm()) > 1e-3 : patch_corner_in_range(a, b);
-          if (!fine)
-            throw InputError("a patch corner outside 1-170 degrees near (" + std::to_string(v[c].x()) + ", " +
-                             std::to_string(v[c].y()) + ")");
-        }
+      make_patch_layout(m, t);
     } catch (const InputError& e) {
-      if (debugging()) std::fprintf(stderr, "layout rejected at level %d: %s\n", level, e.what());
-      if (level == 2) {
-        // The optimization left a corner flat or reflex, or the cuts crossing
-        // (a tangled start near rings much closer than the patch size): the
-        // same mesh without edge rotations.
-        note("mesh " + std::to_string(meshes) + ": " + e.what() + "; the same mesh without edge rotations");
-        out.stats.optimization_level = level = 1;
-        continue;
-      }
-      // Ring nodes more near the place, and a new mesh optimized in full;
-      // once the repairs are used up, the mesher's own nodes (level 0) are the
-      // last try (its cuts may cross where the true rings are far from their chords).
-      const std::string what = e.what();
-      const std::size_t at = what.find("near (");
-      Eigen::Vector2d place(0.0, 0.0);
-      bool again = false;  // this place failed a repair before: a node more there did not mend it
-      if (at != std::string::npos) {
-        char* end = nullptr;
-        place.x() = std::strtod(what.c_str() + at + 6, &end);
-        place.y() = end && *end == ',' ? std::strtod(end + 1, nullptr) : 0.0;
-        // (The message gives 6 decimals.)
-        const double same = std::max(1e-6 * diam, 2e-6);
-        for (const Eigen::Vector2d& p : repaired_at) again = again || (p - place).norm() <= same;
-      }
-      if (at != std::string::npos && repairs < o.max_repair_rounds && !again) {
-        repaired_at.push_back(place);
-        mark_nearest_piece(place);
-        note("mesh " + std::to_string(meshes) + ": " + what + "; a ring node more there, meshing again");
-        split_marked();
-        out.stats.repair_rounds = ++repairs;
-        out.stats.optimization_level = level = 2;
-        continue;
-      }
-      if (level == 1) {
-        // (Also where the same place failed after a node more there: each
-        // further round would cost a mesh and its optimization, to the same end.)
-        if (again)
-          note("mesh " + std::to_string(meshes) + ": " + what +
-               " again after a ring node more there; the mesher's own nodes instead");
-        out.stats.optimization_level = level = 0;
-        continue;
-      }
-      throw NumericalError("no valid quad layout: " + what);
+      recover_from_rejected_layout(e.what());
+      continue;
     }
-    QuadLayoutStats& st = out.stats;
-    st.patches = out.layout.patches.size();
-    st.min_size = so.min_size;
-    st.max_size = so.max_size > 0.0 ? so.max_size : 0.125 * diam;
-    for (std::size_t n = 0; n < m.size(); ++n) {
-      const std::size_t k = t.valence(static_cast<int>(n));
-      if (k == 0) continue;
-      if (m.ring[n] >= 0) ++st.ring_nodes;
-      else ++st.inner_nodes, ++st.valence[std::min<std::size_t>(k, 7)];
-    }
-    double sum = 0.0;
-    st.min_corner_scaled_jacobian = 1.0;
-    for (const auto& q : m.quads) {
-      const double sj = quad_corner_scaled_jacobian({m.x[q[0]], m.x[q[1]], m.x[q[2]], m.x[q[3]]});
-      st.min_corner_scaled_jacobian = std::min(st.min_corner_scaled_jacobian, sj);
-      sum += sj;
-    }
-    st.mean_corner_scaled_jacobian = sum / static_cast<double>(m.quads.size());
-    const LayoutCornerQuality w = worst_layout_quality(m, t, quality);
-    st.corner_mean_ratio = w.mean_ratio;
-    st.corner_scaled_jacobian = w.scaled_jacobian;
-    st.seconds = toolkit::seconds_since(t0);
-    return out;
+    fill_stats(m, t);
+    return std::move(out_);
   }
+}
+
+std::size_t QuadLayoutBuilder::marked() const {
+  std::size_t k = 0;
+  for (const auto& pieces : to_split_) k += pieces.size();
+  return k;
+}
+
+bool QuadLayoutBuilder::split_marked() {
+  bool any = false;
+  for (std::size_t r = 0; r < rings().size(); ++r)
+    // From the last piece down: indices of earlier pieces stay valid.
+    for (auto it = to_split_[r].rbegin(); it != to_split_[r].rend(); ++it) {
+      split_piece(rings()[r], nodes_[r], *it);
+      any = true;
+    }
+  return any;
+}
+
+// The piece of its ring that boundary edge e lies on.
+void QuadLayoutBuilder::mark_piece_of_edge(const RingGeometry::Edge& e) {
+  to_split_[e.ring].insert(piece_of(nodes_[e.ring], rings()[e.ring].arc(e.index)));
+}
+
+// Each ring as the polygon of its nodes (chords between them).
+std::vector<std::vector<Eigen::Vector2d>> QuadLayoutBuilder::straight_rings() const {
+  std::vector<std::vector<Eigen::Vector2d>> straight(rings().size());
+  for (std::size_t r = 0; r < rings().size(); ++r)
+    for (double s : nodes_[r]) straight[r].push_back(rings()[r].point(s));
+  return straight;
+}
+
+// The straight rings must be simple and disjoint, and no chord may cut off a
+// piece of another ring: the pieces involved where one does are marked.
+void QuadLayoutBuilder::mark_crossing_chords(const std::vector<std::vector<Eigen::Vector2d>>& straight) {
+  std::vector<RingGeometry::Edge> chords;
+  for (std::size_t r = 0; r < straight.size(); ++r)
+    for (std::size_t k = 0; k < straight[r].size(); ++k)
+      chords.push_back({straight[r][k], straight[r][(k + 1) % straight[r].size()], static_cast<int>(r), k});
+  const RingGeometry cg(chords, lo_, hi_);
+  for (std::size_t c = 0; c < chords.size(); ++c) {
+    const auto& e = chords[c];
+    for (int o2 : cg.near(e.a.cwiseMin(e.b), e.a.cwiseMax(e.b))) {
+      if (o2 <= static_cast<int>(c)) continue;
+      const auto& f = cg.edge(o2);
+      const std::size_t n = straight[e.ring].size();
+      const bool adjacent = f.ring == e.ring && (f.index == (e.index + 1) % n || e.index == (f.index + 1) % n);
+      if (adjacent && n > 2) continue;
+      if (segments_intersect(e.a, e.b, f.a, f.b)) to_split_[e.ring].insert(e.index), to_split_[f.ring].insert(f.index);
+    }
+  }
+  for (const auto& e : chords)
+    for (int g : geometry_.near(e.a.cwiseMin(e.b), e.a.cwiseMax(e.b))) {
+      const auto& f = geometry_.edge(g);
+      if (f.ring != e.ring && segments_intersect(e.a, e.b, f.a, f.b)) {
+        to_split_[e.ring].insert(e.index);
+        mark_piece_of_edge(f);
+      }
+    }
+}
+
+// At a sharp tip of the coast (the domain's angle there below 60 or above
+// 300 degrees on the scale of a fifth of the pieces next to the node) the
+// straight ring must be as sharp: the chord to a neighbour and the ring's
+// own direction within 35 degrees; else the mesher sees a blunt corner where
+// the coast has a tip, and gives it too few quads (a reflex tip of 340
+// degrees split in two corners of 170 degrees).
+void QuadLayoutBuilder::mark_blunted_tips(const std::vector<std::vector<Eigen::Vector2d>>& straight) {
+  for (std::size_t r = 0; r < rings().size(); ++r) {
+    const std::size_t n = nodes_[r].size();
+    if (n < 3) continue;
+    const RingCurve& ring = rings()[r];
+    const double L = ring.length();
+    for (std::size_t k = 0; k < n; ++k) {
+      const double s = nodes_[r][k];
+      const Eigen::Vector2d p = ring.point(s);
+      double len[2];
+      Eigen::Vector2d near[2], chord[2];
+      for (const int side : {0, 1}) {
+        const std::size_t other = side == 0 ? (k + 1) % n : (k + n - 1) % n;
+        len[side] = side == 0 ? nodes_[r][other] - s : s - nodes_[r][other];
+        if (len[side] <= 0.0) len[side] += L;
+        chord[side] = straight[r][other] - p;
+        near[side] = ring.point(s + (side == 0 ? 1.0 : -1.0) * 0.2 * len[side]) - p;
+      }
+      // The domain's angle at the node from the forward to the backward direction
+      // (the domain on the left of the outer ring, on the right of holes).
+      double phi = std::atan2(cross(near[0], near[1]), near[0].dot(near[1]));
+      if (R_.direction(static_cast<int>(r)) < 0.0) phi = -phi;
+      if (phi < 0.0) phi += 2.0 * std::numbers::pi;
+      if (phi > std::numbers::pi / 3.0 && phi < 5.0 * std::numbers::pi / 3.0) continue;
+      for (const int side : {0, 1}) {
+        const double angle = std::abs(std::atan2(cross(chord[side], near[side]), chord[side].dot(near[side])));
+        if (angle > 35.0 * std::numbers::pi / 180.0 && len[side] > 2.0 * node_options_.min_size)
+          to_split_[r].insert(side == 0 ? k : (k + n - 1) % n);
+      }
+    }
+  }
+}
+
+// The quad mesh of the straight rings, or none where Gmsh could not recover a
+// boundary segment ("... on curve N ..."): that piece and its neighbours are
+// marked for a node more.
+std::optional<PlanarQuadMesh> QuadLayoutBuilder::mesh(const std::vector<std::vector<Eigen::Vector2d>>& straight) {
+  try {
+    return quad_mesh(straight, h_);
+  } catch (const NumericalError& e) {
+    const std::string what = e.what();
+    const std::size_t at = what.find("on curve ");
+    if (at == std::string::npos) throw;
+    long long curve = std::atoll(what.c_str() + at + 9) - 1;  // line tags count the segments from 1
+    std::size_t r = 0;
+    while (r < straight.size() && curve >= static_cast<long long>(straight[r].size()))
+      curve -= static_cast<long long>(straight[r].size()), ++r;
+    if (r == straight.size() || curve < 0) throw;
+    const std::size_t n = straight[r].size(), k = static_cast<std::size_t>(curve);
+    for (const std::size_t j : {(k + n - 1) % n, k, (k + 1) % n}) to_split_[r].insert(j);
+    note("mesh " + std::to_string(meshes_ + 1) + ": the quad mesher lost a piece of ring " + std::to_string(r) +
+         "; 3 ring nodes more there, meshing again");
+    return std::nullopt;
+  }
+}
+
+// The mesh must tile the straight domain: every edge used by two quads in
+// opposite directions, or by one quad along a ring (between nodes of that
+// ring). Gmsh can mesh a sliver inside a hole, or lose a ring node's curve
+// where straight pieces nearly touch: the pieces nearest such edges are
+// marked. Returns whether the mesh fails to tile.
+bool QuadLayoutBuilder::marked_untiled(const PlanarQuadMesh& qm) {
+  std::unordered_map<unsigned long long, int> directed;
+  auto key = [](int a, int b) {
+    return (static_cast<unsigned long long>(static_cast<unsigned>(a)) << 32) | static_cast<unsigned>(b);
+  };
+  for (const auto& q : qm.quads)
+    for (int j = 0; j < 4; ++j) ++directed[key(q[j], q[(j + 1) % 4])];
+  bool broken = false;
+  for (const auto& q : qm.quads)
+    for (int j = 0; j < 4; ++j) {
+      const int a = q[j], b = q[(j + 1) % 4];
+      const bool twice = directed[key(a, b)] > 1;
+      const bool boundary = directed.find(key(b, a)) == directed.end();
+      if (twice || (boundary && !(qm.ring[a] >= 0 && qm.ring[a] == qm.ring[b]))) {
+        mark_nearest_piece(0.5 * (qm.nodes[a] + qm.nodes[b]));
+        broken = true;
+      }
+    }
+  return broken;
+}
+
+// The mesh with its boundary nodes on the true rings: each at the same
+// fraction of its piece's arc length as of the chord.
+LayoutMesh QuadLayoutBuilder::on_true_rings(const PlanarQuadMesh& qm) const {
+  LayoutMesh m{qm.nodes, qm.ring, std::vector<double>(qm.nodes.size(), 0.0), qm.quads};
+  for (std::size_t n = 0; n < m.size(); ++n) {
+    if (m.ring[n] < 0) continue;
+    const auto& nr = nodes_[m.ring[n]];
+    const RingCurve& ring = rings()[m.ring[n]];
+    const double L = ring.length();
+    const std::size_t k = static_cast<std::size_t>(qm.segment[n]);
+    const double a = nr[k], b = k + 1 < nr.size() ? nr[k + 1] : nr.front() + L;
+    m.arc[n] = ring.snap_to_vertex(a + qm.t[n] * (b - a), 0.01 * (b - a));
+    m.x[n] = ring.point(m.arc[n]);
+  }
+  return m;
+}
+
+// The nodes of lm in a violation of the true geometry: an inner node outside
+// the domain, or a cut across a ring. With `mark`, the ring pieces nearest
+// each violation are marked.
+std::set<int> QuadLayoutBuilder::violations(const LayoutMesh& lm, bool mark) {
+  std::set<int> involved;
+  const LayoutTopology t(lm);
+  for (std::size_t n = 0; n < lm.size(); ++n)
+    if (lm.ring[n] < 0 && t.valence(static_cast<int>(n)) > 0 && !geometry_.inside(lm.x[n])) {
+      involved.insert(static_cast<int>(n));
+      if (mark) mark_nearest_piece(lm.x[n]);
+    }
+  for (std::size_t q = 0; q < lm.quads.size(); ++q)
+    for (int j = 0; j < 4; ++j) {
+      const int a = lm.quads[q][j], b = lm.quads[q][(j + 1) % 4];
+      if (t.on_ring(static_cast<int>(q), j) || a > b) continue;  // each cut once
+      const bool a_on = lm.ring[a] >= 0, b_on = lm.ring[b] >= 0;
+      const int g = geometry_.crossing(lm.x[a], lm.x[b], a_on, b_on, tol_);
+      // No crossing: a violation only between two ring nodes with the cut outside (admits_cut).
+      if (g < 0 && geometry_.admits_cut(lm.x[a], lm.x[b], a_on, b_on, tol_)) continue;
+      involved.insert(a), involved.insert(b);
+      if (!mark) continue;
+      if (g < 0)
+        mark_nearest_piece(0.5 * (lm.x[a] + lm.x[b]));
+      else
+        mark_piece_of_edge(geometry_.edge(g));
+    }
+  return involved;
+}
+
+// Checks on the true geometry: inner nodes inside, cuts off the rings. The
+// nodes involved in a violation go back where the mesher put them (with the
+// quads of the mesher, if rotations changed them); what still fails gets ring
+// nodes more near it. Returns whether any were marked (and so split).
+bool QuadLayoutBuilder::undo_violations(LayoutMesh& m, const LayoutMesh& start, int round) {
+  if (debugging())
+    std::fprintf(stderr, "layout round %d: %zu nodes in violations at the start, %zu after optimization\n", round,
+                 violations(start, false).size(), violations(m, false).size());
+  if (!violations(m, false).empty() && m.quads != start.quads) m = start;  // rotations undone
+  for (int pass = 0; pass < 3; ++pass) {
+    bool changed = false;
+    for (int n : violations(m, false))
+      if (m.x[n] != start.x[n]) m.x[n] = start.x[n], m.arc[n] = start.arc[n], changed = true;
+    if (!changed) break;
+  }
+  if (debugging()) std::fprintf(stderr, "  %zu nodes still in violation\n", violations(m, false).size());
+  const std::size_t bad = violations(m, true).size();
+  if (bad > 0)
+    note(mesh_name() + ": " + std::to_string(bad) + " node(s) outside the domain or with cuts across its boundary; " +
+         std::to_string(marked()) + " ring node(s) more there, meshing again");
+  return split_marked();
+}
+
+// The layout: inner edges are cuts, ring nodes of one quad are ring corners.
+// \throw InputError naming the place where a patch corner is out of range
+// (patch_corner_in_range) or the cuts do not make a layout.
+void QuadLayoutBuilder::make_patch_layout(const LayoutMesh& m, const LayoutTopology& t) {
+  std::vector<Cut> cuts;
+  out_.ring_corners.clear();
+  for (std::size_t q = 0; q < m.quads.size(); ++q)
+    for (int j = 0; j < 4; ++j) {
+      const int a = m.quads[q][j], b = m.quads[q][(j + 1) % 4];
+      if (!t.on_ring(static_cast<int>(q), j) && a < b) cuts.push_back({m.x[a], m.x[b]});
+    }
+  for (std::size_t n = 0; n < m.size(); ++n)
+    if (m.ring[n] >= 0 && t.valence(static_cast<int>(n)) == 1) out_.ring_corners.push_back(m.x[n]);
+  out_.layout = build_patch_layout(d_, std::move(cuts), out_.ring_corners);
+  // Every patch corner where the map sees it (at the vertex itself) between 1
+  // and 170 degrees (patch_corner_in_range). (The mesher's own layout, level
+  // 0, only needs convex corners.)
+  for (const Patch& p : out_.layout.patches)
+    for (int k = 0; k < 4; ++k) {
+      const auto& v = p.polygon.vertices;
+      const std::size_t c = p.corners[k], n = v.size();
+      const Eigen::Vector2d a = v[(c + 1) % n] - v[c], b = v[(c + n - 1) % n] - v[c];
+      const bool fine = level_ == 0 ? cross(a, b) / (a.norm() * b.norm()) > 1e-3 : patch_corner_in_range(a, b);
+      if (!fine)
+        throw InputError("a patch corner outside 1-170 degrees near (" + std::to_string(v[c].x()) + ", " +
+                         std::to_string(v[c].y()) + ")");
+    }
+}
+
+// After make_patch_layout rejected this round's mesh (`what`): level 2 becomes
+// level 1 (the same mesh without edge rotations: the optimization left a
+// corner flat or reflex, or cuts crossing near rings much closer than the
+// patch size). Else ring nodes more near the place named, and a new mesh
+// optimized in full; once the repairs are used up, or a node more at the
+// same place did not mend it, the mesher's own nodes (level 0) are the last
+// try (its cuts may cross where the true rings are far from their chords).
+// \throw NumericalError when level 0 fails too.
+void QuadLayoutBuilder::recover_from_rejected_layout(const std::string& what) {
+  if (debugging()) std::fprintf(stderr, "layout rejected at level %d: %s\n", level_, what.c_str());
+  if (level_ == 2) {
+    note(mesh_name() + ": " + what + "; the same mesh without edge rotations");
+    out_.stats.optimization_level = level_ = 1;
+    return;
+  }
+  const std::size_t at = what.find("near (");
+  Eigen::Vector2d place(0.0, 0.0);
+  bool again = false;  // this place failed a repair before: a node more there did not mend it
+  if (at != std::string::npos) {
+    char* end = nullptr;
+    place.x() = std::strtod(what.c_str() + at + 6, &end);
+    place.y() = end && *end == ',' ? std::strtod(end + 1, nullptr) : 0.0;
+    const double same = std::max(1e-6 * diam_, 2e-6);  // (the message gives 6 decimals)
+    for (const Eigen::Vector2d& p : repaired_at_) again = again || (p - place).norm() <= same;
+  }
+  if (at != std::string::npos && repairs_ < o_.max_repair_rounds && !again) {
+    repaired_at_.push_back(place);
+    mark_nearest_piece(place);
+    note(mesh_name() + ": " + what + "; a ring node more there, meshing again");
+    split_marked();
+    count_repair();
+    out_.stats.optimization_level = level_ = 2;
+    return;
+  }
+  if (level_ == 1) {
+    // (Each further round would cost a mesh and its optimization, to the same end.)
+    if (again) note(mesh_name() + ": " + what + " again after a ring node more there; the mesher's own nodes instead");
+    out_.stats.optimization_level = level_ = 0;
+    return;
+  }
+  throw NumericalError("no valid quad layout: " + what);
+}
+
+void QuadLayoutBuilder::fill_stats(const LayoutMesh& m, const LayoutTopology& t) {
+  QuadLayoutStats& st = out_.stats;
+  st.patches = out_.layout.patches.size();
+  st.min_size = size_options_.min_size;
+  st.max_size = size_options_.max_size > 0.0 ? size_options_.max_size : 0.125 * diam_;
+  for (std::size_t n = 0; n < m.size(); ++n) {
+    const std::size_t k = t.valence(static_cast<int>(n));
+    if (k == 0) continue;
+    if (m.ring[n] >= 0)
+      ++st.ring_nodes;
+    else
+      ++st.inner_nodes, ++st.valence[std::min<std::size_t>(k, 7)];
+  }
+  double sum = 0.0;
+  st.min_corner_scaled_jacobian = 1.0;
+  for (const auto& q : m.quads) {
+    const double sj = quad_corner_scaled_jacobian({m.x[q[0]], m.x[q[1]], m.x[q[2]], m.x[q[3]]});
+    st.min_corner_scaled_jacobian = std::min(st.min_corner_scaled_jacobian, sj);
+    sum += sj;
+  }
+  st.mean_corner_scaled_jacobian = sum / static_cast<double>(m.quads.size());
+  const LayoutCornerQuality w = worst_layout_quality(m, t, quality_);
+  st.corner_mean_ratio = w.mean_ratio;
+  st.corner_scaled_jacobian = w.scaled_jacobian;
+  st.seconds = toolkit::seconds_since(t0_);
+}
+
+}  // namespace
+
+QuadLayout build_quad_layout(const Domain& d, const QuadLayoutOptions& o) {
+  if (!quad_mesher_available()) quad_mesh({}, {});  // throws the InputError that explains it
+  QuadLayoutBuilder builder(d, o);
+  return builder.build();
 }
 
 }  // namespace tspline

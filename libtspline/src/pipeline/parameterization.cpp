@@ -4,7 +4,6 @@
 #include <atomic>
 #include <exception>
 #include <mutex>
-#include <chrono>
 #include <cmath>
 #include <limits>
 #include <optional>
@@ -12,81 +11,16 @@
 #include <thread>
 #include <utility>
 
-#include "tspline/tmesh/coons.h"
 #include "tspline/boundary/corners.h"
 #include "tspline/errors.h"
 #include "tspline/boundary/plane.h"
 #include "tspline/boundary/polygon_validation.h"
-#include "tspline/tmesh/smoothing_problem.h"
-#include "tspline/tmesh/tmesh_transfer.h"
+#include "tspline/detail/stage_clock.h"
+#include "tspline/pipeline/front_optimization.h"
 
 namespace tspline {
 
 namespace {
-
-// Accumulates wall time per stage; stages may be entered several times.
-class StageClock {
- public:
-  explicit StageClock(std::vector<StageTime>& times) : times_(times) {}
-  void stop(const std::string& stage) {
-    const auto now = std::chrono::steady_clock::now();
-    const double dt = std::chrono::duration<double>(now - start_).count();
-    start_ = now;
-    for (StageTime& t : times_)
-      if (t.stage == stage) return void(t.seconds += dt);
-    times_.push_back({stage, dt});
-  }
-
- private:
-  std::vector<StageTime>& times_;
-  std::chrono::steady_clock::time_point start_ = std::chrono::steady_clock::now();
-};
-
-// The nested sequence of meshes (coarse to fine) on which the optimization runs.
-// Stage k has uniform level level[k] and boundary tolerance tol[k]; both are
-// monotone, so every stage's tree refines the previous one, and the last stage
-// is exactly the T-mesh of (initial_level, tolerance) built directly (the
-// refinement criterion of a cell depends only on the cell, and the 2:1 balanced
-// closure of a tree is unique).
-struct Stages {
-  std::vector<int> level;
-  std::vector<double> tol;
-};
-
-Stages nested_stages(int initial_level, double tol, double diag, bool nested) {
-  Stages st;
-  if (!nested) return Stages{{initial_level}, {tol}};
-  // Coarsest stage: level <= 2 and a tolerance of 1e-3 diag^2 (a handful of
-  // boundary cells). Each stage halves the cell size: the uniform level grows by
-  // one, and the area criterion, which scales like h^3 on a smooth boundary
-  // (chord c, sagitta c^2/(8R): area ~ c^3/(16R)), tightens by 8.
-  const int l0 = std::min(initial_level, 2);
-  const double coarse_tol = 1e-3 * diag * diag;
-  int k_tol = 0;
-  while (tol * std::pow(8.0, k_tol) < coarse_tol && k_tol < 30) ++k_tol;
-  const int stages = std::max(initial_level - l0, k_tol) + 1;
-  for (int k = 0; k < stages; ++k) {
-    const int remaining = stages - 1 - k;
-    st.level.push_back(std::max(l0, initial_level - remaining));
-    st.tol.push_back(tol * std::pow(8.0, std::min(remaining, k_tol)));
-  }
-  return st;
-}
-
-// Splits every leaf below `level` (one uniform step of the nested sequence).
-void refine_below(TMesh& mesh, int level) {
-  for (bool again = true; again;) {
-    again = false;
-    const std::size_t n = mesh.nodes().size();
-    for (std::size_t i = 0; i < n; ++i) {
-      if (mesh.node(static_cast<int>(i)).is_leaf() && mesh.node(static_cast<int>(i)).level < level) {
-        mesh.refine(static_cast<int>(i));
-        again = true;
-      }
-    }
-  }
-}
-
 
 // Runs body(0), ..., body(n - 1) on up to hardware_concurrency threads; the
 // first exception thrown by a body is rethrown here once the running bodies
@@ -113,161 +47,6 @@ void for_each_concurrently(std::size_t n, Body&& body) {
   for (std::thread& t : pool) t.join();
   for (const std::exception_ptr& e : errors)
     if (e) std::rethrow_exception(e);
-}
-
-}  // namespace
-
-namespace {
-
-// Everything after the corners: adapted T-mesh, Coons start, nested optimization
-// and repair; the stage times go to the result's `times`.
-FrontResult optimize_front(BoundaryMap boundary, const ParameterizationOptions& opt) {
-  auto log = [&](const char* stage, const std::string& s) { report_step(opt.progress, stage, s); };
-  FrontResult r{std::move(boundary)};
-  StageClock clock(r.times);
-
-  r.tolerance_is_relative = !opt.tolerance_absolute.has_value();
-  const double diag = bounding_box_diagonal(r.boundary.polygon());
-  r.tolerance_area = opt.tolerance_absolute ? *opt.tolerance_absolute : opt.tolerance_relative * diag * diag;
-
-  meshopt::SmoothingOptions sopt = opt.smoothing;
-  if (!sopt.progress && opt.progress) {
-    sopt.progress = [&](int sweep, double move, std::size_t tangled) {
-      ProgressEvent e;
-      e.kind = ProgressEvent::Kind::Sweep;
-      e.stage = "optimization";
-      e.count = sweep;
-      e.value = move;
-      e.defects = tangled;
-      std::ostringstream s;
-      s << "sweep " << sweep << ": max relative move " << move << ", tangled nodes " << tangled;
-      e.text = s.str();
-      opt.progress(e);
-    };
-  }
-  auto optimize = [&](const std::string& what) {
-    const meshopt::SmoothingProblem problem = build_smoothing_problem(r.mesh, true);
-    r.smoothing = meshopt::smooth(r.optimized, problem, sopt);
-    r.total_sweeps += r.smoothing.sweeps;
-    r.node_visits += r.smoothing.node_visits;
-    r.quality_optimized = mesh_quality(r.mesh, r.optimized);
-    std::ostringstream s;
-    s << "optimization (" << what << ", " << r.mesh.num_cells() << " cells): " << r.smoothing.sweeps << " sweeps"
-      << (r.smoothing.converged ? "" : " (not converged)") << ", " << r.quality_optimized.inverted_cells
-      << " inverted cells, min/mean quality " << r.quality_optimized.min_quality << " / "
-      << r.quality_optimized.mean_quality;
-    log("optimization", s.str());
-  };
-
-  // Nested iteration: optimize on a coarse mesh, then refine, carry the
-  // positions over and optimize again. Gauss-Seidel sweeps remove the local
-  // errors quickly but the smooth, domain-wide ones slowly; on the coarse stages
-  // those are cheap, so the finest stage starts close to its optimum.
-  const Stages st = nested_stages(opt.initial_level, r.tolerance_area, diag, opt.nested_optimization);
-  // The last stage's T-mesh first (milliseconds: a test per cell), so that a
-  // tolerance that needs more than max_cells fails at once (refine_to_boundary
-  // throws), not after the optimization of every coarser stage.
-  if (st.level.size() > 1) {
-    TMesh last(opt.initial_level);
-    refine_to_boundary(last, r.boundary, {r.tolerance_area, opt.max_level, opt.max_cells});
-  }
-  for (std::size_t k = 0; k < st.level.size(); ++k) {
-    const bool last = k + 1 == st.level.size();
-    TMesh coarse = k == 0 ? TMesh(st.level[0]) : r.mesh;
-    if (k == 0) r.mesh = TMesh(st.level[0]);
-    refine_below(r.mesh, st.level[k]);
-    const BoundaryRefinementReport rep =
-        refine_to_boundary(r.mesh, r.boundary, {st.tol[k], opt.max_level, opt.max_cells});
-    refine_to_border_params(r.mesh, opt.border_params, opt.max_level);
-    if (last) r.refinement = rep;
-    clock.stop("tmesh");
-    if (last) {
-      std::ostringstream s;
-      s << "t-mesh: " << r.mesh.num_cells() << " cells, " << r.mesh.num_vertices() << " vertices ("
-        << r.mesh.num_hanging_vertices() << " hanging), max level " << r.mesh.max_level() << ", tolerance "
-        << r.tolerance_area;
-      log("tmesh", s.str());
-      if (rep.edges_over_tolerance > 0)
-        report_step(opt.progress, "tmesh",
-                    "warning: " + std::to_string(rep.edges_over_tolerance) +
-                        " boundary edges still exceed the tolerance at the maximum level " +
-                        std::to_string(opt.max_level),
-                    -1, ProgressEvent::Kind::Note);
-      // The Coons start of the final T-mesh, for the report (and the start if not nested).
-      r.coons = coons_positions(r.mesh, r.boundary);
-      r.quality_coons = mesh_quality(r.mesh, r.coons);
-      log("coons", "coons: " + std::to_string(r.quality_coons.inverted_cells) + " inverted cells");
-      clock.stop("coons");
-    }
-    // Carry the previous stage over only if it was untangled: a coarse stage
-    // can be impossible to untangle (its boundary too coarse for a thin part of
-    // the domain), and then the Coons start of the finer mesh is the better start.
-    const bool carry = k > 0 && r.quality_optimized.inverted_cells == 0;
-    if (carry)
-      r.optimized = transfer_positions(coarse, r.optimized, r.mesh, r.boundary);
-    else
-      r.optimized = last ? r.coons : coons_positions(r.mesh, r.boundary);
-    // Intermediate stages only provide a start: a bounded number of sweeps.
-    sopt.max_sweeps = last ? opt.smoothing.max_sweeps : std::min(opt.smoothing.max_sweeps, 100);
-    optimize(last ? "final mesh" : "stage " + std::to_string(k + 1) + " of " + std::to_string(st.level.size()));
-    clock.stop("optimization");
-  }
-
-  // Repair: cells that stay inverted lack interior freedom (typically thin
-  // features of the domain). Refine them, place the new vertices in the current
-  // physical mesh, re-balance and optimize again.
-  sopt.max_sweeps = opt.smoothing.max_sweeps;
-  for (int round = 0; round < opt.max_repair_rounds && r.quality_optimized.inverted_cells > 0; ++round) {
-    const std::vector<CellQuality> q = cell_qualities(r.mesh, r.optimized);
-    std::vector<int> inverted;
-    for (int c = 0; c < static_cast<int>(q.size()); ++c)
-      if (!q[c].valid && r.mesh.cell_level(c) < opt.max_level) inverted.push_back(c);
-    if (inverted.empty()) {
-      r.repair_stop_reason = "the " + std::to_string(r.quality_optimized.inverted_cells) +
-                             " inverted cells are at `max_level` " + std::to_string(opt.max_level);
-      log("repair", "repair stopped: " + r.repair_stop_reason);
-      break;
-    }
-    const std::size_t refined = inverted.size();
-    TMesh finer = refine_cells(r.mesh, inverted);
-    if (finer.num_cells() > opt.max_cells) {
-      // The domain needs a finer mesh than allowed (typically a long thin
-      // part): say so and stop rather than go on with a tangled mesh.
-      std::ostringstream s;
-      s << "the polygon needs more than " << opt.max_cells << " cells (`max_cells`): after " << round
-        << " repair round(s) " << r.quality_optimized.inverted_cells << " of " << r.mesh.num_cells()
-        << " T-mesh cells are still inverted, and refining them makes " << finer.num_cells()
-        << " cells; raise `max_cells`, or check the polygon for long thin parts (spikes, narrow channels)";
-      throw InputError(s.str());
-    }
-    // The state before this round, restored if the round makes things worse.
-    std::vector<Eigen::Vector2d> before = r.optimized;
-    const MeshQualityStats quality_before = r.quality_optimized;
-    const meshopt::SmoothingReport smoothing_before = r.smoothing;
-    const TMesh coarse = std::exchange(r.mesh, std::move(finer));
-    r.optimized = transfer_positions(coarse, r.optimized, r.mesh, r.boundary);
-    r.repair_refined_cells.push_back(refined);
-    log("repair", "repair round " + std::to_string(round + 1) + ": refined " + std::to_string(refined) +
-        " inverted cells, now " + std::to_string(r.mesh.num_cells()) + " cells");
-    optimize("repair " + std::to_string(round + 1));
-    clock.stop("repair");
-    if (r.quality_optimized.inverted_cells > quality_before.inverted_cells) {
-      // Diverging (the inverted region grows with each round, as where a long
-      // thin part needs far finer cells than its neighbourhood): more rounds
-      // only multiply the cells. Keep the mesh before this round.
-      r.repair_stop_reason = "repair round " + std::to_string(round + 1) + " left more inverted cells (" +
-                             std::to_string(r.quality_optimized.inverted_cells) + ") than before it (" +
-                             std::to_string(quality_before.inverted_cells) + "); kept the mesh before it";
-      r.mesh = coarse;
-      r.optimized = std::move(before);
-      r.quality_optimized = quality_before;
-      r.smoothing = smoothing_before;
-      r.repair_refined_cells.pop_back();
-      log("repair", "repair stopped: " + r.repair_stop_reason);
-      break;
-    }
-  }
-  return r;
 }
 
 }  // namespace
@@ -428,7 +207,7 @@ void require_convex_corners(const Polygon& poly, const Corners& corners, bool gi
 FrontResult run_front(const Polygon& input, const ParameterizationOptions& opt) {
   validate_options(opt);
   std::vector<StageTime> times;
-  StageClock clock(times);
+  detail::StageClock clock(times);
   CleanBoundary boundary = clean_boundary(input, opt);
   Polygon& poly = boundary.polygon;
   clock.stop("boundary");
