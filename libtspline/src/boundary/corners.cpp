@@ -198,117 +198,169 @@ Corners finish_choice(const Polygon& p, const std::vector<double>& cum, const st
                       double best_cost, std::size_t K);
 }  // namespace
 
-std::vector<Corners> corner_candidates(const Polygon& p, std::size_t count) {
-  if (count == 0) return {};
-  const std::size_t n = p.vertices.size();
-  if (n < 4 || p.file_index.size() != n) throw InputError("corners: the polygon must be validated first");
-  const auto cum = arc_lengths(p);
-  const double per = cum[n];
-  std::vector<double> vc(n);
-  for (std::size_t i = 0; i < n; ++i) vc[i] = vertex_cost(p, cum, i);
+namespace {
+
+// Quadruples of corners ranked by choice_cost: four vertices (in ring order)
+// and their cost.
+using CornerChoice = std::pair<double, std::array<std::size_t, 4>>;
+
+// The search of corner_candidates over one validated polygon: arc lengths,
+// vertex costs, and the vertices by cost.
+class CornerSearch {
+ public:
+  explicit CornerSearch(const Polygon& p) : p_(p), n_(p.vertices.size()), cum_(arc_lengths(p)), per_(cum_[n_]) {
+    vc_.resize(n_);
+    for (std::size_t i = 0; i < n_; ++i) vc_[i] = vertex_cost(p, cum_, i);
+    by_cost_.resize(n_);
+    for (std::size_t i = 0; i < n_; ++i) by_cost_[i] = i;
+    std::stable_sort(by_cost_.begin(), by_cost_.end(), [&](std::size_t a, std::size_t b) { return vc_[a] < vc_[b]; });
+  }
 
   // Candidate set, O(n log n): (1) the best convex vertices by vertex cost, with
   // non-maximum suppression so that they are at least 1% of the perimeter apart;
   // (2) 16 equally spaced positions and (3) the positions a quarter, half and
   // three quarters of the perimeter after the 4 best candidates, each snapped to
   // the cheapest vertex within 1/64 of the perimeter. (2) and (3) give balanced
-  // choices when the boundary is smooth (disk) or corners are few.
-  constexpr std::size_t kBest = 32;
-  std::vector<std::size_t> order(n);
-  for (std::size_t i = 0; i < n; ++i) order[i] = i;
-  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return vc[a] < vc[b]; });
-  auto arc_dist = [&](std::size_t a, std::size_t b) {
-    const double d = std::abs(cum[a] - cum[b]);
-    return std::min(d, per - d);
-  };
-  std::vector<std::size_t> best;
-  for (std::size_t i : order) {
-    if (best.size() == kBest || vc[i] >= 10.0) break;  // vc >= 10: not strictly convex
-    if (std::all_of(best.begin(), best.end(), [&](std::size_t b) { return arc_dist(i, b) >= 0.01 * per; }))
-      best.push_back(i);
+  // choices when the boundary is smooth (disk) or corners are few. Ascending.
+  std::vector<std::size_t> candidates() const {
+    const std::vector<std::size_t> best = best_convex();
+    std::vector<std::size_t> cand = best;
+    for (int j = 0; j < 16; ++j) cand.push_back(snap(j * per_ / 16));
+    for (std::size_t b = 0; b < std::min<std::size_t>(4, best.size()); ++b)
+      for (int j = 1; j < 4; ++j) cand.push_back(snap(cum_[best[b]] + j * per_ / 4));
+    std::sort(cand.begin(), cand.end());
+    cand.erase(std::unique(cand.begin(), cand.end()), cand.end());
+    add_cheapest(cand);
+    // Where four convex candidates are, drop the others, so that no balance
+    // term can pick a reflex or straight vertex.
+    if (std::count_if(cand.begin(), cand.end(), [&](std::size_t i) { return convex(i); }) >= 4)
+      cand.erase(std::remove_if(cand.begin(), cand.end(), [&](std::size_t i) { return !convex(i); }), cand.end());
+    return cand;
   }
-  auto snap = [&](double s) {
-    s = std::fmod(s, per);
-    if (s < 0) s += per;
-    const double w = per / 64;
-    std::size_t k =
-        static_cast<std::size_t>(std::lower_bound(cum.begin(), cum.begin() + n, s) - cum.begin()) % n;
+
+  // Exhaustive search over ordered quadruples of candidates: O(K^4), K <= 72.
+  // The kKeep cheapest, ascending by cost (a max-heap while searching).
+  std::vector<CornerChoice> cheapest_quadruples(const std::vector<std::size_t>& cand) const {
+    const std::size_t K = cand.size();
+    constexpr std::size_t kKeep = 256;
+    std::vector<CornerChoice> heap;
+    heap.reserve(kKeep + 1);
+    for (std::size_t a = 0; a < K; ++a)
+      for (std::size_t b = a + 1; b < K; ++b)
+        for (std::size_t c = b + 1; c < K; ++c)
+          for (std::size_t d = c + 1; d < K; ++d) {
+            const std::size_t q[4] = {cand[a], cand[b], cand[c], cand[d]};
+            const double L[4] = {cum_[q[1]] - cum_[q[0]], cum_[q[2]] - cum_[q[1]], cum_[q[3]] - cum_[q[2]],
+                                 per_ - (cum_[q[3]] - cum_[q[0]])};
+            const double cost = choice_cost(L, vc_[q[0]] + vc_[q[1]] + vc_[q[2]] + vc_[q[3]]);
+            if (heap.size() == kKeep && cost >= heap.front().first) continue;
+            heap.push_back({cost, {q[0], q[1], q[2], q[3]}});
+            std::push_heap(heap.begin(), heap.end());
+            if (heap.size() > kKeep) {
+              std::pop_heap(heap.begin(), heap.end());
+              heap.pop_back();
+            }
+          }
+    std::sort_heap(heap.begin(), heap.end());  // ascending cost
+    return heap;
+  }
+
+  // Up to `count` of the choices (ascending by cost) that differ from each
+  // other: some corner more than 2% of the perimeter away. K: the number of
+  // candidates searched, for the report.
+  std::vector<Corners> distinct_choices(const std::vector<CornerChoice>& choices, std::size_t count,
+                                        std::size_t K) const {
+    std::vector<Corners> result;
+    std::vector<std::array<std::size_t, 4>> kept;
+    for (const CornerChoice& ch : choices) {
+      if (result.size() == count) break;
+      const bool distinct = std::all_of(kept.begin(), kept.end(), [&](const std::array<std::size_t, 4>& k) {
+        for (int i = 0; i < 4; ++i)
+          if (arc_dist(k[i], ch.second[i]) > 0.02 * per_) return true;
+        return false;
+      });
+      if (!distinct) continue;
+      kept.push_back(ch.second);
+      result.push_back(finish_choice(p_, cum_, ch.second, ch.first, K));
+    }
+    return result;
+  }
+
+ private:
+  bool convex(std::size_t i) const { return vc_[i] < 10.0; }  // vc >= 10: not strictly convex
+
+  double arc_dist(std::size_t a, std::size_t b) const {
+    const double d = std::abs(cum_[a] - cum_[b]);
+    return std::min(d, per_ - d);
+  }
+
+  // The cheapest convex vertices, at most 32, at least 1% of the perimeter apart.
+  std::vector<std::size_t> best_convex() const {
+    constexpr std::size_t kBest = 32;
+    std::vector<std::size_t> best;
+    for (std::size_t i : by_cost_) {
+      if (best.size() == kBest || vc_[i] >= 10.0) break;
+      if (std::all_of(best.begin(), best.end(), [&](std::size_t b) { return arc_dist(i, b) >= 0.01 * per_; }))
+        best.push_back(i);
+    }
+    return best;
+  }
+
+  // The cheapest vertex within 1/64 of the perimeter of arc length s.
+  std::size_t snap(double s) const {
+    s = std::fmod(s, per_);
+    if (s < 0) s += per_;
+    const double w = per_ / 64;
+    const std::size_t k =
+        static_cast<std::size_t>(std::lower_bound(cum_.begin(), cum_.begin() + n_, s) - cum_.begin()) % n_;
     std::size_t pick = k;
     // Walk forward and backward from the vertex at/after s while within the window.
     for (int dir : {1, -1}) {
-      for (std::size_t step = 0, j = k; step < n; ++step) {
-        const double d = std::abs(cum[j] - s);
-        if (std::min(d, per - d) > w) break;
-        if (vc[j] < vc[pick]) pick = j;
-        j = dir > 0 ? (j + 1) % n : (j + n - 1) % n;
+      for (std::size_t step = 0, j = k; step < n_; ++step) {
+        const double d = std::abs(cum_[j] - s);
+        if (std::min(d, per_ - d) > w) break;
+        if (vc_[j] < vc_[pick]) pick = j;
+        j = dir > 0 ? (j + 1) % n_ : (j + n_ - 1) % n_;
       }
     }
     return pick;
-  };
-  std::vector<std::size_t> cand = best;
-  for (int j = 0; j < 16; ++j) cand.push_back(snap(j * per / 16));
-  for (std::size_t b = 0; b < std::min<std::size_t>(4, best.size()); ++b)
-    for (int j = 1; j < 4; ++j) cand.push_back(snap(cum[best[b]] + j * per / 4));
-  std::sort(cand.begin(), cand.end());
-  cand.erase(std::unique(cand.begin(), cand.end()), cand.end());
+  }
+
   // Too few distinct candidates (a small polygon, or one whose perimeter is
   // nearly all in a few long edges, so that the snapped positions coincide):
-  // add the cheapest other vertices (convex ones first: `order` is by cost)
-  // until there are 8, or all n.
-  // A corner must be strictly convex (run_front rejects others), so at least
-  // four convex candidates are wanted where the polygon has them.
-  auto convex = [&](std::size_t i) { return vc[i] < 10.0; };
-  const std::size_t convex_wanted = std::min<std::size_t>(4, std::count_if(order.begin(), order.end(), convex));
-  for (std::size_t i : order) {
-    if (cand.size() >= std::min<std::size_t>(8, n) &&
-        static_cast<std::size_t>(std::count_if(cand.begin(), cand.end(), convex)) >= convex_wanted)
-      break;
-    const auto at = std::lower_bound(cand.begin(), cand.end(), i);
-    if (at == cand.end() || *at != i) cand.insert(at, i);
+  // the cheapest other vertices (convex ones first) join until there are 8,
+  // or all n. A corner must be strictly convex (run_front rejects others), so
+  // at least four convex candidates are wanted where the polygon has them.
+  void add_cheapest(std::vector<std::size_t>& cand) const {
+    auto is_convex = [&](std::size_t i) { return convex(i); };
+    const std::size_t convex_wanted =
+        std::min<std::size_t>(4, std::count_if(by_cost_.begin(), by_cost_.end(), is_convex));
+    for (std::size_t i : by_cost_) {
+      if (cand.size() >= std::min<std::size_t>(8, n_) &&
+          static_cast<std::size_t>(std::count_if(cand.begin(), cand.end(), is_convex)) >= convex_wanted)
+        break;
+      const auto at = std::lower_bound(cand.begin(), cand.end(), i);
+      if (at == cand.end() || *at != i) cand.insert(at, i);
+    }
   }
-  // Where four convex candidates are, drop the others, so that no balance
-  // term can pick a reflex or straight vertex.
-  if (std::count_if(cand.begin(), cand.end(), convex) >= 4)
-    cand.erase(std::remove_if(cand.begin(), cand.end(), [&](std::size_t i) { return !convex(i); }), cand.end());
 
-  // Exhaustive search over ordered quadruples of candidates: O(K^4), K <= 72.
-  // Keep the kKeep cheapest in a max-heap, then pick up to `count` of them that
-  // differ from each other (some corner more than 2% of the perimeter away).
-  const std::size_t K = cand.size();
-  using Choice = std::pair<double, std::array<std::size_t, 4>>;
-  constexpr std::size_t kKeep = 256;
-  std::vector<Choice> heap;
-  heap.reserve(kKeep + 1);
-  for (std::size_t a = 0; a < K; ++a)
-    for (std::size_t b = a + 1; b < K; ++b)
-      for (std::size_t c = b + 1; c < K; ++c)
-        for (std::size_t d = c + 1; d < K; ++d) {
-          const std::size_t q[4] = {cand[a], cand[b], cand[c], cand[d]};
-          const double L[4] = {cum[q[1]] - cum[q[0]], cum[q[2]] - cum[q[1]], cum[q[3]] - cum[q[2]],
-                               per - (cum[q[3]] - cum[q[0]])};
-          const double cost = choice_cost(L, vc[q[0]] + vc[q[1]] + vc[q[2]] + vc[q[3]]);
-          if (heap.size() == kKeep && cost >= heap.front().first) continue;
-          heap.push_back({cost, {q[0], q[1], q[2], q[3]}});
-          std::push_heap(heap.begin(), heap.end());
-          if (heap.size() > kKeep) {
-            std::pop_heap(heap.begin(), heap.end());
-            heap.pop_back();
-          }
-        }
-  std::sort_heap(heap.begin(), heap.end());  // ascending cost
-  std::vector<Corners> result;
-  std::vector<std::array<std::size_t, 4>> kept;
-  for (const Choice& ch : heap) {
-    if (result.size() == count) break;
-    const bool distinct = std::all_of(kept.begin(), kept.end(), [&](const std::array<std::size_t, 4>& k) {
-      for (int i = 0; i < 4; ++i)
-        if (arc_dist(k[i], ch.second[i]) > 0.02 * per) return true;
-      return false;
-    });
-    if (!distinct) continue;
-    kept.push_back(ch.second);
-    result.push_back(finish_choice(p, cum, ch.second, ch.first, K));
-  }
+  const Polygon& p_;
+  const std::size_t n_;
+  const std::vector<double> cum_;  // arc length at each vertex; cum_[n_] the perimeter
+  const double per_;
+  std::vector<double> vc_;             // vertex costs
+  std::vector<std::size_t> by_cost_;   // the vertices by ascending cost (stable)
+};
+
+}  // namespace
+
+std::vector<Corners> corner_candidates(const Polygon& p, std::size_t count) {
+  if (count == 0) return {};
+  if (p.vertices.size() < 4 || p.file_index.size() != p.vertices.size())
+    throw InputError("corners: the polygon must be validated first");
+  const CornerSearch search(p);
+  const std::vector<std::size_t> cand = search.candidates();
+  std::vector<Corners> result = search.distinct_choices(search.cheapest_quadruples(cand), count, cand.size());
   // Unreachable for a validated polygon (n >= 4 candidates, finite costs); a
   // clear error rather than an empty list that callers index.
   if (result.empty()) throw NumericalError("corners: no automatic choice of four corners could be evaluated");

@@ -140,93 +140,118 @@ void check_ring_relations(const Domain& d, const std::vector<std::size_t>& numbe
 
 }  // namespace
 
-Domain validate_domain(Domain d, const DomainCleaningOptions& cleaning) {
-  const double width = cleaning.needle_width
-                           ? *cleaning.needle_width
-                           : needle_width_for_ring(d.outer, std::nullopt, kDefaultNeedleWidthRelative);
-  // A crossing islet whose convex hull is smaller than this is below the boundary tolerance.
-  const double repair_area = cleaning.crossing_repair_area
-                                 ? *cleaning.crossing_repair_area
-                                 : (std::isfinite(width) ? width : 0.0) * bounding_box_diagonal(d.outer);
-  auto note = [&](const std::string& s) {
-    if (cleaning.notes) cleaning.notes->push_back(s);
-  };
-  // The ring cleaned and validated; nullopt for a hole that is nothing but needles.
-  auto validated = [&](Polygon p, std::size_t r) -> std::optional<Polygon> {
+namespace {
+
+// The cleaning of a domain's rings with the widths and areas derived from
+// its outer ring (DomainCleaningOptions); what it did goes to the notes.
+class DomainCleaner {
+ public:
+  DomainCleaner(const Polygon& outer, const DomainCleaningOptions& cleaning)
+      : cleaning_(cleaning),
+        width_(cleaning.needle_width ? *cleaning.needle_width
+                                     : needle_width_for_ring(outer, std::nullopt, kDefaultNeedleWidthRelative)),
+        // A crossing islet whose convex hull is smaller than this is below the boundary tolerance.
+        repair_area_(cleaning.crossing_repair_area ? *cleaning.crossing_repair_area
+                                                   : finite_width() * bounding_box_diagonal(outer)) {}
+
+  // Ring r (0: the outer ring) cleaned and validated; nullopt for a hole that
+  // is nothing but needles. Errors name the ring.
+  std::optional<Polygon> ring(Polygon p, std::size_t r) const {
     std::string name = ring_name(r);
     try {
-      PolygonCleaning c = clean_polygon(std::move(p), std::isfinite(width) && width > 0.0 ? width : 0.0);
+      PolygonCleaning c = clean_polygon(std::move(p), width_ > 0.0 ? finite_width() : 0.0);
       if (r > 0 && c.needles > 0 && c.polygon.vertices.size() < 3) {
         std::ostringstream m;
         m.precision(3);
-        m << name << ": dropped: it encloses no area once its needles narrower than " << width
+        m << name << ": dropped: it encloses no area once its needles narrower than " << width_
           << " are removed (an islet below the boundary tolerance)";
         note(m.str());
         return std::nullopt;
       }
       if (!c.notes.empty()) note(cleaning_summary(name, c));
-      if (r > 0 && c.polygon.vertices.size() >= 3) {
-        std::vector<Point> pts;
-        for (const auto& v : c.polygon.vertices) pts.push_back(point(v));
-        if (!CGAL::is_simple_2(pts.begin(), pts.end(), K())) {
-          Polygon h = convex_hull_of(c.polygon);
-          const double hull_area = signed_area(h);
-          const bool below_tolerance = hull_area <= repair_area;
-          if (cleaning.repair_crossing_holes || below_tolerance) {
-            std::ostringstream m;
-            m.precision(4);
-            m << name << ": crosses itself; replaced by its convex hull (" << h.vertices.size() << " of its "
-              << c.polygon.vertices.size() << " vertices; area " << std::abs(signed_area(c.polygon))
-              << " (signed, lobes cancelling) -> " << hull_area;
-            if (below_tolerance) m << ", below the boundary tolerance " << repair_area;
-            m << ")";
-            note(m.str());
-            c.polygon = std::move(h);
-          }
-        }
-      }
-      return validate_cleaned_polygon(std::move(c), width, r == 0 ? 4 : 3);
+      if (r > 0 && c.polygon.vertices.size() >= 3) unless_simple_take_hull(c, name);
+      return validate_cleaned_polygon(std::move(c), width_, r == 0 ? 4 : 3);
     } catch (const InputError& e) {
       name[0] = static_cast<char>(std::toupper(static_cast<unsigned char>(name[0])));
       throw InputError(name + ": " + e.what());
     }
-  };
-  d.outer = *validated(std::move(d.outer), 0);
-  std::vector<std::size_t> number = {0};
+  }
+
+  // Sharp tips cut off within the boundary tolerance (sharp_tips.h); all kept
+  // if a cut would make two rings meet. number[r]: ring r's number in messages.
+  void blunt_tips(Domain& d, const std::vector<std::size_t>& number) const {
+    const double area = cleaning_.blunt_tip_area ? *cleaning_.blunt_tip_area : repair_area_;
+    Domain blunted = d;
+    std::vector<std::string> notes;
+    auto blunt = [&](Polygon& ring, bool hole, std::size_t r) {
+      TipBlunting t = blunt_sharp_tips(std::move(ring), hole, cleaning_.blunt_tips_below_degrees, area,
+                                       finite_width(), ring_name(r));
+      ring = std::move(t.polygon);
+      notes.insert(notes.end(), t.notes.begin(), t.notes.end());
+    };
+    blunt(blunted.outer, false, 0);
+    for (std::size_t h = 0; h < blunted.holes.size(); ++h) blunt(blunted.holes[h], true, number[h + 1]);
+    if (notes.empty()) return;
+    try {
+      check_ring_relations(blunted, number);
+    } catch (const InputError& e) {
+      note(std::string("sharp tips kept as they are: cutting them would make two rings meet (") + e.what() + ")");
+      return;
+    }
+    d = std::move(blunted);
+    for (const std::string& n : notes) note(n);
+    if (cleaning_.blunted_tips) *cleaning_.blunted_tips = notes.size();
+  }
+
+ private:
+  double finite_width() const { return std::isfinite(width_) ? width_ : 0.0; }
+  void note(const std::string& s) const {
+    if (cleaning_.notes) cleaning_.notes->push_back(s);
+  }
+
+  // A hole that crosses itself becomes its convex hull where the options ask
+  // for it or the hull is below the boundary tolerance (else validation
+  // rejects it, naming the edges).
+  void unless_simple_take_hull(PolygonCleaning& c, const std::string& name) const {
+    std::vector<Point> pts;
+    for (const auto& v : c.polygon.vertices) pts.push_back(point(v));
+    if (CGAL::is_simple_2(pts.begin(), pts.end(), K())) return;
+    Polygon h = convex_hull_of(c.polygon);
+    const double hull_area = signed_area(h);
+    const bool below_tolerance = hull_area <= repair_area_;
+    if (!cleaning_.repair_crossing_holes && !below_tolerance) return;
+    std::ostringstream m;
+    m.precision(4);
+    m << name << ": crosses itself; replaced by its convex hull (" << h.vertices.size() << " of its "
+      << c.polygon.vertices.size() << " vertices; area " << std::abs(signed_area(c.polygon))
+      << " (signed, lobes cancelling) -> " << hull_area;
+    if (below_tolerance) m << ", below the boundary tolerance " << repair_area_;
+    m << ")";
+    note(m.str());
+    c.polygon = std::move(h);
+  }
+
+  const DomainCleaningOptions& cleaning_;
+  const double width_;
+  const double repair_area_;
+};
+
+}  // namespace
+
+Domain validate_domain(Domain d, const DomainCleaningOptions& cleaning) {
+  const DomainCleaner cleaner(d.outer, cleaning);
+  d.outer = *cleaner.ring(std::move(d.outer), 0);
+  std::vector<std::size_t> number = {0};  // the holes kept, by their numbers in the input
   std::vector<Polygon> holes;
   for (std::size_t h = 0; h < d.holes.size(); ++h)
-    if (std::optional<Polygon> p = validated(std::move(d.holes[h]), h + 1)) {
+    if (std::optional<Polygon> p = cleaner.ring(std::move(d.holes[h]), h + 1)) {
       holes.push_back(std::move(*p));
       number.push_back(h + 1);
     }
   d.holes = std::move(holes);
   check_ring_relations(d, number);
   if (cleaning.blunted_tips) *cleaning.blunted_tips = 0;
-  if (cleaning.blunt_tips_below_degrees > 0.0) {
-    // Sharp tips cut off within the boundary tolerance (sharp_tips.h); kept
-    // all if a cut would make two rings meet.
-    const double area = cleaning.blunt_tip_area ? *cleaning.blunt_tip_area : repair_area;
-    Domain blunted = d;
-    std::vector<std::string> notes;
-    auto blunt = [&](Polygon& ring, bool hole, std::size_t r) {
-      TipBlunting t = blunt_sharp_tips(std::move(ring), hole, cleaning.blunt_tips_below_degrees, area,
-                                       std::isfinite(width) ? width : 0.0, ring_name(r));
-      ring = std::move(t.polygon);
-      notes.insert(notes.end(), t.notes.begin(), t.notes.end());
-    };
-    blunt(blunted.outer, false, 0);
-    for (std::size_t h = 0; h < blunted.holes.size(); ++h) blunt(blunted.holes[h], true, number[h + 1]);
-    if (!notes.empty()) {
-      try {
-        check_ring_relations(blunted, number);
-        d = std::move(blunted);
-        for (const std::string& s : notes) note(s);
-        if (cleaning.blunted_tips) *cleaning.blunted_tips = notes.size();
-      } catch (const InputError& e) {
-        note(std::string("sharp tips kept as they are: cutting them would make two rings meet (") + e.what() + ")");
-      }
-    }
-  }
+  if (cleaning.blunt_tips_below_degrees > 0.0) cleaner.blunt_tips(d, number);
   return d;
 }
 

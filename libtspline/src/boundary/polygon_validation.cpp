@@ -212,118 +212,153 @@ double needle_width_for_tolerance(double tolerance_area, double diagonal) {
   return tolerance_area / diagonal;
 }
 
-PolygonCleaning clean_polygon(Polygon p, double needle_width) {
-  if (!(needle_width >= 0.0) || !std::isfinite(needle_width))
-    throw toolkit::InputError("clean_polygon: the needle width must be finite and >= 0");
-  const std::size_t n0 = p.vertices.size();
-  if (p.file_index.empty()) {
-    p.file_index.resize(n0);
-    for (std::size_t i = 0; i < n0; ++i) p.file_index[i] = i;
-  }
-  PolygonCleaning out;
-  for (const auto& v : p.vertices)
-    if (!std::isfinite(v.x()) || !std::isfinite(v.y())) {
-      out.polygon = std::move(p);  // validate_polygon names the vertex
-      return out;
+namespace {
+
+std::string three_digits(double x) {
+  std::ostringstream os;
+  os.precision(3);
+  os << x;
+  return os.str();
+}
+
+// The passes of clean_polygon over one ring (finite vertices, file indices set).
+//
+// One pass goes over a stack: a vertex is dropped if it repeats the previous
+// one, or if it is the tip of a needle between the previous kept vertex and
+// the next one (a zero-area spike: the two edges on one line, doubling back;
+// or the two edges folding back within needle_width of each other). Dropping
+// a vertex can expose the next needle (a -> b -> a -> ..., or a needle drawn
+// with several vertices out and back), which the stack handles.
+class NeedleRemoval {
+ public:
+  NeedleRemoval(const Polygon& p, double needle_width) : p_(p), needle_width_(needle_width) {}
+
+  PolygonCleaning run() {
+    std::vector<std::size_t> order(p_.vertices.size());
+    for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
+    // Repeat, rotating the ring between passes so that the triples across each
+    // pass's seam (the last, first and second vertex) are inside the next pass,
+    // until passes have found nothing three times in a row (a 3-vertex ring needs
+    // three rotations to look at each of its triples; a longer ring, two passes).
+    int quiet_passes = 0;
+    while (quiet_passes < 3 && order.size() >= 3) {
+      const bool changed = pass(order);
+      // Rotate so that the seam between the last and first vertex is looked at too.
+      if (keep_.size() >= 3)
+        std::rotate(keep_.begin(), keep_.begin() + static_cast<std::ptrdiff_t>(keep_.size() / 2), keep_.end());
+      order = keep_;
+      quiet_passes = changed ? 0 : quiet_passes + 1;
     }
-  // One pass over a stack: a vertex is dropped if it repeats the previous one,
-  // or if it is the tip of a needle between the previous kept vertex and the
-  // next one (a zero-area spike: the two edges on one line, doubling back; or
-  // the two edges folding back within needle_width of each other). Dropping a
-  // vertex can expose the next needle (a -> b -> a -> ..., or a needle drawn
-  // with several vertices out and back), which the stack handles.
-  std::vector<std::size_t> keep;
-  keep.reserve(n0);
-  // The width of the needle with tip b (< 0: b is no needle's tip). Exactly
-  // collinear fold-backs (exact predicates) have width 0.
-  auto needle = [&](std::size_t a, std::size_t b, std::size_t c) -> double {
-    const Point pa(p.vertices[a].x(), p.vertices[a].y()), pb(p.vertices[b].x(), p.vertices[b].y()),
-        pc(p.vertices[c].x(), p.vertices[c].y());
-    if (CGAL::collinear(pa, pb, pc)) return CGAL::collinear_are_ordered_along_line(pa, pb, pc) ? -1.0 : 0.0;
-    if (needle_width == 0.0) return -1.0;
-    // The edges b->a and b->c fold back (angle below 90 degrees); the width is the
-    // distance of the nearer neighbour from the line of the longer edge, whose
-    // foot lies on that edge.
-    const Eigen::Vector2d u = p.vertices[a] - p.vertices[b], v = p.vertices[c] - p.vertices[b];
-    if (!(u.dot(v) > 0.0)) return -1.0;
-    const double longer = std::max(u.norm(), v.norm());
-    const double width = std::abs(u.x() * v.y() - u.y() * v.x()) / longer;
-    return width <= needle_width ? width : -1.0;
-  };
-  auto note = [&](std::size_t dropped, const std::string& why) {
-    out.removed_file_indices.push_back(p.file_index[dropped]);
-    out.notes.push_back("removed vertex " + std::to_string(p.file_index[dropped]) + " " + why);
-  };
-  auto fmt = [](double x) {
-    std::ostringstream os;
-    os.precision(3);
-    os << x;
-    return os.str();
-  };
-  bool changed = false;
-  // i repeats the last kept vertex: the one later in the file goes (the
-  // closing vertex of a file that repeats its first one, say).
-  // Where a needle's tip has just gone, a vertex within needle_width of the
-  // last kept one repeats it too (the two base vertices of a needle, or the
-  // flat end of a needle drawn with two tip vertices): the change is a triangle
-  // of height at most needle_width. Elsewhere short edges are kept.
-  auto repeats = [&](std::size_t i, bool after_tip) {
-    if (keep.empty()) return false;
-    const bool exact = p.vertices[keep.back()] == p.vertices[i];
-    const double gap = (p.vertices[keep.back()] - p.vertices[i]).norm();
-    if (!exact && !(after_tip && needle_width > 0.0 && gap <= needle_width)) return false;
-    changed = true;
-    const bool drop_last = p.file_index[i] < p.file_index[keep.back()];
-    const std::size_t dropped = drop_last ? keep.back() : i, kept = drop_last ? i : keep.back();
-    note(dropped, exact ? "(repeats vertex " + std::to_string(p.file_index[kept]) + ")"
-                        : "(lies " + fmt(gap) + " from vertex " + std::to_string(p.file_index[kept]) +
-                              ", closer than the needle width " + fmt(needle_width) + ")");
-    if (drop_last) keep.back() = i;
-    return true;
-  };
-  std::vector<std::size_t> order(n0);
-  for (std::size_t i = 0; i < n0; ++i) order[i] = i;
-  // Repeat, rotating the ring between passes so that the triples across each
-  // pass's seam (the last, first and second vertex) are inside the next pass,
-  // until passes have found nothing three times in a row (a 3-vertex ring needs
-  // three rotations to look at each of its triples; a longer ring, two passes).
-  int quiet_passes = 0;
-  while (quiet_passes < 3 && order.size() >= 3) {
-    changed = false;
-    keep.clear();
+    std::sort(order.begin(), order.end());  // file order
+    Polygon q;
+    for (std::size_t i : order) q.vertices.push_back(p_.vertices[i]), q.file_index.push_back(p_.file_index[i]);
+    std::sort(out_.removed_file_indices.begin(), out_.removed_file_indices.end());
+    out_.polygon = std::move(q);
+    return std::move(out_);
+  }
+
+ private:
+  // One pass over `order` into keep_; whether it dropped anything.
+  bool pass(const std::vector<std::size_t>& order) {
+    changed_ = false;
+    keep_.clear();
     for (std::size_t i : order) {
       if (repeats(i, false)) continue;
       double width = 0.0;
       bool tip = false;
-      while (keep.size() >= 2 && (width = needle(keep[keep.size() - 2], keep.back(), i)) >= 0.0) {
-        const std::string a = std::to_string(p.file_index[keep[keep.size() - 2]]),
-                          b = std::to_string(p.file_index[keep.back()]), c = std::to_string(p.file_index[i]);
-        if (width == 0.0)
-          note(keep.back(), "(tip of a zero-area spike: edges " + a + "-" + b + " and " + b + "-" + c + " overlap)");
-        else
-          note(keep.back(), "(tip of a needle of width " + fmt(width) + ", narrower than " + fmt(needle_width) +
-                                ": edges " + a + "-" + b + " and " + b + "-" + c + " fold back)");
-        ++out.needles;
-        out.max_needle_width = std::max(out.max_needle_width, width);
-        keep.pop_back();
-        changed = true;
+      while (keep_.size() >= 2 && (width = needle(keep_[keep_.size() - 2], keep_.back(), i)) >= 0.0) {
+        drop_tip(i, width);
         tip = true;
-        if (!keep.empty() && (p.vertices[keep.back()] - p.vertices[i]).norm() <= needle_width) break;
+        if (!keep_.empty() && (p_.vertices[keep_.back()] - p_.vertices[i]).norm() <= needle_width_) break;
       }
       if (repeats(i, tip)) continue;
-      keep.push_back(i);
+      keep_.push_back(i);
     }
-    // Rotate so that the seam between the last and first vertex is looked at too.
-    if (keep.size() >= 3) std::rotate(keep.begin(), keep.begin() + static_cast<std::ptrdiff_t>(keep.size() / 2), keep.end());
-    order = keep;
-    quiet_passes = changed ? 0 : quiet_passes + 1;
+    return changed_;
   }
-  std::sort(order.begin(), order.end());  // file order
-  Polygon q;
-  for (std::size_t i : order) q.vertices.push_back(p.vertices[i]), q.file_index.push_back(p.file_index[i]);
-  std::sort(out.removed_file_indices.begin(), out.removed_file_indices.end());
-  out.polygon = std::move(q);
-  return out;
+
+  // The width of the needle with tip b (< 0: b is no needle's tip). Exactly
+  // collinear fold-backs (exact predicates) have width 0.
+  double needle(std::size_t a, std::size_t b, std::size_t c) const {
+    const Point pa(p_.vertices[a].x(), p_.vertices[a].y()), pb(p_.vertices[b].x(), p_.vertices[b].y()),
+        pc(p_.vertices[c].x(), p_.vertices[c].y());
+    if (CGAL::collinear(pa, pb, pc)) return CGAL::collinear_are_ordered_along_line(pa, pb, pc) ? -1.0 : 0.0;
+    if (needle_width_ == 0.0) return -1.0;
+    // The edges b->a and b->c fold back (angle below 90 degrees); the width is the
+    // distance of the nearer neighbour from the line of the longer edge, whose
+    // foot lies on that edge.
+    const Eigen::Vector2d u = p_.vertices[a] - p_.vertices[b], v = p_.vertices[c] - p_.vertices[b];
+    if (!(u.dot(v) > 0.0)) return -1.0;
+    const double longer = std::max(u.norm(), v.norm());
+    const double width = std::abs(u.x() * v.y() - u.y() * v.x()) / longer;
+    return width <= needle_width_ ? width : -1.0;
+  }
+
+  // The last kept vertex is the tip of a needle of `width` before vertex i: it goes.
+  void drop_tip(std::size_t i, double width) {
+    const std::string a = std::to_string(p_.file_index[keep_[keep_.size() - 2]]),
+                      b = std::to_string(p_.file_index[keep_.back()]), c = std::to_string(p_.file_index[i]);
+    if (width == 0.0)
+      note(keep_.back(), "(tip of a zero-area spike: edges " + a + "-" + b + " and " + b + "-" + c + " overlap)");
+    else
+      note(keep_.back(), "(tip of a needle of width " + three_digits(width) + ", narrower than " +
+                             three_digits(needle_width_) + ": edges " + a + "-" + b + " and " + b + "-" + c +
+                             " fold back)");
+    ++out_.needles;
+    out_.max_needle_width = std::max(out_.max_needle_width, width);
+    keep_.pop_back();
+    changed_ = true;
+  }
+
+  // Whether vertex i repeats the last kept vertex; if so, the one later in the
+  // file goes (the closing vertex of a file that repeats its first one, say).
+  // Where a needle's tip has just gone, a vertex within needle_width of the
+  // last kept one repeats it too (the two base vertices of a needle, or the
+  // flat end of a needle drawn with two tip vertices): the change is a triangle
+  // of height at most needle_width. Elsewhere short edges are kept.
+  bool repeats(std::size_t i, bool after_tip) {
+    if (keep_.empty()) return false;
+    const bool exact = p_.vertices[keep_.back()] == p_.vertices[i];
+    const double gap = (p_.vertices[keep_.back()] - p_.vertices[i]).norm();
+    if (!exact && !(after_tip && needle_width_ > 0.0 && gap <= needle_width_)) return false;
+    changed_ = true;
+    const bool drop_last = p_.file_index[i] < p_.file_index[keep_.back()];
+    const std::size_t dropped = drop_last ? keep_.back() : i, kept = drop_last ? i : keep_.back();
+    note(dropped, exact ? "(repeats vertex " + std::to_string(p_.file_index[kept]) + ")"
+                        : "(lies " + three_digits(gap) + " from vertex " + std::to_string(p_.file_index[kept]) +
+                              ", closer than the needle width " + three_digits(needle_width_) + ")");
+    if (drop_last) keep_.back() = i;
+    return true;
+  }
+
+  void note(std::size_t dropped, const std::string& why) {
+    out_.removed_file_indices.push_back(p_.file_index[dropped]);
+    out_.notes.push_back("removed vertex " + std::to_string(p_.file_index[dropped]) + " " + why);
+  }
+
+  const Polygon& p_;
+  const double needle_width_;
+  PolygonCleaning out_;
+  std::vector<std::size_t> keep_;  // the vertices kept so far in this pass (indices into p_)
+  bool changed_ = false;           // whether this pass dropped a vertex
+};
+
+}  // namespace
+
+PolygonCleaning clean_polygon(Polygon p, double needle_width) {
+  if (!(needle_width >= 0.0) || !std::isfinite(needle_width))
+    throw toolkit::InputError("clean_polygon: the needle width must be finite and >= 0");
+  if (p.file_index.empty()) {
+    p.file_index.resize(p.vertices.size());
+    for (std::size_t i = 0; i < p.vertices.size(); ++i) p.file_index[i] = i;
+  }
+  for (const auto& v : p.vertices)
+    if (!std::isfinite(v.x()) || !std::isfinite(v.y())) {
+      PolygonCleaning out;
+      out.polygon = std::move(p);  // validate_polygon names the vertex
+      return out;
+    }
+  return NeedleRemoval(p, needle_width).run();
 }
 
 double needle_width_for_ring(const Polygon& p, std::optional<double> tolerance_absolute, double tolerance_relative) {
