@@ -6,6 +6,7 @@
 #include <chrono>
 #include <cmath>
 #include <filesystem>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <numbers>
 #include <string>
@@ -85,49 +86,45 @@ void write_vtu(const std::string& path, const meshopt::RemeshMesh& m, double len
   toolkit::io::write_vtu(path, v);
 }
 
-}  // namespace
-
-nlohmann::json remesh_model(const RemeshArgs& a, tspline_app::Progress& out) {
+// The options' ranges; the report's path (beside --out unless given), every
+// output's folder writable.
+std::string checked_report_path(const RemeshArgs& a) {
   namespace fs = std::filesystem;
   if (!(a.max_deviation >= 0.0) || !std::isfinite(a.max_deviation))
     throw toolkit::InputError("--max-deviation must be positive");
-  if (a.length == 0.0 && a.max_deviation == 0.0)
-    throw toolkit::InputError("give --length or --max-deviation");
+  if (a.length == 0.0 && a.max_deviation == 0.0) throw toolkit::InputError("give --length or --max-deviation");
   if (a.length != 0.0 && (!(a.length > 0.0) || !std::isfinite(a.length)))
     throw toolkit::InputError("--length must be positive");
   if (a.anisotropy != -1.0 && (!(a.anisotropy >= 0.0) || !std::isfinite(a.anisotropy)))
     throw toolkit::InputError("--anisotropy must be >= 0");
   if (!(a.feature_angle >= 0.0 && a.feature_angle <= 180.0))
     throw toolkit::InputError("--feature-angle must be in [0, 180] degrees");
-  if (!(a.min_angle >= 0.0 && a.min_angle < 60.0))
-    throw toolkit::InputError("--min-angle must be in [0, 60) degrees");
+  if (!(a.min_angle >= 0.0 && a.min_angle < 60.0)) throw toolkit::InputError("--min-angle must be in [0, 60) degrees");
   if (a.rounds < 0) throw toolkit::InputError("--rounds must be >= 0");
   if (fs::path(a.out).extension() != ".msh") throw toolkit::InputError("--out must end in .msh");
-  const std::string report =
-      a.report.empty() ? fs::path(a.out).replace_extension(".json").string() : a.report;
+  const std::string report = a.report.empty() ? fs::path(a.out).replace_extension(".json").string() : a.report;
   for (const std::string& f : {a.out, a.vtu, report})
     if (!f.empty()) toolkit::io::ensure_writable_directory(fs::absolute(f).parent_path().string());
+  return report;
+}
 
-  const auto t_start = Clock::now();
-  meshopt::gmsh_io::Session session;
+// The model opened in the Gmsh session, and its start mesh: --mesh, or
+// Gmsh's own.
+void open_model_and_start_mesh(const RemeshArgs& a, tspline_app::Progress& out) {
   meshopt::gmsh_io::open_model(a.model);
-  if (a.mesh.empty()) {
-    out.log("meshing " + a.model + " with Gmsh");
-    // A start that resolves the curvature (12 elements per 2 pi radius, unless
-    // the model sets its own sizing from curvature): on a start coarser than a
-    // pipe's radius the split of a bent feature edge would fold a triangle over
-    // its opposite corner, is refused, and leaves an outlier of deviation.
-    double from_curvature = 0.0;
-    gmsh::option::getNumber("Mesh.MeshSizeFromCurvature", from_curvature);
-    if (from_curvature == 0.0) gmsh::option::setNumber("Mesh.MeshSizeFromCurvature", 12);
-    meshopt::gmsh_io::generate_surface_mesh();
-  } else {
-    meshopt::gmsh_io::merge_mesh(a.mesh);
-  }
-  meshopt::gmsh_io::GmshRemeshGeometry geometry(meshopt::gmsh_io::detect_features(a.feature_angle * kDegree));
-  meshopt::RemeshMesh mesh = meshopt::gmsh_io::read_remesh_mesh(geometry);
-  const double seconds_input = since(t_start);
+  if (!a.mesh.empty()) return meshopt::gmsh_io::merge_mesh(a.mesh);
+  out.log("meshing " + a.model + " with Gmsh");
+  // A start that resolves the curvature (12 elements per 2 pi radius, unless
+  // the model sets its own sizing from curvature): on a start coarser than a
+  // pipe's radius the split of a bent feature edge would fold a triangle over
+  // its opposite corner, is refused, and leaves an outlier of deviation.
+  double from_curvature = 0.0;
+  gmsh::option::getNumber("Mesh.MeshSizeFromCurvature", from_curvature);
+  if (from_curvature == 0.0) gmsh::option::setNumber("Mesh.MeshSizeFromCurvature", 12);
+  meshopt::gmsh_io::generate_surface_mesh();
+}
 
+meshopt::RemeshOptions remesh_options(const RemeshArgs& a, tspline_app::Progress& out) {
   meshopt::RemeshOptions opt;
   // A 3D edge of 6D length L along a direction of normal curvature kappa has
   // h = L / sqrt(1 + s^2 kappa^2) and deviates by kappa h^2 / 8, at most
@@ -143,66 +140,98 @@ nlohmann::json remesh_model(const RemeshArgs& a, tspline_app::Progress& out) {
   opt.anisotropy = a.anisotropy >= 0.0 ? a.anisotropy : 5.0 * opt.length;
   opt.min_angle = a.min_angle * kDegree;
   opt.rounds = a.rounds;
-  opt.progress = [&](int round, const std::string& phase) {
-    out.progress(phase, round, opt.rounds);
+  opt.progress = [&out, rounds = opt.rounds](int round, const std::string& phase) {
+    out.progress(phase, round, rounds);
     out.event({{"event", "phase"}, {"round", round + 1}, {"phase", phase}});
   };
-  const meshopt::RemeshStatistics before = meshopt::remesh_statistics(mesh, opt.length, opt.anisotropy);
-  const auto euler_before = mesh.euler_characteristics();
-  const meshopt::RemeshReport rep = meshopt::remesh(mesh, geometry, opt);
-  const meshopt::RemeshStatistics after = meshopt::remesh_statistics(mesh, opt.length, opt.anisotropy);
+  return opt;
+}
 
+// What remesh_model measured, for its report.
+struct RemeshRun {
+  meshopt::RemeshStatistics before, after;
+  meshopt::RemeshReport operations;
+  std::map<int, long> euler_before, euler_after;  // Euler characteristic per patch
+  std::size_t non_manifold_edges = 0;
+  Deviation deviation;
+  double seconds_input = 0.0, seconds_analysis = 0.0, seconds_output = 0.0;
+};
+
+nlohmann::json remesh_report(const RemeshArgs& a, const meshopt::RemeshOptions& opt,
+                             const meshopt::gmsh_io::GmshRemeshGeometry& geometry, const RemeshRun& r,
+                             const std::string& report) {
+  nlohmann::json euler = nlohmann::json::array();
+  for (const auto& [p, chi] : r.euler_after)
+    euler.push_back({{"patch", p}, {"before", r.euler_before.count(p) ? r.euler_before.at(p) : 0}, {"after", chi}});
+  const double diagonal = geometry.features().diagonal;
+  return {{"model", a.model},
+          {"mesh", a.mesh.empty() ? "generated by Gmsh" : a.mesh},
+          {"length", opt.length},
+          {"anisotropy", opt.anisotropy},
+          {"max_deviation", opt.max_deviation},
+          {"feature_angle_degrees", a.feature_angle},
+          {"min_angle_degrees", a.min_angle},
+          {"rounds", opt.rounds},
+          {"patches", geometry.features().patch_faces.size()},
+          {"feature_curves", geometry.features().feature_curves.size()},
+          {"before", statistics_json(r.before)},
+          {"after", statistics_json(r.after)},
+          {"chordal_deviation",
+           {{"max", r.deviation.max},
+            {"mean", r.deviation.mean},
+            {"max_relative", r.deviation.max / diagonal},
+            {"mean_relative", r.deviation.mean / diagonal},
+            {"diagonal", diagonal}}},
+          {"topology",
+           {{"euler_characteristics", euler},
+            {"kept", r.euler_before == r.euler_after},
+            {"non_manifold_edges", r.non_manifold_edges}}},
+          {"operations",
+           {{"splits", r.operations.splits},
+            {"collapses", r.operations.collapses},
+            {"rejected_collapses", r.operations.rejected_collapses},
+            {"flips", r.operations.flips},
+            {"smoothing_moves", r.operations.smoothing_moves}}},
+          {"seconds",
+           {{"input", r.seconds_input},
+            {"sampling", r.operations.seconds_sampling},
+            {"optimizing", r.operations.seconds_optimizing},
+            {"analysis", r.seconds_analysis},
+            {"output", r.seconds_output}}},
+          {"outputs", {{"mesh", a.out}, {"vtu", a.vtu}, {"report", report}}}};
+}
+
+}  // namespace
+
+nlohmann::json remesh_model(const RemeshArgs& a, tspline_app::Progress& out) {
+  const std::string report = checked_report_path(a);
+  RemeshRun r;
   auto t0 = Clock::now();
+  meshopt::gmsh_io::Session session;
+  open_model_and_start_mesh(a, out);
+  meshopt::gmsh_io::GmshRemeshGeometry geometry(meshopt::gmsh_io::detect_features(a.feature_angle * kDegree));
+  meshopt::RemeshMesh mesh = meshopt::gmsh_io::read_remesh_mesh(geometry);
+  r.seconds_input = since(t0);
+
+  const meshopt::RemeshOptions opt = remesh_options(a, out);
+  r.before = meshopt::remesh_statistics(mesh, opt.length, opt.anisotropy);
+  r.euler_before = mesh.euler_characteristics();
+  r.operations = meshopt::remesh(mesh, geometry, opt);
+  r.after = meshopt::remesh_statistics(mesh, opt.length, opt.anisotropy);
+  r.euler_after = mesh.euler_characteristics();
+  r.non_manifold_edges = mesh.non_manifold_edges();
+
+  t0 = Clock::now();
   const meshopt::gmsh_io::CentroidProjection centroids = meshopt::gmsh_io::project_centroids(mesh, geometry);
   const meshopt::gmsh_io::CurvatureAlignment align = meshopt::gmsh_io::curvature_alignment(mesh, centroids);
-  const Deviation dev = deviation(centroids.distance);
-  const double seconds_analysis = since(t0);
+  r.deviation = deviation(centroids.distance);
+  r.seconds_analysis = since(t0);
   t0 = Clock::now();
   meshopt::gmsh_io::write_remesh_mesh(a.out, mesh, centroids.face);
   if (!a.vtu.empty()) write_vtu(a.vtu, mesh, opt.length, opt.anisotropy, align, centroids);
-  const double seconds_output = since(t0);
+  r.seconds_output = since(t0);
 
-  const auto euler_after = mesh.euler_characteristics();
-  nlohmann::json euler = nlohmann::json::array();
-  bool topology_kept = euler_before == euler_after;
-  for (const auto& [p, chi] : euler_after)
-    euler.push_back(
-        {{"patch", p}, {"before", euler_before.count(p) ? euler_before.at(p) : 0}, {"after", chi}});
-  const std::size_t non_manifold = mesh.non_manifold_edges();
-  const nlohmann::json j = {
-      {"model", a.model},
-      {"mesh", a.mesh.empty() ? "generated by Gmsh" : a.mesh},
-      {"length", opt.length},
-      {"anisotropy", opt.anisotropy},
-      {"max_deviation", opt.max_deviation},
-      {"feature_angle_degrees", a.feature_angle},
-      {"min_angle_degrees", a.min_angle},
-      {"rounds", opt.rounds},
-      {"patches", geometry.features().patch_faces.size()},
-      {"feature_curves", geometry.features().feature_curves.size()},
-      {"before", statistics_json(before)},
-      {"after", statistics_json(after)},
-      {"chordal_deviation",
-       {{"max", dev.max},
-        {"mean", dev.mean},
-        {"max_relative", dev.max / geometry.features().diagonal},
-        {"mean_relative", dev.mean / geometry.features().diagonal},
-        {"diagonal", geometry.features().diagonal}}},
-      {"topology",
-       {{"euler_characteristics", euler}, {"kept", topology_kept}, {"non_manifold_edges", non_manifold}}},
-      {"operations",
-       {{"splits", rep.splits},
-        {"collapses", rep.collapses},
-        {"rejected_collapses", rep.rejected_collapses},
-        {"flips", rep.flips},
-        {"smoothing_moves", rep.smoothing_moves}}},
-      {"seconds",
-       {{"input", seconds_input},
-        {"sampling", rep.seconds_sampling},
-        {"optimizing", rep.seconds_optimizing},
-        {"analysis", seconds_analysis},
-        {"output", seconds_output}}},
-      {"outputs", {{"mesh", a.out}, {"vtu", a.vtu}, {"report", report}}}};
+  const nlohmann::json j = remesh_report(a, opt, geometry, r, report);
   toolkit::io::write_text_atomic(report, j.dump(2) + "\n");
   return j;
 }
