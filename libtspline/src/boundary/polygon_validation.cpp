@@ -116,16 +116,18 @@ void check_polygon_scale(const Polygon& p) {
 
 double signed_area(const Polygon& p) { return signed_area(p.vertices); }
 
-Polygon validate_polygon(Polygon p, std::size_t min_vertices) {
+namespace {
+
+// File indices (0..n-1 where the polygon has none), enough vertices, finite coordinates.
+void check_vertices(Polygon& p, std::size_t min_vertices) {
   const std::size_t n = p.vertices.size();
   if (p.file_index.empty()) {
     p.file_index.resize(n);
     for (std::size_t i = 0; i < n; ++i) p.file_index[i] = i;
   } else if (p.file_index.size() != n) {
     throw toolkit::InputError("validate_polygon: file_index has " + std::to_string(p.file_index.size()) +
-                                " entries for " + std::to_string(n) + " vertices");
+                              " entries for " + std::to_string(n) + " vertices");
   }
-  const auto& fi = p.file_index;
   if (n < std::max<std::size_t>(min_vertices, 3)) {
     throw InputError("polygon has " + std::to_string(n) + " vertices; at least " +
                      std::to_string(std::max<std::size_t>(min_vertices, 3)) + " are needed");
@@ -133,11 +135,15 @@ Polygon validate_polygon(Polygon p, std::size_t min_vertices) {
   for (std::size_t i = 0; i < n; ++i) {
     const auto& v = p.vertices[i];
     if (!std::isfinite(v.x()) || !std::isfinite(v.y())) {
-      throw InputError("vertex " + std::to_string(fi[i]) + " has a non-finite coordinate " +
+      throw InputError("vertex " + std::to_string(p.file_index[i]) + " has a non-finite coordinate " +
                        fmt_point(v.x(), v.y()));
     }
   }
-  check_polygon_scale(p);
+}
+
+void check_no_repeated_neighbours(const Polygon& p) {
+  const std::size_t n = p.vertices.size();
+  const auto& fi = p.file_index;
   for (std::size_t i = 0; i < n; ++i) {
     const std::size_t j = (i + 1) % n;
     if (p.vertices[i] == p.vertices[j]) {
@@ -145,10 +151,12 @@ Polygon validate_polygon(Polygon p, std::size_t min_vertices) {
                        fmt_point(p.vertices[i].x(), p.vertices[i].y()) + "; remove the duplicate");
     }
   }
-  std::vector<Point> pts;
-  pts.reserve(n);
-  for (const auto& v : p.vertices) pts.emplace_back(v.x(), v.y());
+}
 
+// Positive area and no two edges meeting but neighbours at their shared
+// vertex, by exact predicates.
+void check_simple(const std::vector<Point>& pts, const std::vector<std::size_t>& fi) {
+  const std::size_t n = pts.size();
   // Zero area (exact): every vertex collinear with the first two distinct ones.
   bool all_collinear = true;
   for (std::size_t i = 2; i < n && all_collinear; ++i)
@@ -181,7 +189,12 @@ Polygon validate_polygon(Polygon p, std::size_t min_vertices) {
            "vertex order, duplicated or stray points)";
     throw InputError(msg);
   }
+}
 
+// The polygon counter-clockwise (reversed, file indices too, if it was not).
+// \pre simple (check_simple).
+void orient_counter_clockwise(Polygon& p, const std::vector<Point>& pts) {
+  const std::size_t n = pts.size();
   // Orientation, exactly: the lexicographically smallest vertex of a simple
   // polygon is convex, and its neighbours are not collinear with it (they would
   // lie on the same ray from it, i.e. the edges would overlap, excluded above).
@@ -196,6 +209,19 @@ Polygon validate_polygon(Polygon p, std::size_t min_vertices) {
     std::reverse(p.vertices.begin(), p.vertices.end());
     std::reverse(p.file_index.begin(), p.file_index.end());
   }
+}
+
+}  // namespace
+
+Polygon validate_polygon(Polygon p, std::size_t min_vertices) {
+  check_vertices(p, min_vertices);
+  check_polygon_scale(p);
+  check_no_repeated_neighbours(p);
+  std::vector<Point> pts;
+  pts.reserve(p.vertices.size());
+  for (const auto& v : p.vertices) pts.emplace_back(v.x(), v.y());
+  check_simple(pts, p.file_index);
+  orient_counter_clockwise(p, pts);
   return p;
 }
 

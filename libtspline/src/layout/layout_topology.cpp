@@ -113,53 +113,78 @@ std::vector<char> rings_with_flat_corners(const LayoutMesh& m, const LayoutQuali
   return flat;
 }
 
-std::size_t pillow_rings(LayoutMesh& m, const std::vector<char>& pillow) {
-  std::vector<std::array<int, 4>>& quads = m.quads;
-  std::vector<Eigen::Vector2d>& x = m.x;
-  std::vector<int>& ring = m.ring;
-  std::vector<double>& arc = m.arc;
-  std::vector<std::vector<int>> quads_of(x.size());
-  for (std::size_t q = 0; q < quads.size(); ++q)
-    for (int j = 0; j < 4; ++j) quads_of[quads[q][j]].push_back(static_cast<int>(q));
-  std::size_t count = 0;
-  for (const char p : pillow) count += p;
-  if (count == 0) return 0;
-  // Edges along the ring, as directed in their quad.
-  const LayoutTopology t(m);
-  std::vector<std::pair<int, int>> along;
-  for (std::size_t q = 0; q < quads.size(); ++q)
-    for (int j = 0; j < 4; ++j) {
-      const int v = quads[q][j], w = quads[q][(j + 1) % 4];
-      if (t.on_ring(static_cast<int>(q), j) && ring[v] >= 0 && ring[w] == ring[v] && pillow[ring[v]])
-        along.push_back({v, w});
+namespace {
+
+// One pillowing (pillow_rings): each pillowed ring node gets a copy on the
+// ring, the old node moves inside, and each ring edge gets a layer quad
+// between the two.
+class Pillowing {
+ public:
+  Pillowing(LayoutMesh& m, const std::vector<char>& pillow) : m_(m), pillow_(pillow), n0_(m.size()) {
+    quads_of_.resize(n0_);
+    for (std::size_t q = 0; q < m.quads.size(); ++q)
+      for (int j = 0; j < 4; ++j) quads_of_[m.quads[q][j]].push_back(static_cast<int>(q));
+  }
+
+  void run() {
+    const std::vector<std::pair<int, int>> along = pillowed_ring_edges();
+    copy_ring_nodes();
+    move_old_ring_nodes_inside();
+    add_layer_quads(along);
+    std::vector<char> resplit(m_.quads.size(), 0);  // old quads already part of a hexagon
+    for (std::size_t v = 0; v < n0_; ++v) keep_one_quad_at_tip(static_cast<int>(v), resplit);
+  }
+
+ private:
+  // Edges along the pillowed rings, as directed in their quad.
+  std::vector<std::pair<int, int>> pillowed_ring_edges() const {
+    const LayoutTopology t(m_);
+    std::vector<std::pair<int, int>> along;
+    for (std::size_t q = 0; q < m_.quads.size(); ++q)
+      for (int j = 0; j < 4; ++j) {
+        const int v = m_.quads[q][j], w = m_.quads[q][(j + 1) % 4];
+        if (t.on_ring(static_cast<int>(q), j) && m_.ring[v] >= 0 && m_.ring[w] == m_.ring[v] && pillow_[m_.ring[v]])
+          along.push_back({v, w});
+      }
+    return along;
+  }
+
+  void copy_ring_nodes() {
+    copy_.assign(n0_, -1);
+    for (std::size_t v = 0; v < n0_; ++v) {
+      if (m_.ring[v] < 0 || !pillow_[m_.ring[v]]) continue;
+      copy_[v] = static_cast<int>(m_.x.size());
+      m_.x.push_back(m_.x[v]);
+      m_.ring.push_back(m_.ring[v]);
+      m_.arc.push_back(m_.arc[v]);
     }
-  const std::size_t n0 = x.size();
-  std::vector<int> copy(n0, -1);
-  for (std::size_t v = 0; v < n0; ++v) {
-    if (ring[v] < 0 || !pillow[ring[v]]) continue;
-    copy[v] = static_cast<int>(x.size());
-    x.push_back(x[v]);
-    ring.push_back(ring[v]);
-    arc.push_back(arc[v]);
   }
+
   // The old ring nodes move a third of the way towards the mean of their other quad corners.
-  for (std::size_t v = 0; v < n0; ++v) {
-    if (copy[v] < 0) continue;
-    Eigen::Vector2d mean = Eigen::Vector2d::Zero();
-    int k = 0;
-    for (int q : quads_of[v])
-      for (int j = 0; j < 4; ++j)
-        if (quads[q][j] != static_cast<int>(v)) mean += x[quads[q][j]], ++k;
-    if (k > 0) x[v] += (1.0 / 3.0) * (mean / k - x[v]);
-    ring[v] = -1;
+  void move_old_ring_nodes_inside() {
+    for (std::size_t v = 0; v < n0_; ++v) {
+      if (copy_[v] < 0) continue;
+      Eigen::Vector2d mean = Eigen::Vector2d::Zero();
+      int k = 0;
+      for (int q : quads_of_[v])
+        for (int j = 0; j < 4; ++j)
+          if (m_.quads[q][j] != static_cast<int>(v)) mean += m_.x[m_.quads[q][j]], ++k;
+      if (k > 0) m_.x[v] += (1.0 / 3.0) * (mean / k - m_.x[v]);
+      m_.ring[v] = -1;
+    }
   }
+
   // The layer quad of each ring edge, by the edge's first node in its quad.
-  std::vector<int> layer_from(n0, -1), layer_to(n0, -1);
-  for (const auto& [v, w] : along) {
-    layer_from[v] = static_cast<int>(quads.size());
-    layer_to[w] = static_cast<int>(quads.size());
-    quads.push_back({w, v, copy[v], copy[w]});
+  void add_layer_quads(const std::vector<std::pair<int, int>>& along) {
+    layer_from_.assign(n0_, -1);
+    layer_to_.assign(n0_, -1);
+    for (const auto& [v, w] : along) {
+      layer_from_[v] = static_cast<int>(m_.quads.size());
+      layer_to_[w] = static_cast<int>(m_.quads.size());
+      m_.quads.push_back({w, v, copy_[v], copy_[w]});
+    }
   }
+
   // A tip keeps one quad: where a node was the corner of one quad only, with
   // a corner below 150 degrees (a convex tip of the coast, not the flat corner
   // the layer is for), its two layer quads and its old quad form a hexagon
@@ -168,20 +193,22 @@ std::size_t pillow_rings(LayoutMesh& m, const std::vector<char>& pillow) {
   // straight sides; it may be folded where the moved nodes crowd a thin tip:
   // the node optimization that follows untangles it, and the checks on the
   // true geometry still hold the layout to account).
-  std::vector<char> resplit(quads.size(), 0);  // old quads already part of a hexagon
-  for (std::size_t v = 0; v < n0; ++v) {
-    if (copy[v] < 0 || quads_of[v].size() != 1 || layer_from[v] < 0 || layer_to[v] < 0) continue;
-    const int q = quads_of[v].front();
-    if (resplit[q]) continue;
+  void keep_one_quad_at_tip(int v, std::vector<char>& resplit) {
+    auto& quads = m_.quads;
+    const auto& x = m_.x;
+    const int n0 = static_cast<int>(n0_);
+    if (copy_[v] < 0 || quads_of_[v].size() != 1 || layer_from_[v] < 0 || layer_to_[v] < 0) return;
+    const int q = quads_of_[v].front();
+    if (resplit[q]) return;
     int j = 0;
-    while (j < 4 && quads[q][j] != static_cast<int>(v)) ++j;
-    if (j == 4) continue;
+    while (j < 4 && quads[q][j] != v) ++j;
+    if (j == 4) return;
     const int b = quads[q][(j + 1) % 4], X = quads[q][(j + 2) % 4], a = quads[q][(j + 3) % 4];
-    if (b >= static_cast<int>(n0) || a >= static_cast<int>(n0) || copy[a] < 0 || copy[b] < 0) continue;
-    const Eigen::Vector2d tip = x[copy[v]];
-    const double sn = corner_sj(tip, x[copy[b]], x[copy[a]]);
-    if (!(sn > 0.5 || (sn > 0.0 && (x[copy[b]] - tip).dot(x[copy[a]] - tip) > 0.0))) continue;
-    const int ar = copy[a], vr = copy[v], br = copy[b];
+    if (b >= n0 || a >= n0 || copy_[a] < 0 || copy_[b] < 0) return;
+    const Eigen::Vector2d tip = x[copy_[v]];
+    const double sn = corner_sj(tip, x[copy_[b]], x[copy_[a]]);
+    if (!(sn > 0.5 || (sn > 0.0 && (x[copy_[b]] - tip).dot(x[copy_[a]] - tip) > 0.0))) return;
+    const int ar = copy_[a], vr = copy_[v], br = copy_[b];
     const std::array<std::array<int, 4>, 2> split_a = {{{ar, vr, br, b}, {b, X, a, ar}}};
     const std::array<std::array<int, 4>, 2> split_b = {{{a, ar, vr, br}, {br, b, X, a}}};
     auto worst = [&](const std::array<std::array<int, 4>, 2>& s2) {
@@ -191,23 +218,39 @@ std::size_t pillow_rings(LayoutMesh& m, const std::vector<char>& pillow) {
       return w;
     };
     const auto& best = worst(split_a) >= worst(split_b) ? split_a : split_b;
-    const int kept = layer_from[v], gone = layer_to[v];
+    const int kept = layer_from_[v], gone = layer_to_[v];
     resplit[q] = 1;
     quads[q] = best[0];
     quads[kept] = best[1];
     // Neither is a layer quad any more; `gone` is removed, the last quad takes its place.
-    for (std::vector<int>* l : {&layer_from, &layer_to})
+    for (std::vector<int>* l : {&layer_from_, &layer_to_})
       for (int& f : *l)
         if (f == kept || f == gone) f = -1;
     const int last = static_cast<int>(quads.size()) - 1;
     if (gone != last) {
       quads[gone] = quads[last];
-      for (std::vector<int>* l : {&layer_from, &layer_to})
+      for (std::vector<int>* l : {&layer_from_, &layer_to_})
         for (int& f : *l)
           if (f == last) f = gone;
     }
     quads.pop_back();
   }
+
+  LayoutMesh& m_;
+  const std::vector<char>& pillow_;
+  const std::size_t n0_;                     // nodes before the pillowing
+  std::vector<std::vector<int>> quads_of_;   // the quads at each old node
+  std::vector<int> copy_;                    // the ring copy of each pillowed node (-1: none)
+  std::vector<int> layer_from_, layer_to_;   // the layer quad whose ring edge starts / ends at a node
+};
+
+}  // namespace
+
+std::size_t pillow_rings(LayoutMesh& m, const std::vector<char>& pillow) {
+  std::size_t count = 0;
+  for (const char p : pillow) count += p;
+  if (count == 0) return 0;
+  Pillowing(m, pillow).run();
   return count;
 }
 

@@ -55,26 +55,20 @@ void mark_levels(CDT& cdt) {
   }
 }
 
-}  // namespace
+// Samples of the rings: the vertices, and points on long edges so that no gap
+// exceeds `spacing`; inserted in `cdt` with the rings as constraints.
+struct RingSamples {
+  std::vector<Eigen::Vector2d> points;
+  std::vector<double> ring_length;
+};
 
-SizeField::SizeField(const Domain& d, const SizeFieldOptions& o) {
-  Eigen::Vector2d lo = d.outer.vertices.front(), hi = lo;
-  for (const auto& v : d.outer.vertices) lo = lo.cwiseMin(v), hi = hi.cwiseMax(v);
-  const double diag = (hi - lo).norm();
-  max_size_ = o.max_size > 0.0 ? o.max_size : 0.125 * diag;
-  min_size_ = std::min(o.min_size, max_size_);
-
-  // Ring samples: the vertices, and points on long edges so that no gap exceeds spacing.
-  const double spacing = diag / 400.0;
+RingSamples sample_rings(const Domain& d, double spacing, CDT& cdt) {
   std::vector<const Polygon*> rings = {&d.outer};
   for (const Polygon& h : d.holes) rings.push_back(&h);
-  std::vector<Eigen::Vector2d> pts;
-  std::vector<SampleInfo> info;
-  std::vector<double> ring_length;
-  CDT cdt;
+  RingSamples out;
   for (std::size_t r = 0; r < rings.size(); ++r) {
     const RingCurve ring(rings[r]->vertices);
-    ring_length.push_back(ring.length());
+    out.ring_length.push_back(ring.length());
     std::vector<CDT::Vertex_handle> handles;
     for (std::size_t i = 0; i < ring.size(); ++i) {
       const Eigen::Vector2d a = ring.vertex(i), b = ring.vertex(i + 1);
@@ -84,40 +78,92 @@ SizeField::SizeField(const Domain& d, const SizeFieldOptions& o) {
         const Eigen::Vector2d p = a + t * (b - a);
         CDT::Vertex_handle vh = cdt.insert(K::Point_2(p.x(), p.y()));
         if (vh->info().sample < 0) {
-          vh->info() = {static_cast<int>(r), ring.arc(i) + t * (b - a).norm(), static_cast<int>(pts.size())};
-          pts.push_back(p);
-          info.push_back(vh->info());
+          vh->info() = {static_cast<int>(r), ring.arc(i) + t * (b - a).norm(), static_cast<int>(out.points.size())};
+          out.points.push_back(p);
         }
         handles.push_back(vh);
       }
     }
     for (std::size_t k = 0; k < handles.size(); ++k)
-      if (handles[k] != handles[(k + 1) % handles.size()]) cdt.insert_constraint(handles[k], handles[(k + 1) % handles.size()]);
+      if (handles[k] != handles[(k + 1) % handles.size()])
+        cdt.insert_constraint(handles[k], handles[(k + 1) % handles.size()]);
   }
-  mark_levels(cdt);
-  // Widths: shortest inside edge to a sample "across".
-  std::vector<double> width(pts.size(), std::numeric_limits<double>::infinity());
-  std::vector<char> between_rings(pts.size(), 0);  // the width is a gap to another ring
+  return out;
+}
+
+// The local width at each sample: its shortest edge inside the domain to a
+// sample "across" (on another ring, or on its own ring more than across_ratio
+// times the edge's length away along the ring); infinite where none is.
+struct LocalWidths {
+  std::vector<double> width;
+  std::vector<char> between_rings;  // the width is a gap to another ring
+};
+
+LocalWidths local_widths(const CDT& cdt, const RingSamples& samples, double across_ratio) {
+  LocalWidths w{std::vector<double>(samples.points.size(), std::numeric_limits<double>::infinity()),
+                std::vector<char>(samples.points.size(), 0)};
   for (auto e = cdt.finite_edges_begin(); e != cdt.finite_edges_end(); ++e) {
     CDT::Face_handle f = e->first, g = f->neighbor(e->second);
     const bool inside = (f->info() % 2 == 1 && !cdt.is_infinite(f)) || (g->info() % 2 == 1 && !cdt.is_infinite(g));
     if (!inside || cdt.is_constrained(*e)) continue;
     const SampleInfo a = f->vertex(CDT::cw(e->second))->info(), b = f->vertex(CDT::ccw(e->second))->info();
     if (a.sample < 0 || b.sample < 0) continue;
-    const double dist = (pts[a.sample] - pts[b.sample]).norm();
+    const double dist = (samples.points[a.sample] - samples.points[b.sample]).norm();
     bool across = a.ring != b.ring;
     if (!across) {
-      const double L = ring_length[a.ring];
+      const double L = samples.ring_length[a.ring];
       double arc = std::abs(a.arc - b.arc);
       arc = std::min(arc, L - arc);
-      across = arc > o.across_ratio * dist;
+      across = arc > across_ratio * dist;
     }
     if (!across) continue;
     for (const int k : {a.sample, b.sample})
-      if (dist < width[k]) width[k] = dist, between_rings[k] = a.ring != b.ring;
+      if (dist < w.width[k]) w.width[k] = dist, w.between_rings[k] = a.ring != b.ring;
   }
+  return w;
+}
+
+// Grading of a grid of node values: two chamfer passes make
+// h(node) <= h(neighbour) + g |node - neighbour| over the 8 neighbours.
+template <class At>
+void chamfer(At& at, int nx, int ny, double g, double cell) {
+  const double a1 = g * cell, a2 = g * cell * std::sqrt(2.0);
+  for (int j = 0; j <= ny; ++j)
+    for (int i = 0; i <= nx; ++i) {
+      double& v = at(i, j);
+      if (i > 0) v = std::min(v, at(i - 1, j) + a1);
+      if (j > 0) {
+        v = std::min(v, at(i, j - 1) + a1);
+        if (i > 0) v = std::min(v, at(i - 1, j - 1) + a2);
+        if (i < nx) v = std::min(v, at(i + 1, j - 1) + a2);
+      }
+    }
+  for (int j = ny; j >= 0; --j)
+    for (int i = nx; i >= 0; --i) {
+      double& v = at(i, j);
+      if (i < nx) v = std::min(v, at(i + 1, j) + a1);
+      if (j < ny) {
+        v = std::min(v, at(i, j + 1) + a1);
+        if (i < nx) v = std::min(v, at(i + 1, j + 1) + a2);
+        if (i > 0) v = std::min(v, at(i - 1, j + 1) + a2);
+      }
+    }
+}
+
+}  // namespace
+
+SizeField::SizeField(const Domain& d, const SizeFieldOptions& o) {
+  Eigen::Vector2d lo = d.outer.vertices.front(), hi = lo;
+  for (const auto& v : d.outer.vertices) lo = lo.cwiseMin(v), hi = hi.cwiseMax(v);
+  const double diag = (hi - lo).norm();
+  max_size_ = o.max_size > 0.0 ? o.max_size : 0.125 * diag;
+  min_size_ = std::min(o.min_size, max_size_);
+  CDT cdt;
+  const RingSamples samples = sample_rings(d, diag / 400.0, cdt);
+  mark_levels(cdt);
+  const LocalWidths w = local_widths(cdt, samples, o.across_ratio);
   min_width_ = std::numeric_limits<double>::infinity();
-  for (double w : width) min_width_ = std::min(min_width_, w);
+  for (double x : w.width) min_width_ = std::min(min_width_, x);
 
   // Background grid over the bounding box, one cell of margin.
   const int n = std::max(o.grid_cells, 8);
@@ -127,43 +173,22 @@ SizeField::SizeField(const Domain& d, const SizeFieldOptions& o) {
   ny_ = static_cast<int>(std::ceil((hi.y() - lo.y()) / cell_)) + 2;
   h_.assign(static_cast<std::size_t>(nx_ + 1) * (ny_ + 1), max_size_);
   auto at = [&](int i, int j) -> double& { return h_[static_cast<std::size_t>(j) * (nx_ + 1) + i]; };
-  const double g = o.grading;
-  for (std::size_t s = 0; s < pts.size(); ++s) {
-    if (!std::isfinite(width[s])) continue;
+  for (std::size_t s = 0; s < samples.points.size(); ++s) {
+    if (!std::isfinite(w.width[s])) continue;
     // A gap between two rings is always resolved (two islands must not share a
     // patch side); min_size only spares the narrow places of one ring.
-    const double floor = between_rings[s] ? 0.0 : min_size_;
-    const double v = std::clamp(o.factor * width[s], floor, max_size_);
-    const int i = std::clamp(static_cast<int>((pts[s].x() - lo_.x()) / cell_), 0, nx_ - 1);
-    const int j = std::clamp(static_cast<int>((pts[s].y() - lo_.y()) / cell_), 0, ny_ - 1);
+    const double floor = w.between_rings[s] ? 0.0 : min_size_;
+    const double v = std::clamp(o.factor * w.width[s], floor, max_size_);
+    const Eigen::Vector2d& x = samples.points[s];
+    const int i = std::clamp(static_cast<int>((x.x() - lo_.x()) / cell_), 0, nx_ - 1);
+    const int j = std::clamp(static_cast<int>((x.y() - lo_.y()) / cell_), 0, ny_ - 1);
     for (int di = 0; di <= 1; ++di)
       for (int dj = 0; dj <= 1; ++dj) {
         const Eigen::Vector2d node = lo_ + cell_ * Eigen::Vector2d(i + di, j + dj);
-        at(i + di, j + dj) = std::min(at(i + di, j + dj), v + g * (node - pts[s]).norm());
+        at(i + di, j + dj) = std::min(at(i + di, j + dj), v + o.grading * (node - x).norm());
       }
   }
-  // Two chamfer passes: h(node) <= h(neighbour) + g |node - neighbour|.
-  const double a1 = g * cell_, a2 = g * cell_ * std::sqrt(2.0);
-  for (int j = 0; j <= ny_; ++j)
-    for (int i = 0; i <= nx_; ++i) {
-      double& v = at(i, j);
-      if (i > 0) v = std::min(v, at(i - 1, j) + a1);
-      if (j > 0) {
-        v = std::min(v, at(i, j - 1) + a1);
-        if (i > 0) v = std::min(v, at(i - 1, j - 1) + a2);
-        if (i < nx_) v = std::min(v, at(i + 1, j - 1) + a2);
-      }
-    }
-  for (int j = ny_; j >= 0; --j)
-    for (int i = nx_; i >= 0; --i) {
-      double& v = at(i, j);
-      if (i < nx_) v = std::min(v, at(i + 1, j) + a1);
-      if (j < ny_) {
-        v = std::min(v, at(i, j + 1) + a1);
-        if (i < nx_) v = std::min(v, at(i + 1, j + 1) + a2);
-        if (i > 0) v = std::min(v, at(i - 1, j + 1) + a2);
-      }
-    }
+  chamfer(at, nx_, ny_, o.grading, cell_);
 }
 
 double SizeField::operator()(const Eigen::Vector2d& x) const {

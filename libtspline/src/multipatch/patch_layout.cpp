@@ -77,92 +77,118 @@ struct Graph {
   std::vector<std::vector<int>> outgoing;
 };
 
-Graph build_graph(const Domain& d, const std::vector<Cut>& cuts, const std::vector<Eigen::Vector2d>& ring_corners) {
-  Graph g;
-  const double tol = snap_tolerance(d);
-  // Ring vertices first (ring r, vertex i -> ring_first[r] + i).
-  std::vector<std::size_t> ring_first;
-  for (std::size_t r = 0; r < ring_count(d); ++r) {
-    ring_first.push_back(g.points.size());
-    for (const auto& v : ring(d, r).vertices) g.points.push_back(v);
+// The building of a Graph: ring vertices first (ring r, vertex i ->
+// ring_first_[r] + i), then the cuts' ends and inner points, then the half-edges.
+class GraphBuilder {
+ public:
+  explicit GraphBuilder(const Domain& d) : d_(d), tol_(snap_tolerance(d)) {
+    for (std::size_t r = 0; r < ring_count(d); ++r) {
+      ring_first_.push_back(g_.points.size());
+      for (const auto& v : ring(d, r).vertices) g_.points.push_back(v);
+    }
+    g_.is_node.assign(g_.points.size(), 0);
   }
-  g.is_node.assign(g.points.size(), 0);
-  // Cut ends: an end of an earlier cut, a ring vertex, or a new vertex on a ring edge.
-  std::map<std::pair<std::size_t, std::size_t>, std::vector<std::pair<double, int>>> inserted;
-  std::vector<std::vector<int>> cut_ids(cuts.size());
-  // Ends found so far, by a grid of cells of size tol (a match lies in one of the 3 x 3 cells around).
-  std::map<std::pair<long long, long long>, std::vector<int>> ends;
-  auto cell_of = [&](const Eigen::Vector2d& p) {
-    return std::pair<long long, long long>(static_cast<long long>(std::floor(p.x() / tol)),
-                                           static_cast<long long>(std::floor(p.y() / tol)));
-  };
-  auto end_id = [&](const Eigen::Vector2d& p) {
+
+  Graph build(const std::vector<Cut>& cuts, const std::vector<Eigen::Vector2d>& ring_corners) {
+    for (const Eigen::Vector2d& p : ring_corners) end_id(p);
+    std::vector<std::vector<int>> cut_ids(cuts.size());
+    for (std::size_t c = 0; c < cuts.size(); ++c) {
+      cut_ids[c].push_back(end_id(cuts[c].front()));
+      for (std::size_t k = 1; k + 1 < cuts[c].size(); ++k) cut_ids[c].push_back(new_point(cuts[c][k]));
+      cut_ids[c].push_back(end_id(cuts[c].back()));
+    }
+    add_ring_edges();
+    for (std::size_t c = 0; c < cuts.size(); ++c)
+      for (std::size_t k = 0; k + 1 < cut_ids[c].size(); ++k) {
+        add(cut_ids[c][k], cut_ids[c][k + 1], static_cast<int>(c));
+        add(cut_ids[c][k + 1], cut_ids[c][k], static_cast<int>(c));
+      }
+    g_.outgoing.assign(g_.points.size(), {});
+    for (std::size_t h = 0; h < g_.half_edges.size(); ++h)
+      g_.outgoing[g_.half_edges[h].from].push_back(static_cast<int>(h));
+    return std::move(g_);
+  }
+
+ private:
+  using Cell = std::pair<long long, long long>;
+  Cell cell_of(const Eigen::Vector2d& p) const {
+    return {static_cast<long long>(std::floor(p.x() / tol_)), static_cast<long long>(std::floor(p.y() / tol_))};
+  }
+  int new_point(const Eigen::Vector2d& p) {
+    g_.points.push_back(p);
+    g_.is_node.push_back(0);
+    return static_cast<int>(g_.points.size()) - 1;
+  }
+  void add(int a, int b, int cut) { g_.half_edges.push_back({a, b, cut}); }
+
+  // A cut end (or a given ring corner): an end found before within tol, a
+  // ring vertex, a new vertex on a ring edge, or a new node inside the domain
+  // where cuts meet (the first of them to arrive there).
+  int end_id(const Eigen::Vector2d& p) {
     const auto [ci, cj] = cell_of(p);
     for (long long i = ci - 1; i <= ci + 1; ++i)
       for (long long j = cj - 1; j <= cj + 1; ++j) {
-        auto it = ends.find({i, j});
-        if (it == ends.end()) continue;
+        auto it = ends_.find({i, j});
+        if (it == ends_.end()) continue;
         for (int e : it->second)
-          if ((g.points[e] - p).norm() <= tol) return e;
+          if ((g_.points[e] - p).norm() <= tol_) return e;
       }
-    const RingHit h = closest_ring_point(d, p);
-    const auto& v = ring(d, h.ring).vertices;
+    const RingHit h = closest_ring_point(d_, p);
+    const auto& v = ring(d_, h.ring).vertices;
     const Eigen::Vector2d a = v[h.edge], b = v[(h.edge + 1) % v.size()];
     int id;
-    if (h.distance > tol) {
-      // Inside the domain: a node where cuts meet (the first of them to arrive here).
-      id = static_cast<int>(g.points.size());
-      g.points.push_back(p);
-      g.is_node.push_back(0);
-    } else if ((a - p).norm() <= tol) id = static_cast<int>(ring_first[h.ring] + h.edge);
-    else if ((b - p).norm() <= tol) id = static_cast<int>(ring_first[h.ring] + (h.edge + 1) % v.size());
-    else {
-      id = static_cast<int>(g.points.size());
-      g.points.push_back(a + h.s * (b - a));
-      g.is_node.push_back(0);
-      inserted[{h.ring, h.edge}].push_back({h.s, id});
+    if (h.distance > tol_) {
+      id = new_point(p);
+    } else if ((a - p).norm() <= tol_) {
+      id = static_cast<int>(ring_first_[h.ring] + h.edge);
+    } else if ((b - p).norm() <= tol_) {
+      id = static_cast<int>(ring_first_[h.ring] + (h.edge + 1) % v.size());
+    } else {
+      id = new_point(a + h.s * (b - a));
+      inserted_[{h.ring, h.edge}].push_back({h.s, id});
     }
-    g.is_node[id] = 1;
-    ends[cell_of(p)].push_back(id);
+    g_.is_node[id] = 1;
+    ends_[cell_of(p)].push_back(id);
     return id;
-  };
-  for (const Eigen::Vector2d& p : ring_corners) end_id(p);
-  for (std::size_t c = 0; c < cuts.size(); ++c) {
-    cut_ids[c].push_back(end_id(cuts[c].front()));
-    for (std::size_t k = 1; k + 1 < cuts[c].size(); ++k) {
-      cut_ids[c].push_back(static_cast<int>(g.points.size()));
-      g.points.push_back(cuts[c][k]);
-      g.is_node.push_back(0);
-    }
-    cut_ids[c].push_back(end_id(cuts[c].back()));
   }
-  auto add = [&](int a, int b, int cut) { g.half_edges.push_back({a, b, cut}); };
-  for (std::size_t r = 0; r < ring_count(d); ++r) {
-    const std::size_t n = ring(d, r).vertices.size();
-    std::vector<int> seq;
-    for (std::size_t i = 0; i < n; ++i) {
-      seq.push_back(static_cast<int>(ring_first[r] + i));
-      auto it = inserted.find({r, i});
-      if (it == inserted.end()) continue;
-      auto on_edge = it->second;
-      std::sort(on_edge.begin(), on_edge.end());
-      for (const auto& [s, id] : on_edge) seq.push_back(id);
-    }
-    // The domain lies left of the outer ring (CCW) and right of each hole (CCW): walk holes backwards.
-    for (std::size_t i = 0; i < seq.size(); ++i) {
-      const int a = seq[i], b = seq[(i + 1) % seq.size()];
-      if (r == 0) add(a, b, -1);
-      else add(b, a, -1);
+
+  // Each ring's edges, split at the cut ends inserted on them. The domain lies
+  // left of the outer ring (CCW) and right of each hole (CCW): holes are
+  // walked backwards.
+  void add_ring_edges() {
+    for (std::size_t r = 0; r < ring_count(d_); ++r) {
+      const std::size_t n = ring(d_, r).vertices.size();
+      std::vector<int> seq;
+      for (std::size_t i = 0; i < n; ++i) {
+        seq.push_back(static_cast<int>(ring_first_[r] + i));
+        auto it = inserted_.find({r, i});
+        if (it == inserted_.end()) continue;
+        auto on_edge = it->second;
+        std::sort(on_edge.begin(), on_edge.end());
+        for (const auto& [s, id] : on_edge) seq.push_back(id);
+      }
+      for (std::size_t i = 0; i < seq.size(); ++i) {
+        const int a = seq[i], b = seq[(i + 1) % seq.size()];
+        if (r == 0)
+          add(a, b, -1);
+        else
+          add(b, a, -1);
+      }
     }
   }
-  for (std::size_t c = 0; c < cuts.size(); ++c)
-    for (std::size_t k = 0; k + 1 < cut_ids[c].size(); ++k) {
-      add(cut_ids[c][k], cut_ids[c][k + 1], static_cast<int>(c));
-      add(cut_ids[c][k + 1], cut_ids[c][k], static_cast<int>(c));
-    }
-  g.outgoing.assign(g.points.size(), {});
-  for (std::size_t h = 0; h < g.half_edges.size(); ++h) g.outgoing[g.half_edges[h].from].push_back(static_cast<int>(h));
-  return g;
+
+  const Domain& d_;
+  const double tol_;
+  Graph g_;
+  std::vector<std::size_t> ring_first_;
+  // Vertices inserted on ring edges: (ring, edge) -> (edge parameter, id).
+  std::map<std::pair<std::size_t, std::size_t>, std::vector<std::pair<double, int>>> inserted_;
+  // Ends found so far, by a grid of cells of size tol (a match lies in one of the 3 x 3 cells around).
+  std::map<Cell, std::vector<int>> ends_;
+};
+
+Graph build_graph(const Domain& d, const std::vector<Cut>& cuts, const std::vector<Eigen::Vector2d>& ring_corners) {
+  return GraphBuilder(d).build(cuts, ring_corners);
 }
 
 double angle_of(const Eigen::Vector2d& v) { return std::atan2(v.y(), v.x()); }
@@ -242,8 +268,11 @@ std::vector<LayoutFace> layout_faces(const Domain& domain, const std::vector<Cut
   return out;
 }
 
-void validate_cuts(const Domain& d, const std::vector<Cut>& cuts) {
-  const double tol = snap_tolerance(d);
+namespace {
+
+// Each cut: two or more finite points, none repeated, each end on a ring or at
+// an end of another cut, and its first segment inside the domain.
+void check_cut_points(const Domain& d, const std::vector<Cut>& cuts, double tol) {
   // The cuts' ends by cells of size tol (a match lies in one of the 3 x 3 cells around a point).
   auto end_cell = [&](const Eigen::Vector2d& p) {
     return std::pair<long long, long long>(static_cast<long long>(std::floor(p.x() / tol)),
@@ -279,6 +308,9 @@ void validate_cuts(const Domain& d, const std::vector<Cut>& cuts) {
     if (!domain_contains(d, 0.5 * (cuts[c][0] + cuts[c][1])))
       throw InputError(name + " runs outside the domain near " + fmt(0.5 * (cuts[c][0] + cuts[c][1])));
   }
+}
+
+void check_cuts_against_rings(const Domain& d, const std::vector<Cut>& cuts, double tol) {
   // Cut segments against ring edges: they may meet only at the cut's own ends.
   auto near_end = [&](const Cut& cut, const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
     for (const Eigen::Vector2d& e : {cut.front(), cut.back()})
@@ -312,6 +344,9 @@ void validate_cuts(const Domain& d, const std::vector<Cut>& cuts) {
       }
     }
   }
+}
+
+void check_cuts_against_cuts(const std::vector<Cut>& cuts, double tol) {
   // Cuts against cuts (and a cut against itself): they may share ends only.
   // Segments swept in order of their smallest x, each tested against the
   // active ones whose boxes overlap its own.
@@ -359,6 +394,82 @@ void validate_cuts(const Domain& d, const std::vector<Cut>& cuts) {
   }
 }
 
+}  // namespace
+
+void validate_cuts(const Domain& d, const std::vector<Cut>& cuts) {
+  const double tol = snap_tolerance(d);
+  check_cut_points(d, cuts, tol);
+  check_cuts_against_rings(d, cuts, tol);
+  check_cuts_against_cuts(cuts, tol);
+}
+
+namespace {
+
+// The patch of face f of the layout (ids: its vertices in the graph, for the
+// simplicity check): its cut ends are its corners, completed to four by its
+// sharpest convex ring vertices.
+Patch patch_of_face(const LayoutFace& f, const std::vector<int>& ids) {
+  const std::size_t n = f.points.size();
+  double area2 = 0.0;
+  for (std::size_t i = 0; i < n; ++i) area2 += cross(f.points[i], f.points[(i + 1) % n]);
+  if (!(area2 > 0.0))
+    throw InputError("a ring near " + fmt(f.points.front()) +
+                     " is not connected to the others by cuts: every hole needs at least two cuts");
+  std::vector<int> sorted = ids;
+  std::sort(sorted.begin(), sorted.end());
+  if (std::adjacent_find(sorted.begin(), sorted.end()) != sorted.end())
+    throw InputError(face_name(f) + " is not simply connected or touches itself: every hole needs at least "
+                                    "two cuts, and cuts must split the domain into simple four-sided patches");
+  std::vector<std::size_t> corners;
+  for (std::size_t i = 0; i < n; ++i)
+    if (f.is_node[i]) corners.push_back(i);
+  if (corners.size() > 4)
+    throw InputError(face_name(f) + " has " + std::to_string(corners.size()) +
+                     " cut ends on its boundary; a four-sided patch can have at most four (its corners)");
+  // Missing corners: the sharpest convex ring vertices.
+  if (corners.size() < 4) {
+    std::vector<std::pair<double, std::size_t>> cand;
+    for (std::size_t i = 0; i < n; ++i)
+      if (!f.is_node[i]) cand.push_back({inner_angle(f.points, i), i});
+    std::sort(cand.begin(), cand.end());
+    for (const auto& [angle, i] : cand) {
+      if (corners.size() == 4 || angle >= std::numbers::pi * (1.0 - 1e-9)) break;
+      corners.push_back(i);
+    }
+    if (corners.size() < 4)
+      throw InputError(face_name(f) + " has only " + std::to_string(corners.size()) +
+                       " corners (cut ends and convex vertices): add cuts");
+    std::sort(corners.begin(), corners.end());
+  }
+  Patch p;
+  p.polygon.vertices = f.points;
+  p.polygon.file_index.resize(n);
+  for (std::size_t i = 0; i < n; ++i) p.polygon.file_index[i] = i;
+  for (int k = 0; k < 4; ++k) {
+    p.corners[k] = corners[k];
+    // Side k is a cut if its first edge is one (every cut end is a corner).
+    p.side_cut[k] = f.edge_cut[corners[k]];
+  }
+  return p;
+}
+
+// One interface per cut: the two patch sides it is.
+std::vector<Interface> interfaces_of(const std::vector<Patch>& patches, std::size_t cuts) {
+  std::vector<std::vector<std::pair<std::size_t, int>>> sides_of(cuts);
+  for (std::size_t q = 0; q < patches.size(); ++q)
+    for (int k = 0; k < 4; ++k)
+      if (patches[q].side_cut[k] >= 0) sides_of[patches[q].side_cut[k]].push_back({q, k});
+  std::vector<Interface> out;
+  for (std::size_t c = 0; c < cuts; ++c) {
+    const auto& sides = sides_of[c];
+    if (sides.size() != 2) throw InputError("cut " + std::to_string(c + 1) + " is not the side of two patches");
+    out.push_back({c, sides[0].first, sides[1].first, sides[0].second, sides[1].second});
+  }
+  return out;
+}
+
+}  // namespace
+
 PatchLayout build_patch_layout(const Domain& d, std::vector<Cut> cuts, const std::vector<Eigen::Vector2d>& ring_corners) {
   validate_cuts(d, cuts);
   for (const Eigen::Vector2d& p : ring_corners)
@@ -366,60 +477,8 @@ PatchLayout build_patch_layout(const Domain& d, std::vector<Cut> cuts, const std
       throw InputError("the patch corner " + fmt(p) + " does not lie on a ring");
   PatchLayout L;
   L.cuts = std::move(cuts);
-  for (auto& [f, ids] : faces_with_ids(d, L.cuts, ring_corners)) {
-    const std::size_t n = f.points.size();
-    double area2 = 0.0;
-    for (std::size_t i = 0; i < n; ++i) area2 += cross(f.points[i], f.points[(i + 1) % n]);
-    if (!(area2 > 0.0))
-      throw InputError("a ring near " + fmt(f.points.front()) +
-                       " is not connected to the others by cuts: every hole needs at least two cuts");
-    std::vector<int> sorted = ids;
-    std::sort(sorted.begin(), sorted.end());
-    if (std::adjacent_find(sorted.begin(), sorted.end()) != sorted.end())
-      throw InputError(face_name(f) + " is not simply connected or touches itself: every hole needs at least "
-                                      "two cuts, and cuts must split the domain into simple four-sided patches");
-    std::vector<std::size_t> corners;
-    for (std::size_t i = 0; i < n; ++i)
-      if (f.is_node[i]) corners.push_back(i);
-    if (corners.size() > 4)
-      throw InputError(face_name(f) + " has " + std::to_string(corners.size()) +
-                       " cut ends on its boundary; a four-sided patch can have at most four (its corners)");
-    // Missing corners: the sharpest convex ring vertices.
-    if (corners.size() < 4) {
-      std::vector<std::pair<double, std::size_t>> cand;
-      for (std::size_t i = 0; i < n; ++i)
-        if (!f.is_node[i]) cand.push_back({inner_angle(f.points, i), i});
-      std::sort(cand.begin(), cand.end());
-      for (const auto& [angle, i] : cand) {
-        if (corners.size() == 4 || angle >= std::numbers::pi * (1.0 - 1e-9)) break;
-        corners.push_back(i);
-      }
-      if (corners.size() < 4)
-        throw InputError(face_name(f) + " has only " + std::to_string(corners.size()) +
-                         " corners (cut ends and convex vertices): add cuts");
-      std::sort(corners.begin(), corners.end());
-    }
-    Patch p;
-    p.polygon.vertices = f.points;
-    p.polygon.file_index.resize(n);
-    for (std::size_t i = 0; i < n; ++i) p.polygon.file_index[i] = i;
-    for (int k = 0; k < 4; ++k) {
-      p.corners[k] = corners[k];
-      // Side k is a cut if its first edge is one (every cut end is a corner).
-      p.side_cut[k] = f.edge_cut[corners[k]];
-    }
-    L.patches.push_back(std::move(p));
-  }
-  std::vector<std::vector<std::pair<std::size_t, int>>> sides_of(L.cuts.size());
-  for (std::size_t q = 0; q < L.patches.size(); ++q)
-    for (int k = 0; k < 4; ++k)
-      if (L.patches[q].side_cut[k] >= 0) sides_of[L.patches[q].side_cut[k]].push_back({q, k});
-  for (std::size_t c = 0; c < L.cuts.size(); ++c) {
-    const auto& sides = sides_of[c];
-    if (sides.size() != 2)
-      throw InputError("cut " + std::to_string(c + 1) + " is not the side of two patches");
-    L.interfaces.push_back({c, sides[0].first, sides[1].first, sides[0].second, sides[1].second});
-  }
+  for (auto& [f, ids] : faces_with_ids(d, L.cuts, ring_corners)) L.patches.push_back(patch_of_face(f, ids));
+  L.interfaces = interfaces_of(L.patches, L.cuts.size());
   return L;
 }
 
