@@ -91,18 +91,17 @@ TEST_SUITE("bezier_export") {
     const fs::path d = test_support::scratch_dir("bezier_export", "app");
     const fs::path map = test_support::param_polygon("disk.txt", d / "disk", "--layout single");
     const fs::path out = d / "disk_bezier.json";
-    const auto r =
-        test_support::run_app("export " + test_support::quoted(map) + " --bezier " + test_support::quoted(out), d);
-    CAPTURE(r.err);
-    REQUIRE(r.exit_code == 0);
+    const auto r = test_support::require_success(
+        test_support::run_app("export " + test_support::quoted(map) + " --bezier " + test_support::quoted(out), d));
     CHECK(test_support::contains(r.out, "Bezier elements"));
     const json doc = json::parse(test_support::slurp(out));
     CHECK(doc["version"] == 1);
     CHECK(!doc["elements"].empty());
-    const auto bad = test_support::run_app(
-        "export " + test_support::quoted(d / "nonesuch.json") + " --bezier " + test_support::quoted(d / "x.json"), d);
-    CHECK(bad.exit_code == 2);
-    CHECK(test_support::count_lines(bad.err) == 1);
+    // A map that does not exist: exit 2, one line naming it.
+    test_support::check_bad_invocation(
+        {"export " + test_support::quoted(d / "nonesuch.json") + " --bezier " + test_support::quoted(d / "x.json"),
+         "nonesuch.json", 2},
+        d);
     CHECK(!fs::exists(d / "x.json"));
   }
 }

@@ -195,10 +195,8 @@ TEST_SUITE("msh_export") {
     const fs::path d = test_support::scratch_dir("msh_export", "app");
     const fs::path map = test_support::param_polygon("disk.txt", d / "disk");
     const fs::path out = d / "disk.msh";
-    const auto r =
-        test_support::run_app("export " + test_support::quoted(map) + " --msh " + test_support::quoted(out), d);
-    CAPTURE(r.err);
-    REQUIRE(r.exit_code == 0);
+    const auto r = test_support::require_success(
+        test_support::run_app("export " + test_support::quoted(map) + " --msh " + test_support::quoted(out), d));
     CHECK(test_support::contains(r.out, "Gmsh type 36"));
     const std::string text = test_support::slurp(out);
     CHECK(text.rfind("$MeshFormat\n4.1 0 8\n", 0) == 0);
@@ -207,10 +205,11 @@ TEST_SUITE("msh_export") {
     const auto none = test_support::run_app("export " + test_support::quoted(map), d);
     CHECK(none.exit_code == 1);
     CHECK(test_support::count_lines(none.err) == 1);
-    const auto bad = test_support::run_app(
-        "export " + test_support::quoted(d / "nonesuch.json") + " --msh " + test_support::quoted(d / "x.msh"), d);
-    CHECK(bad.exit_code == 2);
-    CHECK(test_support::count_lines(bad.err) == 1);
+    // A map that does not exist: exit 2, one line naming it.
+    test_support::check_bad_invocation(
+        {"export " + test_support::quoted(d / "nonesuch.json") + " --msh " + test_support::quoted(d / "x.msh"),
+         "nonesuch.json", 2},
+        d);
     CHECK(!fs::exists(d / "x.msh"));
   }
 }

@@ -14,6 +14,7 @@
 
 #include "test_support.h"
 #include "tspline/boundary/domain.h"
+#include "tspline/boundary/plane.h"
 #include "tspline/errors.h"
 #include "tspline/layout/layout_energy.h"
 #include "tspline/layout/layout_mesh.h"
@@ -27,6 +28,11 @@
 namespace {
 
 using V = Eigen::Vector2d;
+
+// The signed area of quad q of m with straight sides (> 0: counter-clockwise).
+double quad_area(const tspline::LayoutMesh& m, const std::array<int, 4>& q) {
+  return tspline::signed_area(std::vector<V>{m.x[q[0]], m.x[q[1]], m.x[q[2]], m.x[q[3]]});
+}
 
 // A layout whose nodes are the given ring vertices (ring 0, arc lengths along
 // it) followed by inner nodes.
@@ -404,14 +410,7 @@ TEST_SUITE("layout_quality") {
         CHECK_FALSE(((a == 0 && b == 3) || (a == 3 && b == 0)));
       }
     CHECK(shared == 1);
-    for (const auto& q : m.quads) {
-      double area = 0.0;
-      for (int k = 0; k < 4; ++k) {
-        const V &p = m.x[q[k]], &s = m.x[q[(k + 1) % 4]];
-        area += p.x() * s.y() - p.y() * s.x();
-      }
-      CHECK(area > 0.0);
-    }
+    for (const auto& q : m.quads) CHECK(quad_area(m, q) > 0.0);
   }
 
   TEST_CASE("opening: a crack tip split into two 169-degree corners gets a third quad, no rotation could") {
@@ -464,14 +463,7 @@ TEST_SUITE("layout_quality") {
     // Euler's count for a disk (quads = inner nodes + ring nodes / 2 - 1),
     // inner nodes of valence >= 3.
     const tspline::LayoutTopology t(m);
-    for (const auto& q : m.quads) {
-      double a = 0.0;
-      for (int k = 0; k < 4; ++k) {
-        const V &p = m.x[q[k]], &s = m.x[q[(k + 1) % 4]];
-        a += p.x() * s.y() - p.y() * s.x();
-      }
-      CHECK(a > 0.0);
-    }
+    for (const auto& q : m.quads) CHECK(quad_area(m, q) > 0.0);
     int on_ring = 0, inner = 0;
     for (int q = 0; q < static_cast<int>(m.quads.size()); ++q)
       for (int j = 0; j < 4; ++j) {
