@@ -27,6 +27,7 @@
 #include <vector>
 
 #include "commands.h"
+#include "exit_codes.h"
 #include "progress.h"
 #include "expression.h"
 #include "tspline/errors.h"
@@ -311,14 +312,8 @@ int run_poisson(const PoissonArgs& args) {
   // Other ranks fail alike (same input, same collective calls); only rank 0 prints the message.
   try {
     return run_poisson_process(args, session, t_start);
-  } catch (const tspline::InputError&) {
-    return 1;
-  } catch (const tspline::IoError&) {
-    return 2;
-  } catch (const tspline::NumericalError&) {
-    return 3;
-  } catch (const std::exception&) {
-    return 4;
+  } catch (...) {
+    return exit_code_for(std::current_exception());  // the same code as rank 0, without its message
   }
 }
 
