@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "tspline/boundary/plane.h"
 #include "tspline/errors.h"
 
 namespace tspline {
@@ -28,10 +29,7 @@ std::vector<double> arc_lengths(const Polygon& p) {
 // to the next point `b` and to the previous point `a`: the interior lies to the left
 // of the boundary, so the inner angle is the CCW rotation taking (b - v) to (a - v).
 double inner_angle(const Eigen::Vector2d& a, const Eigen::Vector2d& v, const Eigen::Vector2d& b) {
-  const Eigen::Vector2d u = b - v, w = a - v;
-  double ang = std::atan2(u.x() * w.y() - u.y() * w.x(), u.dot(w)) * 180.0 / kPi;
-  if (ang < 0) ang += 360.0;
-  return ang;
+  return ccw_degrees(b - v, a - v);
 }
 
 double local_angle(const Polygon& p, std::size_t i) {

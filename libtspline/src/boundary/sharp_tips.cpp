@@ -8,6 +8,7 @@
 #include <sstream>
 #include <utility>
 
+#include "tspline/boundary/plane.h"
 #include "tspline/boundary/polygon_validation.h"
 #include "tspline/errors.h"
 
@@ -16,15 +17,11 @@ namespace {
 
 using V = Eigen::Vector2d;
 
-double cross(const V& a, const V& b) { return a.x() * b.y() - a.y() * b.x(); }
-
 // The angle at p from the direction to q counter-clockwise to the direction
 // to r, in [0, 360) degrees: the inside angle of a counter-clockwise ring at
 // p when q is its next vertex and r its previous one.
-double ccw_degrees(const V& p, const V& q, const V& r) {
-  const V a = q - p, b = r - p;
-  const double d = std::atan2(cross(a, b), a.dot(b)) * 180.0 / std::numbers::pi;
-  return d < 0.0 ? d + 360.0 : d;
+double angle_at(const V& p, const V& q, const V& r) {
+  return ccw_degrees(q - p, r - p);
 }
 
 // From vertex i along the ring (step +1 or -1) a distance d: the vertices
@@ -88,8 +85,8 @@ std::optional<Cut> cut_at(const Polygon& p, std::size_t i, double d, bool hole) 
   // before it and the chord, at the ahead one between the chord and the ring after it.
   const std::size_t before = (c.back.last + n - 1) % n;  // the ring vertex before the back cut point
   const std::size_t after = (c.ahead.last + 1) % n;       // the ring vertex after the ahead cut point
-  c.angle_back = ccw_degrees(c.back.end, c.ahead.end, v[before]);
-  c.angle_ahead = ccw_degrees(c.ahead.end, v[after], c.back.end);
+  c.angle_back = angle_at(c.back.end, c.ahead.end, v[before]);
+  c.angle_ahead = angle_at(c.ahead.end, v[after], c.back.end);
   if (hole) c.angle_back = 360.0 - c.angle_back, c.angle_ahead = 360.0 - c.angle_ahead;
   return c;
 }
@@ -119,7 +116,7 @@ Polygon with_cut(const Polygon& p, std::size_t i, const Cut& c) {
 double domain_angle_degrees(const Polygon& ring, std::size_t i, bool hole) {
   const std::vector<V>& v = ring.vertices;
   const std::size_t n = v.size();
-  const double inside = ccw_degrees(v[i], v[(i + 1) % n], v[(i + n - 1) % n]);
+  const double inside = angle_at(v[i], v[(i + 1) % n], v[(i + n - 1) % n]);
   return hole ? 360.0 - inside : inside;
 }
 

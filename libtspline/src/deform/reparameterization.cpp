@@ -7,6 +7,7 @@
 #include <string>
 #include <utility>
 
+#include "tspline/boundary/plane.h"
 #include "tspline/boundary/boundary_map.h"
 #include "tspline/boundary/polygon_validation.h"
 #include "tspline/deform/boundary_deformation.h"
@@ -77,8 +78,7 @@ ParameterizationResult reparameterize(const TSplineMap& old_map, const Polygon& 
     const std::size_t n = moved.vertices.size(), i = corners[k];
     const Eigen::Vector2d a = moved.vertices[(i + 1) % n] - moved.vertices[i];
     const Eigen::Vector2d b = moved.vertices[(i + n - 1) % n] - moved.vertices[i];
-    c.inner_angle_deg[k] = std::atan2(a.x() * b.y() - a.y() * b.x(), a.dot(b)) * 180.0 / 3.14159265358979323846;
-    if (c.inner_angle_deg[k] < 0.0) c.inner_angle_deg[k] += 360.0;
+    c.inner_angle_deg[k] = ccw_degrees(a, b);
   }
   const BoundaryMap old_boundary(old_polygon, c);
   BoundaryMap new_boundary(moved, c);

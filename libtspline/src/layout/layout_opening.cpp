@@ -6,6 +6,7 @@
 #include <utility>
 #include <vector>
 
+#include "tspline/boundary/plane.h"
 #include "layout_local.h"
 #include "tspline/layout/layout_optimizer.h"
 #include "tspline/layout/layout_topology.h"
@@ -14,12 +15,6 @@ namespace tspline {
 namespace {
 
 using namespace layout_local;
-
-// The angle from a to b, counter-clockwise, in [0, 360) degrees.
-double ccw_degrees(const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
-  const double d = std::atan2(a.x() * b.y() - a.y() * b.x(), a.dot(b)) * 180.0 / std::numbers::pi;
-  return d < 0.0 ? d + 360.0 : d;
-}
 
 // The widest patch corner at node n, at the node itself (degrees).
 double widest_corner(const LayoutMesh& m, const LayoutTopology& t, const LayoutQuality& Q, int n) {

@@ -423,12 +423,12 @@ void QuadLayoutBuilder::mark_blunted_tips(const std::vector<std::vector<Eigen::V
       }
       // The domain's angle at the node from the forward to the backward direction
       // (the domain on the left of the outer ring, on the right of holes).
-      double phi = std::atan2(cross(near[0], near[1]), near[0].dot(near[1]));
+      double phi = signed_angle(near[0], near[1]);
       if (R_.direction(static_cast<int>(r)) < 0.0) phi = -phi;
       if (phi < 0.0) phi += 2.0 * std::numbers::pi;
       if (phi > std::numbers::pi / 3.0 && phi < 5.0 * std::numbers::pi / 3.0) continue;
       for (const int side : {0, 1}) {
-        const double angle = std::abs(std::atan2(cross(chord[side], near[side]), chord[side].dot(near[side])));
+        const double angle = std::abs(signed_angle(chord[side], near[side]));
         if (angle > 35.0 * std::numbers::pi / 180.0 && len[side] > 2.0 * node_options_.min_size)
           to_split_[r].insert(side == 0 ? k : (k + n - 1) % n);
       }

@@ -5,6 +5,8 @@
 #include <numbers>
 #include <utility>
 
+#include "tspline/boundary/plane.h"
+
 namespace tspline {
 
 RingCurve::RingCurve(const std::vector<Eigen::Vector2d>& vertices) : v_(vertices) {
@@ -50,7 +52,7 @@ Eigen::Vector2d RingCurve::direction(double s_in, double dir) const {
 double RingCurve::turn(std::size_t i) const {
   const std::size_t n = v_.size();
   const Eigen::Vector2d a = v_[i % n] - v_[(i + n - 1) % n], b = v_[(i + 1) % n] - v_[i % n];
-  return std::atan2(a.x() * b.y() - a.y() * b.x(), a.dot(b));
+  return signed_angle(a, b);
 }
 
 std::size_t RingCurve::first_vertex_after(double s) const {
@@ -159,7 +161,7 @@ std::vector<double> ring_nodes(const RingCurve& ring, const RingNodeOptions& o,
       const double h = size ? std::max(size(p), o.min_size) : 0.1 * L;
       const double l = std::min(0.25 * h, 0.1 * L);
       const Eigen::Vector2d u = ring.point(ring.arc(i) + l) - p, w = p - ring.point(ring.arc(i) - l);
-      const double turn = std::abs(std::atan2(w.x() * u.y() - w.y() * u.x(), w.dot(u)));
+      const double turn = std::abs(signed_angle(w, u));
       // A vertex sharp at its own edges (a spike or a crack narrower than the
       // quarter piece) is a node too, ahead of every other: inside a side it
       // leaves the patch map J_r about sin^2(phi / 2) there (layout_quality.h),

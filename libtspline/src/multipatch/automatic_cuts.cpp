@@ -18,12 +18,6 @@ namespace {
 constexpr double kPi = std::numbers::pi;
 
 
-// Angle from direction b counter-clockwise to direction a, in [0, 2 pi).
-double ccw_angle(const Eigen::Vector2d& b, const Eigen::Vector2d& a) {
-  double t = std::atan2(cross(b, a), b.dot(a));
-  return t < 0 ? t + 2.0 * kPi : t;
-}
-
 // A closed polyline with arc-length access.
 class Loop {
  public:

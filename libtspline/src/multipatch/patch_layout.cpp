@@ -237,10 +237,7 @@ std::vector<std::pair<LayoutFace, std::vector<int>>> faces_with_ids(const Domain
 // Interior angle (radians) of a CCW polygon at vertex i.
 double inner_angle(const std::vector<Eigen::Vector2d>& p, std::size_t i) {
   const std::size_t n = p.size();
-  const Eigen::Vector2d a = p[(i + n - 1) % n] - p[i], b = p[(i + 1) % n] - p[i];
-  double t = std::atan2(cross(b, a), b.dot(a));
-  if (t < 0) t += 2.0 * std::numbers::pi;
-  return t;
+  return ccw_angle(p[(i + 1) % n] - p[i], p[(i + n - 1) % n] - p[i]);
 }
 
 std::string face_name(const LayoutFace& f) {

@@ -1,8 +1,10 @@
 #pragma once
-// Plane geometry on Eigen vectors, in floating point: the cross product and the
-// signed area of a ring. (Predicates whose sign must be exact, such as whether
+// Plane geometry on Eigen vectors, in floating point: the cross product,
+// angles between directions and the signed area of a ring. (Predicates whose sign must be exact, such as whether
 // a ring is simple, use CGAL's exact predicates instead: polygon_validation.)
 #include <Eigen/Core>
+#include <cmath>
+#include <numbers>
 #include <vector>
 
 namespace tspline {
@@ -10,6 +12,26 @@ namespace tspline {
 /// a x b: the z component of the 3D cross product, twice the signed area of
 /// the triangle (0, a, b); > 0 when b lies counter-clockwise of a.
 inline double cross(const Eigen::Vector2d& a, const Eigen::Vector2d& b) { return a.x() * b.y() - a.y() * b.x(); }
+
+/// The angle that turns direction a into direction b, counter-clockwise
+/// positive, in [-pi, pi].
+inline double signed_angle(const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
+  return std::atan2(cross(a, b), a.dot(b));
+}
+
+/// The angle from direction a counter-clockwise to direction b, in [0, 2 pi):
+/// with a towards the next vertex of a counter-clockwise ring and b towards
+/// the previous one, the ring's inside angle there.
+inline double ccw_angle(const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
+  const double t = signed_angle(a, b);
+  return t < 0 ? t + 2.0 * std::numbers::pi : t;
+}
+
+/// ccw_angle in degrees, in [0, 360).
+inline double ccw_degrees(const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
+  const double d = signed_angle(a, b) * 180.0 / std::numbers::pi;
+  return d < 0.0 ? d + 360.0 : d;
+}
 
 /// The signed area of the closed ring (> 0 counter-clockwise), by the shoelace
 /// formula relative to the first vertex (less cancellation for rings far from
