@@ -210,6 +210,9 @@ TEST_SUITE("io") {
       CHECK(text.find("format=\"appended\"") != std::string::npos);
       CHECK(text.find("<AppendedData encoding=\"raw\">") != std::string::npos);
       CHECK(text.find("format=\"ascii\"") == std::string::npos);
+      // Connectivity and offsets in 32 bits (the writer checks that they fit).
+      CHECK(text.find("type=\"Int32\" Name=\"connectivity\"") != std::string::npos);
+      CHECK(text.find("type=\"Int32\" Name=\"offsets\"") != std::string::npos);
     }
   }
 

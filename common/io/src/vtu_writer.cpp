@@ -24,6 +24,7 @@
 #include <algorithm>
 #include <charconv>
 #include <cmath>
+#include <cstdint>
 #include <cstring>
 #include <exception>
 #include <functional>
@@ -213,6 +214,12 @@ vtkNew<vtkUnstructuredGrid> build_grid(std::span<Part> parts, const std::string&
   vtkNew<vtkCellArray> cells;
   vtkNew<vtkUnsignedCharArray> types;
   types->SetNumberOfTuples(static_cast<vtkIdType>(L.cells));
+  // Connectivity and offsets in 32 bits where they fit (any grid below 2^31
+  // point references): half the bytes to hold, compress and write (VTK writes
+  // the storage's own type; readers take either).
+  if (L.connectivity < static_cast<std::size_t>(std::numeric_limits<std::int32_t>::max()) &&
+      L.point_offset.back() < static_cast<std::size_t>(std::numeric_limits<std::int32_t>::max()))
+    cells->Use32BitStorage();
   cells->AllocateExact(static_cast<vtkIdType>(L.cells), static_cast<vtkIdType>(L.connectivity));
   std::vector<vtkIdType> ids;
   vtkIdType c = 0;
