@@ -148,6 +148,140 @@ void validate_surface_options(const SurfaceSmoothingOptions& o) {
   if (!(o.tol_f >= 0.0) || !std::isfinite(o.tol_f)) bad("tol_f must be finite and >= 0");
 }
 
+// The largest stretch of D phi at u: the square root of the largest
+// eigenvalue of D phi^T D phi.
+double largest_stretch(const ParametricSurface& surface, const Eigen::Vector2d& u) {
+  const SurfacePoint p = surface.evaluate(u, 1);
+  return std::sqrt(Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(p.d.transpose() * p.d, Eigen::EigenvaluesOnly)
+                       .eigenvalues()
+                       .maxCoeff());
+}
+
+// One run of smooth_surface: Gauss-Seidel sweeps over the free nodes, each
+// moved within its face to the minimum of its submesh's objective. Holds the
+// corner normals and node sizes as the nodes move.
+class SurfaceSmoothing {
+ public:
+  SurfaceSmoothing(SurfaceMesh& m, const SurfaceSmoothingOptions& opt)
+      : m_(m),
+        opt_(opt),
+        normals_(corner_normals(m)),
+        node_size_(node_sizes(m, opt.size)),
+        corners_(node_corners(m)),
+        active_(m.x.size(), 1) {}
+
+  SurfaceSmoothingReport run() {
+    rep_.tangled_before = tangled();
+    double F = objective();
+    for (int sweep = 0; sweep < opt_.max_sweeps; ++sweep) {
+      const Sweep s = sweep_nodes();
+      const double F_new = objective();
+      const double r_f = std::isfinite(F) && std::isfinite(F_new) && F_new > 0.0 ? std::abs(F - F_new) / F_new : kInf;
+      F = F_new;
+      rep_.sweeps = sweep + 1;
+      rep_.last_relative_move = s.r_x;
+      rep_.last_relative_objective = r_f;
+      if (opt_.progress) opt_.progress(sweep, s.r_x, r_f, tangled());
+      if ((s.r_x < opt_.tol_x && r_f < opt_.tol_f) || s.visited == 0) {
+        rep_.converged = true;
+        break;
+      }
+    }
+    rep_.objective = F;
+    rep_.tangled_after = tangled();
+    rep_.newton_steps = cnt_.newton;
+    rep_.gradient_fallbacks = cnt_.gradient;
+    return rep_;
+  }
+
+ private:
+  struct Sweep {
+    double r_x = 0.0;  // the largest move relative to the node's submesh
+    std::size_t visited = 0;
+  };
+
+  std::size_t tangled() const { return element_qualities(m_, normals_, opt_.measure, node_size_).tangled; }
+  double objective() const { return global_objective(m_, normals_, opt_.measure, node_size_); }
+
+  // One sweep over the active free nodes.
+  Sweep sweep_nodes() {
+    Sweep s;
+    for (std::size_t i = 0; i < m_.x.size(); ++i) {
+      if (m_.free_face[i] < 0 || corners_[i].empty() || !active_[i]) continue;
+      active_[i] = 0;
+      ++s.visited;
+      s.r_x = std::max(s.r_x, visit(i));
+    }
+    return s;
+  }
+
+  // Free node i moved to the minimum of its submesh's objective, if it may go
+  // there. Returns its move relative to the largest submesh edge (0: it stays).
+  double visit(std::size_t i) {
+    const ParametricSurface& surface = *m_.faces[m_.free_face[i]];
+    const double max_edge = build_terms(m_, corners_[i], normals_, node_size_, terms_);
+    if (terms_.empty() || !(max_edge > 0.0)) return 0.0;
+    ++rep_.node_visits;
+    // Parametric length scale for the step cap: the submesh size divided by the
+    // largest stretch of D phi (a step of this length moves x by <= max_edge).
+    const double stretch = largest_stretch(surface, m_.u[i]);
+    if (!(stretch > 0.0) || !std::isfinite(stretch)) return 0.0;
+    const SurfaceNodeObjective obj{surface, terms_, opt_.measure};
+    if (!(obj.min_sigma(m_.u[i]) > 0.0)) active_[i] = 1;  // tangled: keep visiting
+    const Eigen::Vector2d un = descend(m_.u[i], obj, max_edge / stretch);
+    if (un == m_.u[i] || !may_move_to(m_, corners_[i], surface, un)) return 0.0;
+    const SurfacePoint q = surface.evaluate(un, 1);
+    const Eigen::Vector3d n = unit_normal(q);
+    if (n.isZero()) return 0.0;  // never move a node onto a degenerate point
+    const double move = (q.x - m_.x[i]).norm() / max_edge;
+    if (move >= 0.1 * opt_.tol_x) activate_star(i);
+    place(i, un, q.x, n);
+    return move;
+  }
+
+  // Newton descent from u with steps of at most step_cap.
+  Eigen::Vector2d descend(const Eigen::Vector2d& u, const SurfaceNodeObjective& obj, double step_cap) {
+    Eigen::Vector2d un = detail::newton_descent(u, obj, opt_.newton, step_cap, cnt_);
+    // Nonlinear over-relaxation (as in smooth()): taken only if the submesh stays
+    // valid and the node inside its face there.
+    if (opt_.newton.over_relaxation != 1.0) {
+      const Eigen::Vector2d ur = u + opt_.newton.over_relaxation * (un - u);
+      if (obj.min_sigma(un) > 0.0 && obj.min_sigma(ur) > 0.0) un = ur;
+    }
+    return un;
+  }
+
+  void activate_star(std::size_t i) {
+    for (const Corner& c : corners_[i])
+      for (int k = 0; k < m_.elements[c.element].nv; ++k) active_[m_.elements[c.element].v[k]] = 1;
+  }
+
+  // Node i at uv point un of its face (x there, unit normal n).
+  void place(std::size_t i, const Eigen::Vector2d& un, const Eigen::Vector3d& x, const Eigen::Vector3d& n) {
+    m_.u[i] = un;
+    m_.x[i] = x;
+    for (const Corner& c : corners_[i]) normals_[4 * static_cast<std::size_t>(c.element) + c.local] = n;
+    if (opt_.size) {
+      node_size_[i] = opt_.size(x);
+      if (!(node_size_[i] > 0.0) || !std::isfinite(node_size_[i]))
+        throw toolkit::InputError("meshopt::smooth_surface: the size field is not positive and finite at node " +
+                                    std::to_string(i) + " after it moved");
+    }
+  }
+
+  SurfaceMesh& m_;
+  const SurfaceSmoothingOptions& opt_;
+  std::vector<Eigen::Vector3d> normals_;
+  std::vector<double> node_size_;
+  const std::vector<std::vector<Corner>> corners_;
+  // Active nodes: a node is visited again only if it or a neighbour moved by more
+  // than tol_x / 10 (relative) at their last visit, or its submesh is tangled.
+  std::vector<char> active_;
+  std::vector<SurfaceTerm> terms_;  // node i's, rebuilt at each visit
+  detail::Counters cnt_;
+  SurfaceSmoothingReport rep_;
+};
+
 }  // namespace
 
 ElementQualities surface_mesh_quality(const SurfaceMesh& mesh, SurfaceMeasure measure, const SizeField& size) {
@@ -160,86 +294,7 @@ ElementQualities surface_mesh_quality(const SurfaceMesh& mesh, SurfaceMeasure me
 SurfaceSmoothingReport smooth_surface(SurfaceMesh& m, const SurfaceSmoothingOptions& opt) {
   validate_surface_options(opt);
   validate_surface_mesh(m);
-  std::vector<Eigen::Vector3d> normals = corner_normals(m);
-  std::vector<double> node_size = node_sizes(m, opt.size);
-  const std::vector<std::vector<Corner>> corners = node_corners(m);
-
-  SurfaceSmoothingReport rep;
-  rep.tangled_before = element_qualities(m, normals, opt.measure, node_size).tangled;
-  double F = global_objective(m, normals, opt.measure, node_size);
-  detail::Counters cnt;
-  std::vector<SurfaceTerm> terms;
-  // Active nodes: a node is visited again only if it or a neighbour moved by more
-  // than tol_x / 10 (relative) at their last visit, or its submesh is tangled.
-  std::vector<char> active(m.x.size(), 1);
-  auto activate_star = [&](std::size_t i) {
-    for (const Corner& c : corners[i])
-      for (int k = 0; k < m.elements[c.element].nv; ++k) active[m.elements[c.element].v[k]] = 1;
-  };
-  for (int sweep = 0; sweep < opt.max_sweeps; ++sweep) {
-    double r_x = 0.0;
-    std::size_t visited = 0;
-    for (std::size_t i = 0; i < m.x.size(); ++i) {
-      const int face = m.free_face[i];
-      if (face < 0 || corners[i].empty() || !active[i]) continue;
-      active[i] = 0;
-      ++visited;
-      const ParametricSurface& surface = *m.faces[face];
-      const double max_edge = build_terms(m, corners[i], normals, node_size, terms);
-      if (terms.empty() || !(max_edge > 0.0)) continue;
-      ++rep.node_visits;
-      // Parametric length scale for the step cap: the submesh size divided by the
-      // largest stretch of D phi (a step of this length moves x by <= max_edge).
-      const SurfacePoint p = surface.evaluate(m.u[i], 1);
-      const double stretch = std::sqrt(Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(
-                                           p.d.transpose() * p.d, Eigen::EigenvaluesOnly)
-                                           .eigenvalues()
-                                           .maxCoeff());
-      if (!(stretch > 0.0) || !std::isfinite(stretch)) continue;
-      const SurfaceNodeObjective obj{surface, terms, opt.measure};
-      if (!(obj.min_sigma(m.u[i]) > 0.0)) active[i] = 1;  // tangled: keep visiting
-      Eigen::Vector2d un = detail::newton_descent(m.u[i], obj, opt.newton, max_edge / stretch, cnt);
-      // Nonlinear over-relaxation (as in smooth()): taken only if the submesh stays
-      // valid and the node inside its face there.
-      if (opt.newton.over_relaxation != 1.0) {
-        const Eigen::Vector2d ur = m.u[i] + opt.newton.over_relaxation * (un - m.u[i]);
-        if (obj.min_sigma(un) > 0.0 && obj.min_sigma(ur) > 0.0) un = ur;
-      }
-      if (un == m.u[i] || !may_move_to(m, corners[i], surface, un)) continue;
-      const SurfacePoint q = surface.evaluate(un, 1);
-      const Eigen::Vector3d n = unit_normal(q);
-      if (n.isZero()) continue;  // never move a node onto a degenerate point
-      const double move = (q.x - m.x[i]).norm() / max_edge;
-      r_x = std::max(r_x, move);
-      if (move >= 0.1 * opt.tol_x) activate_star(i);
-      m.u[i] = un;
-      m.x[i] = q.x;
-      for (const Corner& c : corners[i]) normals[4 * static_cast<std::size_t>(c.element) + c.local] = n;
-      if (opt.size) {
-        node_size[i] = opt.size(q.x);
-        if (!(node_size[i] > 0.0) || !std::isfinite(node_size[i]))
-          throw toolkit::InputError("meshopt::smooth_surface: the size field is not positive and finite at node " +
-                                      std::to_string(i) + " after it moved");
-      }
-    }
-    const double F_new = global_objective(m, normals, opt.measure, node_size);
-    const double r_f = std::isfinite(F) && std::isfinite(F_new) && F_new > 0.0 ? std::abs(F - F_new) / F_new : kInf;
-    F = F_new;
-    rep.sweeps = sweep + 1;
-    rep.last_relative_move = r_x;
-    rep.last_relative_objective = r_f;
-    if (opt.progress)
-      opt.progress(sweep, r_x, r_f, element_qualities(m, normals, opt.measure, node_size).tangled);
-    if ((r_x < opt.tol_x && r_f < opt.tol_f) || visited == 0) {
-      rep.converged = true;
-      break;
-    }
-  }
-  rep.objective = F;
-  rep.tangled_after = element_qualities(m, normals, opt.measure, node_size).tangled;
-  rep.newton_steps = cnt.newton;
-  rep.gradient_fallbacks = cnt.gradient;
-  return rep;
+  return SurfaceSmoothing(m, opt).run();
 }
 
 }  // namespace meshopt

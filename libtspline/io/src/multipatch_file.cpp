@@ -91,13 +91,103 @@ void write_multipatch_file(const std::string& path, const std::vector<const TSpl
   });
 }
 
-LoadedMaps read_maps_file(const std::string& path) {
-  json doc;
+namespace {
+
+// The document at path; null if it is not JSON.
+json parsed_or_null(const std::string& path) {
   try {
-    doc = json::parse(read_text_file(path));
+    return json::parse(read_text_file(path));
   } catch (const json::exception&) {
-    doc = nullptr;
+    return nullptr;
   }
+}
+
+// The points [x, y] of array a.
+std::vector<Eigen::Vector2d> points_of(const json& a, const std::string& where) {
+  std::vector<Eigen::Vector2d> points;
+  for (const json& q : a) {
+    if (!q.is_array() || q.size() != 2 || !q[0].is_number() || !q[1].is_number())
+      throw InputError(where + ": expected points [x, y]");
+    points.emplace_back(q[0].get<double>(), q[1].get<double>());
+  }
+  return points;
+}
+
+std::vector<LoadedTSpline> read_patches(const json& doc, const std::string& path) {
+  const json& patches = member(doc, "patches", path + ": /");
+  if (!patches.is_array() || patches.empty()) throw InputError(path + ": /patches: expected a non-empty array");
+  std::vector<LoadedTSpline> out;
+  for (std::size_t p = 0; p < patches.size(); ++p)
+    out.push_back(tspline_from_json(patches[p], path + ": /patches/" + std::to_string(p)));
+  return out;
+}
+
+std::vector<Cut> read_cuts(const json& doc, const std::string& path) {
+  const json& cuts = member(doc, "cuts", path + ": /");
+  if (!cuts.is_array()) throw InputError(path + ": /cuts: expected an array");
+  std::vector<Cut> out;
+  for (std::size_t c = 0; c < cuts.size(); ++c) {
+    const std::string where = path + ": /cuts/" + std::to_string(c);
+    if (!cuts[c].is_array()) throw InputError(where + ": expected an array of points");
+    out.push_back(points_of(cuts[c], where));
+  }
+  return out;
+}
+
+// One ring of "domain": {"polygon": [[x, y], ...], "file_index": [...]}.
+Polygon read_ring(const json& r, const std::string& where) {
+  Polygon ring;
+  const json& pts = member(r, "polygon", where);
+  const json& idx = member(r, "file_index", where);
+  if (!pts.is_array() || !idx.is_array() || idx.size() != pts.size())
+    throw InputError(where + ": expected \"polygon\" and \"file_index\" arrays of one size");
+  ring.vertices = points_of(pts, where + "/polygon");
+  for (const json& f : idx) {
+    if (!f.is_number_integer() || f.get<long long>() < 0)
+      throw InputError(where + "/file_index: expected non-negative integers");
+    ring.file_index.push_back(f.get<std::size_t>());
+  }
+  return ring;
+}
+
+// The rings of "domain": the outer ring, then the holes.
+Domain read_domain(const json& rings, const std::string& path) {
+  if (!rings.is_array() || rings.empty()) throw InputError(path + ": /domain: expected a non-empty array of rings");
+  Domain d;
+  for (std::size_t r = 0; r < rings.size(); ++r) {
+    Polygon ring = read_ring(rings[r], path + ": /domain/" + std::to_string(r));
+    if (r == 0) d.outer = std::move(ring);
+    else d.holes.push_back(std::move(ring));
+  }
+  return d;
+}
+
+// The interfaces, whose cuts and patches are checked against those read.
+std::vector<Interface> read_interfaces(const json& doc, const std::string& path, std::size_t cuts,
+                                       std::size_t patches) {
+  const json& faces = member(doc, "interfaces", path + ": /");
+  if (!faces.is_array()) throw InputError(path + ": /interfaces: expected an array");
+  std::vector<Interface> out;
+  for (std::size_t i = 0; i < faces.size(); ++i) {
+    const std::string where = path + ": /interfaces/" + std::to_string(i);
+    const json& f = faces[i];
+    Interface itf;
+    itf.cut = index_in(member(f, "cut", where), cuts, where + "/cut");
+    itf.patch_a = index_in(member(f, "patch_a", where), patches, where + "/patch_a");
+    itf.patch_b = index_in(member(f, "patch_b", where), patches, where + "/patch_b");
+    itf.side_a = side_index(member(f, "side_a", where), where + "/side_a");
+    itf.side_b = side_index(member(f, "side_b", where), where + "/side_b");
+    if (member(f, "orientation", where) != "reversed")
+      throw InputError(where + "/orientation: expected \"reversed\"");
+    out.push_back(itf);
+  }
+  return out;
+}
+
+}  // namespace
+
+LoadedMaps read_maps_file(const std::string& path) {
+  const json doc = parsed_or_null(path);
   LoadedMaps out;
   // Version 1 (or anything that is not a version-2 document): the single-patch reader and its messages.
   if (!doc.is_object() || !doc.contains("version") || doc["version"] != kVersion) {
@@ -108,64 +198,10 @@ LoadedMaps read_maps_file(const std::string& path) {
   out.version = kVersion;
   if (member(doc, "format", path + ": /") != "tspline") throw InputError(path + ": /format: expected \"tspline\"");
   if (doc.contains("source") && doc["source"].is_string()) out.source = doc["source"].get<std::string>();
-  const json& patches = member(doc, "patches", path + ": /");
-  if (!patches.is_array() || patches.empty()) throw InputError(path + ": /patches: expected a non-empty array");
-  for (std::size_t p = 0; p < patches.size(); ++p)
-    out.patches.push_back(tspline_from_json(patches[p], path + ": /patches/" + std::to_string(p)));
-  const json& cuts = member(doc, "cuts", path + ": /");
-  if (!cuts.is_array()) throw InputError(path + ": /cuts: expected an array");
-  for (std::size_t c = 0; c < cuts.size(); ++c) {
-    Cut cut;
-    const std::string where = path + ": /cuts/" + std::to_string(c);
-    if (!cuts[c].is_array()) throw InputError(where + ": expected an array of points");
-    for (const json& q : cuts[c]) {
-      if (!q.is_array() || q.size() != 2 || !q[0].is_number() || !q[1].is_number())
-        throw InputError(where + ": expected points [x, y]");
-      cut.emplace_back(q[0].get<double>(), q[1].get<double>());
-    }
-    out.cuts.push_back(std::move(cut));
-  }
-  if (doc.contains("domain")) {
-    const json& rings = doc["domain"];
-    if (!rings.is_array() || rings.empty()) throw InputError(path + ": /domain: expected a non-empty array of rings");
-    Domain d;
-    for (std::size_t r = 0; r < rings.size(); ++r) {
-      const std::string where = path + ": /domain/" + std::to_string(r);
-      Polygon ring;
-      const json& pts = member(rings[r], "polygon", where);
-      const json& idx = member(rings[r], "file_index", where);
-      if (!pts.is_array() || !idx.is_array() || idx.size() != pts.size())
-        throw InputError(where + ": expected \"polygon\" and \"file_index\" arrays of one size");
-      for (const json& q : pts) {
-        if (!q.is_array() || q.size() != 2 || !q[0].is_number() || !q[1].is_number())
-          throw InputError(where + "/polygon: expected points [x, y]");
-        ring.vertices.emplace_back(q[0].get<double>(), q[1].get<double>());
-      }
-      for (const json& f : idx) {
-        if (!f.is_number_integer() || f.get<long long>() < 0)
-          throw InputError(where + "/file_index: expected non-negative integers");
-        ring.file_index.push_back(f.get<std::size_t>());
-      }
-      if (r == 0) d.outer = std::move(ring);
-      else d.holes.push_back(std::move(ring));
-    }
-    out.domain = std::move(d);
-  }
-  const json& faces = member(doc, "interfaces", path + ": /");
-  if (!faces.is_array()) throw InputError(path + ": /interfaces: expected an array");
-  for (std::size_t i = 0; i < faces.size(); ++i) {
-    const std::string where = path + ": /interfaces/" + std::to_string(i);
-    const json& f = faces[i];
-    Interface itf;
-    itf.cut = index_in(member(f, "cut", where), out.cuts.size(), where + "/cut");
-    itf.patch_a = index_in(member(f, "patch_a", where), out.patches.size(), where + "/patch_a");
-    itf.patch_b = index_in(member(f, "patch_b", where), out.patches.size(), where + "/patch_b");
-    itf.side_a = side_index(member(f, "side_a", where), where + "/side_a");
-    itf.side_b = side_index(member(f, "side_b", where), where + "/side_b");
-    if (member(f, "orientation", where) != "reversed")
-      throw InputError(where + "/orientation: expected \"reversed\"");
-    out.interfaces.push_back(itf);
-  }
+  out.patches = read_patches(doc, path);
+  out.cuts = read_cuts(doc, path);
+  if (doc.contains("domain")) out.domain = read_domain(doc["domain"], path);
+  out.interfaces = read_interfaces(doc, path, out.cuts.size(), out.patches.size());
   return out;
 }
 

@@ -375,55 +375,68 @@ nlohmann::json combine_whole_map_quality_json(const std::vector<nlohmann::json>&
   return out;
 }
 
-nlohmann::json param_report(const ParameterizationResult& r, const std::string& input_path) {
-  using nlohmann::json;
-  const AdaptiveOptions& ad = r.adaptive;
-  json rep = front_report(r.front, input_path);
+namespace {
+
+// The T-spline: its functions by kind, the boundary interpolation's residuals.
+nlohmann::json tspline_json(const ParameterizationResult& r) {
   std::size_t kinds[3] = {0, 0, 0};
   for (const auto& f : r.map->basis().functions()) ++kinds[static_cast<int>(f.kind)];
-  rep["tspline"] = {{"degree", 3},
-                    {"blending_functions", r.map->basis().size()},
-                    {"control_points", r.map->control_points().size()},
-                    {"anchor_functions", kinds[0]},
-                    {"edge_extra_functions", kinds[1]},
-                    {"corner_extra_functions", kinds[2]},
-                    {"interpolation_max_residual", r.fit.max_residual},
-                    {"interpolation_relative_residual", r.fit.relative_residual},
-                    {"matrix_nonzeros", r.fit.nonzeros}};
-  rep["jacobian"] = map_quality_json(r.quality);
-  rep["jacobian"]["gauss_points_per_direction"] = ad.gauss;
-  rep["jacobian"]["threshold"] = ad.min_jacobian;
-  rep["jacobian"]["note"] =
+  return {{"degree", 3},
+          {"blending_functions", r.map->basis().size()},
+          {"control_points", r.map->control_points().size()},
+          {"anchor_functions", kinds[0]},
+          {"edge_extra_functions", kinds[1]},
+          {"corner_extra_functions", kinds[2]},
+          {"interpolation_max_residual", r.fit.max_residual},
+          {"interpolation_relative_residual", r.fit.relative_residual},
+          {"matrix_nonzeros", r.fit.nonzeros},
+          {"control_points_optimized", r.control_points_optimized}};
+}
+
+// The adaptive loop's dense sample and, with a map, the certified bounds and
+// dense sample of whole_map_quality_json and the worst boundary corner.
+nlohmann::json whole_map_json(const ParameterizationResult& r) {
+  const DenseMapQuality& q = r.dense_quality;
+  nlohmann::json w = {{"min_mean_ratio", q.min_mean_ratio},
+                      {"min_scaled", q.min_scaled},
+                      {"nonpositive_det_points", q.nonpositive_det},
+                      {"points", q.points},
+                      {"points_per_element", (q.samples_per_edge + 1) * (q.samples_per_edge + 1)},
+                      {"worst_at", {q.worst_at.x(), q.worst_at.y()}}};
+  if (r.map) {
+    const QualityBoundOptions qo = report_quality_bound_options();
+    w.update(whole_map_quality_json(certified_map_quality(*r.map, qo), qo));
+    if (const auto corner = worst_boundary_corner(*r.map)) w["boundary_corner"] = boundary_corner_json(*corner);
+  }
+  return w;
+}
+
+// The Jacobian's quality at the Gauss points, and over the whole map.
+nlohmann::json jacobian_json(const ParameterizationResult& r) {
+  nlohmann::json j = map_quality_json(r.quality);
+  j["gauss_points_per_direction"] = r.adaptive.gauss;
+  j["threshold"] = r.adaptive.min_jacobian;
+  j["note"] =
       "min/mean at the Gauss points; whole_map.mean_ratio and whole_map.scaled_jacobian: certified_lower_bound holds "
       "everywhere on the map (Bernstein bounds), sampled_min is the minimum of a dense sample (samples_per_element "
       "points per Bezier element), a value of the map, so the true minimum lies between them; whole_map.min_mean_ratio, "
       "min_scaled, points, points_per_element and worst_at: the adaptive loop's sample (points_per_element points per "
       "element and the Gauss points), kept for older readers";
-  rep["jacobian"]["whole_map"] = {{"min_mean_ratio", r.dense_quality.min_mean_ratio},
-                                  {"min_scaled", r.dense_quality.min_scaled},
-                                  {"nonpositive_det_points", r.dense_quality.nonpositive_det},
-                                  {"points", r.dense_quality.points},
-                                  {"points_per_element", (r.dense_quality.samples_per_edge + 1) *
-                                                             (r.dense_quality.samples_per_edge + 1)},
-                                  {"worst_at", {r.dense_quality.worst_at.x(), r.dense_quality.worst_at.y()}}};
-  if (r.map) {
-    const QualityBoundOptions qo = report_quality_bound_options();
-    rep["jacobian"]["whole_map"].update(whole_map_quality_json(certified_map_quality(*r.map, qo), qo));
-    if (const auto corner = worst_boundary_corner(*r.map))
-      rep["jacobian"]["whole_map"]["boundary_corner"] = boundary_corner_json(*corner);
-  }
-  rep["boundary_curve_proven_simple"] = r.boundary_simple;
-  if (!r.boundary_problem.empty()) rep["boundary_problem"] = r.boundary_problem;
-  rep["tspline"]["control_points_optimized"] = r.control_points_optimized;
-  rep["valid"] = r.valid();
-  rep["good"] = r.good();
-  if (ad.certify) {
-    rep["certified_valid"] = r.certified_valid();
-    rep["certification"] = certification_json(r.certification);
-    rep["certification"]["depth_limit"] = ad.certification.max_depth;
-    rep["certification"]["extra_refinement_rounds"] = r.certification_rounds;
-  }
-  json its = json::array();
+  j["whole_map"] = whole_map_json(r);
+  return j;
+}
+
+// The certification of the map kept.
+nlohmann::json final_certification_json(const ParameterizationResult& r) {
+  nlohmann::json c = certification_json(r.certification);
+  c["depth_limit"] = r.adaptive.certification.max_depth;
+  c["extra_refinement_rounds"] = r.certification_rounds;
+  return c;
+}
+
+// The adaptive rounds, one record each.
+nlohmann::json iterations_json(const ParameterizationResult& r) {
+  nlohmann::json its = nlohmann::json::array();
   for (const AdaptIteration& it : r.iterations)
     its.push_back({{"cells", it.cells},
                    {"vertices", it.vertices},
@@ -435,18 +448,40 @@ nlohmann::json param_report(const ParameterizationResult& r, const std::string& 
                    {"untangling", untangling_json(it.untangling)},
                    {"jacobian", map_quality_json(it.quality)},
                    {"seconds", it.seconds}});
-  if (ad.certify)
+  if (r.adaptive.certify)
     for (std::size_t k = 0; k < r.iterations.size(); ++k) {
       its[k]["certification"] = certification_json(r.iterations[k].certification);
       its[k]["certification"]["cells_marked_only_for_certification"] = r.iterations[k].certification_marked_cells;
     }
-  rep["adaptive"] = {{"max_rounds", ad.max_adapt},
-                     {"stall_rounds", ad.stall_rounds},
-                     {"max_cells", r.options.max_cells},
-                     {"map_untangling", ad.optimize_control_points},
-                     {"iterations", its},
-                     {"kept_iteration", r.kept_iteration},
-                     {"stop_reason", r.stop_reason}};
+  return its;
+}
+
+nlohmann::json adaptive_json(const ParameterizationResult& r) {
+  const AdaptiveOptions& ad = r.adaptive;
+  return {{"max_rounds", ad.max_adapt},
+          {"stall_rounds", ad.stall_rounds},
+          {"max_cells", r.options.max_cells},
+          {"map_untangling", ad.optimize_control_points},
+          {"iterations", iterations_json(r)},
+          {"kept_iteration", r.kept_iteration},
+          {"stop_reason", r.stop_reason}};
+}
+
+}  // namespace
+
+nlohmann::json param_report(const ParameterizationResult& r, const std::string& input_path) {
+  nlohmann::json rep = front_report(r.front, input_path);
+  rep["tspline"] = tspline_json(r);
+  rep["jacobian"] = jacobian_json(r);
+  rep["boundary_curve_proven_simple"] = r.boundary_simple;
+  if (!r.boundary_problem.empty()) rep["boundary_problem"] = r.boundary_problem;
+  rep["valid"] = r.valid();
+  rep["good"] = r.good();
+  if (r.adaptive.certify) {
+    rep["certified_valid"] = r.certified_valid();
+    rep["certification"] = final_certification_json(r);
+  }
+  rep["adaptive"] = adaptive_json(r);
   double total = 0.0;
   for (const auto& t : r.front.times) rep["seconds"][t.stage] = t.seconds, total += t.seconds;
   rep["seconds"]["total"] = total;

@@ -116,6 +116,8 @@ struct PetscPoissonSolver::Impl {
   void build_pattern(const AnalysisSpace& space, const std::vector<int>& interior, int ni,
                      const std::vector<std::int64_t>& start, const std::vector<int>& cells);
   bool own(PetscInt g) const { return g >= row_begin && g < row_end; }
+  // solve()'s PETSc objects and steps (below).
+  class CgRun;
 
   void release() {
     if (A) MatDestroy(&A);
@@ -405,38 +407,11 @@ bool PetscPoissonSolver::end_assembly(bool ok) {
   return true;
 }
 
-SolverStats PetscPoissonSolver::solve(Eigen::VectorXd& u) {
-  Impl& m = *impl_;
-  const IterativeOptions& o = m.options;
-  const auto t0 = Clock::now();
-  SolverStats st;
-  st.processes = process_count();
-  st.kind = std::string("PETSc CG + ") + preconditioner_name(o.preconditioner);
+namespace {
 
-  KSP ksp = nullptr;
-  Vec x = nullptr, r = nullptr, xall = nullptr;
-  VecScatter gather = nullptr;
-  struct Cleanup {  // frees the PETSc objects on every exit (the system too: the memory is wanted back)
-    KSP& ksp;
-    Vec &x, &r, &xall;
-    VecScatter& gather;
-    Impl& m;
-    ~Cleanup() {
-      if (ksp) KSPDestroy(&ksp);
-      if (x) VecDestroy(&x);
-      if (r) VecDestroy(&r);
-      if (xall) VecDestroy(&xall);
-      if (gather) VecScatterDestroy(&gather);
-      m.release();
-    }
-  } cleanup{ksp, x, r, xall, gather, m};
-
-  check(KSPCreate(PETSC_COMM_WORLD, &ksp), "KSPCreate");
-  check(KSPSetOperators(ksp, m.A, m.A), "KSPSetOperators");
-  check(KSPSetType(ksp, KSPCG), "KSPSetType");
-  PC pc = nullptr;
-  check(KSPGetPC(ksp, &pc), "KSPGetPC");
-  if (o.preconditioner == Preconditioner::BoomerAMG) {
+// The preconditioner p on pc.
+void set_preconditioner(PC pc, Preconditioner p) {
+  if (p == Preconditioner::BoomerAMG) {
     check(PCSetType(pc, PCHYPRE), "PCSetType(hypre)");
     check(PCHYPRESetType(pc, "boomeramg"), "PCHYPRESetType");
     // PETSc's BoomerAMG defaults (Falgout coarsening, classical interpolation)
@@ -458,43 +433,104 @@ SolverStats PetscPoissonSolver::solve(Eigen::VectorXd& u) {
   } else {
     check(PCSetType(pc, PCGAMG), "PCSetType(gamg)");
   }
-  // Stop on the true (unpreconditioned) residual: ||b - K u|| <= rtol ||b||.
-  check(KSPSetNormType(ksp, KSP_NORM_UNPRECONDITIONED), "KSPSetNormType");
+}
+
+}  // namespace
+
+// One CG solve of the assembled system: the PETSc objects it creates, freed
+// on every exit, and the system with them (the memory is wanted back).
+class PetscPoissonSolver::Impl::CgRun {
+ public:
+  explicit CgRun(Impl& m) : m_(m) {}
+  CgRun(const CgRun&) = delete;
+  CgRun& operator=(const CgRun&) = delete;
+  ~CgRun() {
+    if (ksp_) KSPDestroy(&ksp_);
+    if (x_) VecDestroy(&x_);
+    if (r_) VecDestroy(&r_);
+    if (xall_) VecDestroy(&xall_);
+    if (gather_) VecScatterDestroy(&gather_);
+    m_.release();
+  }
+
+  // CG on K with the options' preconditioner, to the relative tolerance rtol.
+  void set_up(double rtol) {
+    check(KSPCreate(PETSC_COMM_WORLD, &ksp_), "KSPCreate");
+    check(KSPSetOperators(ksp_, m_.A, m_.A), "KSPSetOperators");
+    check(KSPSetType(ksp_, KSPCG), "KSPSetType");
+    PC pc = nullptr;
+    check(KSPGetPC(ksp_, &pc), "KSPGetPC");
+    set_preconditioner(pc, m_.options.preconditioner);
+    // Stop on the true (unpreconditioned) residual: ||b - K u|| <= rtol ||b||.
+    check(KSPSetNormType(ksp_, KSP_NORM_UNPRECONDITIONED), "KSPSetNormType");
+    check(KSPSetTolerances(ksp_, rtol, 1e-300, PETSC_DEFAULT, m_.options.max_iterations), "KSPSetTolerances");
+    check(KSPSetFromOptions(ksp_), "KSPSetFromOptions");
+  }
+
+  struct Outcome {
+    KSPConvergedReason reason = KSP_CONVERGED_ITERATING;
+    PetscInt iterations = 0;
+  };
+  // x: CG's solution of K x = b (as far as it got: see reason).
+  Outcome solve() {
+    check(MatCreateVecs(m_.A, &x_, nullptr), "MatCreateVecs");
+    check(KSPSolve(ksp_, m_.b, x_), "KSPSolve");
+    Outcome o;
+    check(KSPGetConvergedReason(ksp_, &o.reason), "KSPGetConvergedReason");
+    check(KSPGetIterationNumber(ksp_, &o.iterations), "KSPGetIterationNumber");
+    return o;
+  }
+
+  // The true relative residual, recomputed (not the recurrence's estimate).
+  double relative_residual() {
+    PetscReal bnorm = 0, rnorm = 0;
+    check(VecDuplicate(m_.b, &r_), "VecDuplicate");
+    check(MatMult(m_.A, x_, r_), "MatMult");
+    check(VecAYPX(r_, -1.0, m_.b), "VecAYPX");  // r = b - K x
+    check(VecNorm(r_, NORM_2, &rnorm), "VecNorm");
+    check(VecNorm(m_.b, NORM_2, &bnorm), "VecNorm");
+    return bnorm > 0 ? rnorm / bnorm : rnorm;
+  }
+
+  // Gather the solution on every process and undo the renumbering.
+  void solution(Eigen::VectorXd& u) {
+    check(VecScatterCreateToAll(x_, &gather_, &xall_), "VecScatterCreateToAll");
+    check(VecScatterBegin(gather_, x_, xall_, INSERT_VALUES, SCATTER_FORWARD), "VecScatterBegin");
+    check(VecScatterEnd(gather_, x_, xall_, INSERT_VALUES, SCATTER_FORWARD), "VecScatterEnd");
+    const PetscScalar* xa = nullptr;
+    check(VecGetArrayRead(xall_, &xa), "VecGetArrayRead");
+    u.resize(m_.n);
+    for (PetscInt i = 0; i < m_.n; ++i) u[i] = xa[m_.perm[i]];
+    check(VecRestoreArrayRead(xall_, &xa), "VecRestoreArrayRead");
+  }
+
+ private:
+  Impl& m_;
+  KSP ksp_ = nullptr;
+  Vec x_ = nullptr, r_ = nullptr, xall_ = nullptr;
+  VecScatter gather_ = nullptr;
+};
+
+SolverStats PetscPoissonSolver::solve(Eigen::VectorXd& u) {
+  Impl& m = *impl_;
+  const IterativeOptions& o = m.options;
+  const auto t0 = Clock::now();
+  SolverStats st;
+  st.processes = process_count();
+  st.kind = std::string("PETSc CG + ") + preconditioner_name(o.preconditioner);
+  Impl::CgRun cg(m);  // frees its PETSc objects and the system on every exit
   const double rtol = o.rtol ? *o.rtol : automatic_rtol(static_cast<std::size_t>(m.n));
   st.tolerance = rtol;
-  check(KSPSetTolerances(ksp, rtol, 1e-300, PETSC_DEFAULT, o.max_iterations), "KSPSetTolerances");
-  check(KSPSetFromOptions(ksp), "KSPSetFromOptions");
-  check(MatCreateVecs(m.A, &x, nullptr), "MatCreateVecs");
-  check(KSPSolve(ksp, m.b, x), "KSPSolve");
-
-  KSPConvergedReason reason;
-  PetscInt its = 0;
-  check(KSPGetConvergedReason(ksp, &reason), "KSPGetConvergedReason");
-  check(KSPGetIterationNumber(ksp, &its), "KSPGetIterationNumber");
+  cg.set_up(rtol);
+  const auto [reason, its] = cg.solve();
   st.iterations = static_cast<int>(its);
-  // The true relative residual, recomputed (not the recurrence's estimate).
-  PetscReal bnorm = 0, rnorm = 0;
-  check(VecDuplicate(m.b, &r), "VecDuplicate");
-  check(MatMult(m.A, x, r), "MatMult");
-  check(VecAYPX(r, -1.0, m.b), "VecAYPX");  // r = b - K x
-  check(VecNorm(r, NORM_2, &rnorm), "VecNorm");
-  check(VecNorm(m.b, NORM_2, &bnorm), "VecNorm");
-  st.relative_residual = bnorm > 0 ? rnorm / bnorm : rnorm;
+  st.relative_residual = cg.relative_residual();
   if (reason < 0)
     throw NumericalError("iterative solve (" + st.kind + ") did not converge: " + KSPConvergedReasons[reason] +
                          " after " + std::to_string(its) + " iterations (limit " +
                          std::to_string(o.max_iterations) + "), relative residual " +
                          g3(st.relative_residual) + " (rtol " + g3(rtol) + ")");
-
-  // Gather the solution on every process and undo the renumbering.
-  check(VecScatterCreateToAll(x, &gather, &xall), "VecScatterCreateToAll");
-  check(VecScatterBegin(gather, x, xall, INSERT_VALUES, SCATTER_FORWARD), "VecScatterBegin");
-  check(VecScatterEnd(gather, x, xall, INSERT_VALUES, SCATTER_FORWARD), "VecScatterEnd");
-  const PetscScalar* xa = nullptr;
-  check(VecGetArrayRead(xall, &xa), "VecGetArrayRead");
-  u.resize(m.n);
-  for (PetscInt i = 0; i < m.n; ++i) u[i] = xa[m.perm[i]];
-  check(VecRestoreArrayRead(xall, &xa), "VecRestoreArrayRead");
+  cg.solution(u);
   st.seconds = seconds_since(t0);
   return st;
 }

@@ -84,10 +84,9 @@ bool monotone(const Piece* a, const Piece* b, double tiny) {
   return true;
 }
 
-}  // namespace
-
-BoundaryCurveCheck check_boundary_curve(const TSplineMap& map, int max_depth) {
-  if (max_depth < 0 || max_depth > 20) throw toolkit::InputError("check_boundary_curve: max_depth out of range");
+// The border segments of the map's Bezier elements as one closed curve, side
+// by side in the CCW order of the border.
+std::vector<Piece> boundary_pieces(const TSplineMap& map) {
   const BezierExtraction ex(map.basis());
   std::array<std::vector<Piece>, 4> sides;
   std::array<std::vector<double>, 4> keys;
@@ -99,73 +98,116 @@ BoundaryCurveCheck check_boundary_curve(const TSplineMap& map, int max_depth) {
     std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return keys[s][a] < keys[s][b]; });
     for (std::size_t i : order) pieces.push_back(sides[s][i]);
   }
-  BoundaryCurveCheck out;
-  out.segments = pieces.size();
+  return pieces;
+}
+
+// The diagonal of the bounding box of the pieces' control points.
+double control_box_diagonal(const std::vector<Piece>& pieces) {
   Eigen::Vector2d lo = pieces.front().P[0], hi = lo;
   for (const Piece& p : pieces)
     for (const auto& q : p.P) lo = lo.cwiseMin(q), hi = hi.cwiseMax(q);
-  const double diag = (hi - lo).norm();
+  return (hi - lo).norm();
+}
+
+// The pieces not proven apart from the rest of the curve in one round.
+struct Conflicts {
+  std::vector<char> bad;                                    // per piece
+  std::vector<std::pair<std::size_t, std::size_t>> pairs;  // overlapping boxes, i < j
+  bool any() const { return std::find(bad.begin(), bad.end(), 1) != bad.end(); }
+};
+
+// A piece is bad if it is not monotone, or if its box (the control points'
+// bounding box, padded by pad) overlaps another piece's, unless the two are
+// neighbours along the curve and monotone together.
+Conflicts find_conflicts(const std::vector<Piece>& pieces, double pad, double tiny) {
+  const std::size_t n = pieces.size();
+  Conflicts out{std::vector<char>(n, 0), {}};
+  for (std::size_t i = 0; i < n; ++i)
+    if (!monotone(&pieces[i], nullptr, tiny)) out.bad[i] = 1;
+  std::vector<Box> boxes;
+  boxes.reserve(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    Eigen::Vector2d a = pieces[i].P[0], b = a;
+    for (const auto& q : pieces[i].P) a = a.cwiseMin(q), b = b.cwiseMax(q);
+    boxes.emplace_back(CGAL::Bbox_2(a.x() - pad, a.y() - pad, b.x() + pad, b.y() + pad), i);
+  }
+  CGAL::box_self_intersection_d(boxes.begin(), boxes.end(), [&](const Box& A, const Box& B) {
+    std::size_t i = A.info(), j = B.info();
+    if (i > j) std::swap(i, j);
+    const bool adjacent = j == i + 1 || (i == 0 && j == n - 1);
+    if (adjacent) {
+      const Piece& first = (j == i + 1) ? pieces[i] : pieces[j];
+      const Piece& second = (j == i + 1) ? pieces[j] : pieces[i];
+      if (monotone(&first, &second, tiny)) return;
+    }
+    out.bad[i] = out.bad[j] = 1;
+    out.pairs.emplace_back(i, j);
+  });
+  return out;
+}
+
+bool can_split(const std::vector<Piece>& pieces, const std::vector<char>& bad, int max_depth) {
+  bool can = false;
+  for (std::size_t i = 0; i < pieces.size(); ++i) can = can || (bad[i] && pieces[i].depth < max_depth);
+  return can;
+}
+
+// The pieces with each bad one halved unless it is at the depth limit.
+std::vector<Piece> split_bad(const std::vector<Piece>& pieces, const std::vector<char>& bad, int max_depth) {
+  std::vector<Piece> next;
+  next.reserve(pieces.size() + 64);
+  for (std::size_t i = 0; i < pieces.size(); ++i) {
+    if (bad[i] && pieces[i].depth < max_depth) {
+      const auto two = split(pieces[i]);
+      next.push_back(two[0]);
+      next.push_back(two[1]);
+    } else {
+      next.push_back(pieces[i]);
+    }
+  }
+  return next;
+}
+
+// The conflicts that no split resolved: the parametric midpoints of the bad
+// pieces, and the message naming where the first of them starts.
+void report_not_simple(const std::vector<Piece>& pieces, const Conflicts& c, BoundaryCurveCheck& out) {
+  for (std::size_t i = 0; i < pieces.size(); ++i)
+    if (c.bad[i]) out.conflicts.push_back(0.5 * (pieces[i].uv0 + pieces[i].uv1));
+  const std::size_t k = c.pairs.empty()
+                            ? static_cast<std::size_t>(std::find(c.bad.begin(), c.bad.end(), 1) - c.bad.begin())
+                            : c.pairs.front().first;
+  const Eigen::Vector2d at = pieces[k].P[0];
+  std::ostringstream s;
+  s << "the boundary curve of the map is not proven simple: it crosses itself, or two of its parts come "
+       "closer than the check resolves, near ("
+    << at.x() << ", " << at.y() << ")";
+  out.message = s.str();
+}
+
+}  // namespace
+
+BoundaryCurveCheck check_boundary_curve(const TSplineMap& map, int max_depth) {
+  if (max_depth < 0 || max_depth > 20) throw toolkit::InputError("check_boundary_curve: max_depth out of range");
+  std::vector<Piece> pieces = boundary_pieces(map);
+  BoundaryCurveCheck out;
+  out.segments = pieces.size();
+  const double diag = control_box_diagonal(pieces);
   const double pad = 1e-12 * diag, tiny = 1e-14 * diag;
   constexpr std::size_t kMaxPieces = 1u << 20;
-
-  for (int round = 0;; ++round) {
-    const std::size_t n = pieces.size();
-    std::vector<char> bad(n, 0);
-    std::vector<std::pair<std::size_t, std::size_t>> pairs;
-    for (std::size_t i = 0; i < n; ++i)
-      if (!monotone(&pieces[i], nullptr, tiny)) bad[i] = 1;
-    std::vector<Box> boxes;
-    boxes.reserve(n);
-    for (std::size_t i = 0; i < n; ++i) {
-      Eigen::Vector2d a = pieces[i].P[0], b = a;
-      for (const auto& q : pieces[i].P) a = a.cwiseMin(q), b = b.cwiseMax(q);
-      boxes.emplace_back(CGAL::Bbox_2(a.x() - pad, a.y() - pad, b.x() + pad, b.y() + pad), i);
-    }
-    CGAL::box_self_intersection_d(boxes.begin(), boxes.end(), [&](const Box& A, const Box& B) {
-      std::size_t i = A.info(), j = B.info();
-      if (i > j) std::swap(i, j);
-      const bool adjacent = j == i + 1 || (i == 0 && j == n - 1);
-      if (adjacent) {
-        const Piece& first = (j == i + 1) ? pieces[i] : pieces[j];
-        const Piece& second = (j == i + 1) ? pieces[j] : pieces[i];
-        if (monotone(&first, &second, tiny)) return;
-      }
-      bad[i] = bad[j] = 1;
-      pairs.emplace_back(i, j);
-    });
-    out.pieces = n;
-    const bool any = std::find(bad.begin(), bad.end(), 1) != bad.end();
-    if (!any) {
+  // Rounds of subdivision: the bad pieces halved until none is left, none can
+  // be halved (max_depth) or there are too many.
+  for (;;) {
+    const Conflicts c = find_conflicts(pieces, pad, tiny);
+    out.pieces = pieces.size();
+    if (!c.any()) {
       out.simple = true;
       return out;
     }
-    bool can_split = false;
-    for (std::size_t i = 0; i < n; ++i) can_split = can_split || (bad[i] && pieces[i].depth < max_depth);
-    if (!can_split || n > kMaxPieces) {
-      for (std::size_t i = 0; i < n; ++i)
-        if (bad[i]) out.conflicts.push_back(0.5 * (pieces[i].uv0 + pieces[i].uv1));
-      const std::size_t k = pairs.empty() ? static_cast<std::size_t>(std::find(bad.begin(), bad.end(), 1) - bad.begin())
-                                          : pairs.front().first;
-      const Eigen::Vector2d at = pieces[k].P[0];
-      std::ostringstream s;
-      s << "the boundary curve of the map is not proven simple: it crosses itself, or two of its parts come "
-           "closer than the check resolves, near ("
-        << at.x() << ", " << at.y() << ")";
-      out.message = s.str();
+    if (!can_split(pieces, c.bad, max_depth) || pieces.size() > kMaxPieces) {
+      report_not_simple(pieces, c, out);
       return out;
     }
-    std::vector<Piece> next;
-    next.reserve(n + 64);
-    for (std::size_t i = 0; i < n; ++i) {
-      if (bad[i] && pieces[i].depth < max_depth) {
-        const auto two = split(pieces[i]);
-        next.push_back(two[0]);
-        next.push_back(two[1]);
-      } else {
-        next.push_back(pieces[i]);
-      }
-    }
-    pieces = std::move(next);
+    pieces = split_bad(pieces, c.bad, max_depth);
   }
 }
 
