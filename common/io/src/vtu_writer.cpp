@@ -189,15 +189,9 @@ std::vector<int> part_index(std::span<Part> parts, std::size_t cells) {
   return index;
 }
 
-// The grid of the parts as one mesh (merge_vtu). With non-const parts
-// (write_vtu(path, VtuMesh&&), write_vtu_parts) each of their arrays is
-// released once VTK has its copy, so that the two are never whole at once (a
-// sea of 9,000 patches: surface.vtu's mesh and its grid were 1 GB together).
+// The points of every part, in part order (each part's points released once copied).
 template <class Part>
-vtkNew<vtkUnstructuredGrid> build_grid(std::span<Part> parts, const std::string& part_array) {
-  const PartsLayout L = parts_layout(std::span<const VtuMesh>(parts.data(), parts.size()), part_array);
-  vtkNew<vtkUnstructuredGrid> grid;
-
+void set_points(vtkUnstructuredGrid* grid, std::span<Part> parts, const PartsLayout& L) {
   vtkNew<vtkPoints> points;
   points->SetDataTypeToDouble();
   points->SetNumberOfPoints(static_cast<vtkIdType>(L.point_offset.back()));
@@ -208,9 +202,11 @@ vtkNew<vtkUnstructuredGrid> build_grid(std::span<Part> parts, const std::string&
     release(p, p.points), release(p, p.points3d);
   }
   grid->SetPoints(points);
+}
 
-  // Part indices before the parts' cells are released.
-  std::vector<int> index = part_array.empty() ? std::vector<int>() : part_index(parts, L.cells);
+// The cells of every part, their point ids offset by the part's first point.
+template <class Part>
+void set_cells(vtkUnstructuredGrid* grid, std::span<Part> parts, const PartsLayout& L) {
   vtkNew<vtkCellArray> cells;
   vtkNew<vtkUnsignedCharArray> types;
   types->SetNumberOfTuples(static_cast<vtkIdType>(L.cells));
@@ -237,7 +233,13 @@ vtkNew<vtkUnstructuredGrid> build_grid(std::span<Part> parts, const std::string&
     release(p, p.cells), release(p, p.cell_types);
   }
   grid->SetCells(types, cells);
+}
 
+// The point and cell fields of the parts, gathered by name; `index`: the
+// values of the part-index array `part_array` ("" for none).
+template <class Part>
+void add_fields(vtkUnstructuredGrid* grid, std::span<Part> parts, const PartsLayout& L, const std::string& part_array,
+                const std::vector<int>& index) {
   const vtkIdType np = static_cast<vtkIdType>(L.point_offset.back()), nc = static_cast<vtkIdType>(L.cells);
   auto doubles = [&](const std::string& name, auto member, vtkIdType n) {
     vtkNew<vtkDoubleArray> a;
@@ -277,18 +279,38 @@ vtkNew<vtkUnstructuredGrid> build_grid(std::span<Part> parts, const std::string&
   for (const std::string& name : L.cell_scalars) cd->AddArray(doubles(name, &VtuMesh::cell_scalars, nc));
   for (const std::string& name : L.cell_ints) cd->AddArray(ints(name, &VtuMesh::cell_ints, nc));
   for (const std::string& name : L.cell_vectors) cd->AddArray(vectors(name, &VtuMesh::cell_vectors, nc));
-  if (L.degrees && L.cells > 0) {
-    vtkNew<vtkIntArray> a;
-    a->SetName("HigherOrderDegrees");
-    a->SetNumberOfComponents(3);
-    a->SetNumberOfTuples(nc);
-    vtkIdType i = 0;
-    for (Part& p : parts) {
-      for (const std::array<int, 3>& d : p.higher_order_degrees) a->SetTypedTuple(i++, d.data());
-      release(p, p.higher_order_degrees);
-    }
-    cd->SetHigherOrderDegrees(a);
+}
+
+// VTK's HigherOrderDegrees cell array, where the parts give cell degrees.
+template <class Part>
+void add_higher_order_degrees(vtkUnstructuredGrid* grid, std::span<Part> parts, const PartsLayout& L) {
+  if (!L.degrees || L.cells == 0) return;
+  vtkNew<vtkIntArray> a;
+  a->SetName("HigherOrderDegrees");
+  a->SetNumberOfComponents(3);
+  a->SetNumberOfTuples(static_cast<vtkIdType>(L.cells));
+  vtkIdType i = 0;
+  for (Part& p : parts) {
+    for (const std::array<int, 3>& d : p.higher_order_degrees) a->SetTypedTuple(i++, d.data());
+    release(p, p.higher_order_degrees);
   }
+  grid->GetCellData()->SetHigherOrderDegrees(a);
+}
+
+// The grid of the parts as one mesh (merge_vtu). With non-const parts
+// (write_vtu(path, VtuMesh&&), write_vtu_parts) each of their arrays is
+// released once VTK has its copy, so that the two are never whole at once (a
+// sea of 9,000 patches: surface.vtu's mesh and its grid were 1 GB together).
+template <class Part>
+vtkNew<vtkUnstructuredGrid> build_grid(std::span<Part> parts, const std::string& part_array) {
+  const PartsLayout L = parts_layout(std::span<const VtuMesh>(parts.data(), parts.size()), part_array);
+  vtkNew<vtkUnstructuredGrid> grid;
+  set_points(grid.Get(), parts, L);
+  // Part indices before the parts' cells are released.
+  const std::vector<int> index = part_array.empty() ? std::vector<int>() : part_index(parts, L.cells);
+  set_cells(grid.Get(), parts, L);
+  add_fields(grid.Get(), parts, L, part_array, index);
+  add_higher_order_degrees(grid.Get(), parts, L);
   return grid;
 }
 
