@@ -109,30 +109,40 @@ void generate_surface_mesh() {
   }
 }
 
-GmshSurfaceMesh read_surface_mesh() {
-  GmshSurfaceMesh out;
-  SurfaceMesh& m = out.mesh;
-  std::unordered_map<std::size_t, int> index_of;  // node tag -> mesh node
-  auto node_index = [&](std::size_t tag, const double* xyz) {
-    const auto [it, inserted] = index_of.emplace(tag, static_cast<int>(m.x.size()));
+namespace {
+
+// The reading of the session's mesh into a GmshSurfaceMesh, face by face.
+class SurfaceMeshReader {
+ public:
+  GmshSurfaceMesh read() {
+    gmsh::vectorpair faces;
+    gmsh::model::getEntities(faces, 2);
+    for (const auto& [dim, tag] : faces) read_face(tag);
+    if (m_.elements.empty()) throw InputError("the mesh has no triangles or quadrangles on the model's surfaces");
+    for (int n : foreign_) m_.free_face[n] = -1;
+    return std::move(out_);
+  }
+
+ private:
+  // The mesh node of node tag `tag` at xyz, added the first time it is seen.
+  int node_index(std::size_t tag, const double* xyz) {
+    const auto [it, inserted] = index_of_.emplace(tag, static_cast<int>(m_.x.size()));
     if (inserted) {
-      out.node_tags.push_back(tag);
-      m.x.emplace_back(xyz[0], xyz[1], xyz[2]);
-      m.u.emplace_back(0.0, 0.0);
-      m.free_face.push_back(-1);
+      out_.node_tags.push_back(tag);
+      m_.x.emplace_back(xyz[0], xyz[1], xyz[2]);
+      m_.u.emplace_back(0.0, 0.0);
+      m_.free_face.push_back(-1);
     }
     return it->second;
-  };
-  std::vector<int> foreign;  // nodes used by elements of a face they are not on
-  gmsh::vectorpair faces;
-  gmsh::model::getEntities(faces, 2);
-  for (const auto& [dim, tag] : faces) {
+  }
+
+  void read_face(int tag) {
     const FaceElements elements =
         face_elements(tag, {2, 3}, "only linear triangles (2) and quadrangles (3) are supported");
-    if (elements.count == 0) continue;
-    const int f = static_cast<int>(out.faces.size());
-    out.faces.push_back(std::make_unique<GmshFace>(tag));
-    m.faces.push_back(out.faces.back().get());
+    if (elements.count == 0) return;
+    const int f = static_cast<int>(out_.faces.size());
+    out_.faces.push_back(std::make_unique<GmshFace>(tag));
+    m_.faces.push_back(out_.faces.back().get());
     // All nodes of the face with parametric coordinates on it (boundary nodes
     // reparametrized by Gmsh), and which of them are inside the face.
     std::vector<std::size_t> tags, inner_tags;
@@ -142,34 +152,51 @@ GmshSurfaceMesh read_surface_mesh() {
     if (!inner_tags.empty() && inner_uv.size() != 2 * inner_tags.size())
       throw InputError(cat("the mesh has no parametric coordinates for the nodes inside surface ", tag,
                            " (save it with Mesh.SaveParametric = 1)"));
-    std::unordered_map<std::size_t, std::size_t> xyz_of;
-    for (std::size_t i = 0; i < tags.size(); ++i) xyz_of[tags[i]] = i;
-    std::unordered_map<std::size_t, Eigen::Vector2d> uv_of;
+    FaceNodes nodes;
+    for (std::size_t i = 0; i < tags.size(); ++i) nodes.xyz_of[tags[i]] = &xyz[3 * i];
     if (uv.size() == 2 * tags.size())
-      for (std::size_t i = 0; i < tags.size(); ++i) uv_of[tags[i]] = Eigen::Vector2d(uv[2 * i], uv[2 * i + 1]);
-    const GmshFace& face = *out.faces.back();
+      for (std::size_t i = 0; i < tags.size(); ++i) nodes.uv_of[tags[i]] = Eigen::Vector2d(uv[2 * i], uv[2 * i + 1]);
+    const GmshFace& face = *out_.faces.back();
     for (std::size_t i = 0; i < inner_tags.size(); ++i) {
       const int n = node_index(inner_tags[i], &inner_xyz[3 * i]);
-      m.free_face[n] = f;
-      m.u[n] = Eigen::Vector2d(inner_uv[2 * i], inner_uv[2 * i + 1]);
-      uv_of[inner_tags[i]] = m.u[n];
-      // The checks of validate_surface_mesh, named with Gmsh tags.
-      const std::string where =
-          cat("node ", inner_tags[i], " of surface ", tag, " at (u, v) = (", m.u[n].x(), ", ", m.u[n].y(), ")");
-      const SurfacePoint p = face.evaluate(m.u[n], 1);
-      if (unit_normal(p).isZero())
-        throw InputError(cat(where, " lies at a degenerate point of the surface (phi_u x phi_v = 0)"));
-      if (!face.contains(m.u[n]))
-        throw InputError(cat(where, " is outside the surface's parameter range [", face.lower().x(), ", ",
-                             face.upper().x(), "] x [", face.lower().y(), ", ", face.upper().y(), "]"));
-      if (!face.contains_exactly(m.u[n]))
-        throw InputError(cat(where, " lies outside the trimmed face (in a trimmed-away part of its parameter range)"));
-      const double scale = std::max(1.0, p.x.norm());
-      if (!((p.x - m.x[n]).norm() <= 1e-6 * scale))
-        throw InputError(cat(where, ": the surface at these parametric coordinates is ", (p.x - m.x[n]).norm(),
-                             " away from the node"));
+      m_.free_face[n] = f;
+      m_.u[n] = Eigen::Vector2d(inner_uv[2 * i], inner_uv[2 * i + 1]);
+      nodes.uv_of[inner_tags[i]] = m_.u[n];
+      check_inner_node(face, tag, inner_tags[i], n);
     }
-    const std::size_t first_element = m.elements.size();
+    const std::size_t first_element = m_.elements.size();
+    add_elements(elements, f, tag, nodes);
+    orient_like_the_normal(m_, face, first_element);
+  }
+
+  // Where a face's nodes are: coordinates (into Gmsh's arrays) and parametric
+  // coordinates on the face, by node tag.
+  struct FaceNodes {
+    std::unordered_map<std::size_t, const double*> xyz_of;
+    std::unordered_map<std::size_t, Eigen::Vector2d> uv_of;
+  };
+
+  // The checks of validate_surface_mesh on a node inside face `tag`, named with Gmsh tags.
+  void check_inner_node(const GmshFace& face, int tag, std::size_t node_tag, int n) const {
+    const std::string where =
+        cat("node ", node_tag, " of surface ", tag, " at (u, v) = (", m_.u[n].x(), ", ", m_.u[n].y(), ")");
+    const SurfacePoint p = face.evaluate(m_.u[n], 1);
+    if (unit_normal(p).isZero())
+      throw InputError(cat(where, " lies at a degenerate point of the surface (phi_u x phi_v = 0)"));
+    if (!face.contains(m_.u[n]))
+      throw InputError(cat(where, " is outside the surface's parameter range [", face.lower().x(), ", ",
+                           face.upper().x(), "] x [", face.lower().y(), ", ", face.upper().y(), "]"));
+    if (!face.contains_exactly(m_.u[n]))
+      throw InputError(cat(where, " lies outside the trimmed face (in a trimmed-away part of its parameter range)"));
+    const double scale = std::max(1.0, p.x.norm());
+    if (!((p.x - m_.x[n]).norm() <= 1e-6 * scale))
+      throw InputError(cat(where, ": the surface at these parametric coordinates is ", (p.x - m_.x[n]).norm(),
+                           " away from the node"));
+  }
+
+  // The elements of face `tag` (mesh face f), each corner with its parametric
+  // coordinates on the face.
+  void add_elements(const FaceElements& elements, int f, int tag, FaceNodes& nodes) {
     for (std::size_t k = 0; k < elements.types.size(); ++k) {
       const int nv = elements.types[k] == 2 ? 3 : 4;
       for (std::size_t e = 0; e < elements.tags[k].size(); ++e) {
@@ -178,32 +205,38 @@ GmshSurfaceMesh read_surface_mesh() {
         el.face = f;
         for (int i = 0; i < nv; ++i) {
           const std::size_t nt = elements.nodes[k][nv * e + i];
-          const auto xt = xyz_of.find(nt);
-          if (xt != xyz_of.end()) {
-            el.v[i] = node_index(nt, &xyz[3 * xt->second]);
+          const auto xt = nodes.xyz_of.find(nt);
+          if (xt != nodes.xyz_of.end()) {
+            el.v[i] = node_index(nt, xt->second);
           } else {
             // A node classified on another entity (a remeshed element across a
             // smooth junction between faces): fixed, with its parametric
             // coordinates on this face from the closest point.
-            el.v[i] = foreign_node(nt, tag, node_index, uv_of);
-            foreign.push_back(el.v[i]);
+            auto index = [this](std::size_t t, const double* x) { return node_index(t, x); };
+            el.v[i] = foreign_node(nt, tag, index, nodes.uv_of);
+            foreign_.push_back(el.v[i]);
           }
-          const auto it = uv_of.find(nt);
-          if (it == uv_of.end())
+          const auto it = nodes.uv_of.find(nt);
+          if (it == nodes.uv_of.end())
             throw InputError(cat("node ", nt, " of surface ", tag, " has no parametric coordinates on it"));
-          m.corner_uv.push_back(it->second);
+          m_.corner_uv.push_back(it->second);
         }
-        for (int i = nv; i < 4; ++i) m.corner_uv.push_back(Eigen::Vector2d::Zero());
-        m.elements.push_back(el);
-        out.face_tags.push_back(tag);
+        for (int i = nv; i < 4; ++i) m_.corner_uv.push_back(Eigen::Vector2d::Zero());
+        m_.elements.push_back(el);
+        out_.face_tags.push_back(tag);
       }
     }
-    orient_like_the_normal(m, face, first_element);
   }
-  if (m.elements.empty()) throw InputError("the mesh has no triangles or quadrangles on the model's surfaces");
-  for (int n : foreign) m.free_face[n] = -1;
-  return out;
-}
+
+  GmshSurfaceMesh out_;
+  SurfaceMesh& m_ = out_.mesh;
+  std::unordered_map<std::size_t, int> index_of_;  // node tag -> mesh node
+  std::vector<int> foreign_;  // nodes used by elements of a face they are not on
+};
+
+}  // namespace
+
+GmshSurfaceMesh read_surface_mesh() { return SurfaceMeshReader().read(); }
 
 void write_mesh(const std::string& path, const GmshSurfaceMesh& m) {
   for (std::size_t i = 0; i < m.mesh.x.size(); ++i) {
