@@ -390,27 +390,42 @@ Eigen::Vector3d GmshRemeshGeometry::patch_normal(int patch, VertexKind kind, con
   return Eigen::Vector3d::Zero();
 }
 
-RemeshMesh read_remesh_mesh(const GmshRemeshGeometry& g) {
-  const CadFeatures& f = g.features();
-  RemeshMesh m;
-  std::unordered_map<std::size_t, int> index;  // node tag -> vertex
-  std::unordered_map<std::size_t, int> face_of_node;
-  std::vector<int> tri_patch;
-  std::vector<std::array<std::size_t, 3>> tri_nodes;
-  for (const auto& [face, patch] : f.patch_of_face) {
-    std::vector<std::size_t> elems, nodes;
-    gmsh::model::mesh::getElementsByType(2, elems, nodes, face);
-    // Gmsh's triangles turn counter-clockwise about the oriented normal
-    // face_sign * phi_u x phi_v by the definition of face_sign.
-    for (std::size_t e = 0; e < elems.size(); ++e) {
-      const std::array<std::size_t, 3> n{nodes[3 * e], nodes[3 * e + 1], nodes[3 * e + 2]};
-      tri_nodes.push_back(n);
-      tri_patch.push_back(patch);
-      for (std::size_t k : n) face_of_node.emplace(k, face);
+namespace {
+
+// The reading of the session's triangles into a RemeshMesh: vertices
+// classified by the model entity Gmsh put each node on, normals per patch,
+// feature edges.
+class RemeshMeshReader {
+ public:
+  explicit RemeshMeshReader(const GmshRemeshGeometry& g) : g_(g), f_(g.features()) {}
+
+  RemeshMesh read() {
+    read_triangle_nodes();
+    for (int dim = 0; dim <= 2; ++dim) add_vertices_on(dim);
+    add_triangles();
+    add_normals();
+    mark_feature_edges();
+    return std::move(m_);
+  }
+
+ private:
+  // Gmsh's triangles turn counter-clockwise about the oriented normal
+  // face_sign * phi_u x phi_v by the definition of face_sign.
+  void read_triangle_nodes() {
+    for (const auto& [face, patch] : f_.patch_of_face) {
+      std::vector<std::size_t> elems, nodes;
+      gmsh::model::mesh::getElementsByType(2, elems, nodes, face);
+      for (std::size_t e = 0; e < elems.size(); ++e) {
+        const std::array<std::size_t, 3> n{nodes[3 * e], nodes[3 * e + 1], nodes[3 * e + 2]};
+        tri_nodes_.push_back(n);
+        tri_patch_.push_back(patch);
+        for (std::size_t k : n) face_of_node_.emplace(k, face);
+      }
     }
   }
-  // Vertices, classified by the entity Gmsh put each node on.
-  for (int dim = 0; dim <= 2; ++dim) {
+
+  // The vertices of the nodes on the entities of dimension `dim` that some triangle uses.
+  void add_vertices_on(int dim) {
     gmsh::vectorpair ents;
     gmsh::model::getEntities(ents, dim);
     for (const auto& [d, tag] : ents) {
@@ -418,69 +433,97 @@ RemeshMesh read_remesh_mesh(const GmshRemeshGeometry& g) {
       std::vector<double> xyz, par;
       gmsh::model::mesh::getNodes(tags, xyz, par, dim, tag, false, true);
       for (std::size_t i = 0; i < tags.size(); ++i) {
-        const auto fn = face_of_node.find(tags[i]);
-        if (fn == face_of_node.end()) continue;  // not on a triangle
-        RemeshVertex v;
-        v.x = vec3(xyz, i);
-        if (dim == 0 && f.is_corner(tag)) {
-          v.kind = VertexKind::corner;
-          v.on = {v.x, tag, Eigen::Vector2d::Zero()};
-        } else if (dim == 1 && f.is_feature(tag)) {
-          if (par.size() != tags.size())
-            throw InputError(cat("the mesh has no parametric coordinates on curve ", tag));
-          v.kind = VertexKind::curve;
-          v.on = {v.x, tag, Eigen::Vector2d(par[i], 0.0)};
-        } else if (dim == 2) {
-          if (par.size() != 2 * tags.size())
-            throw InputError(cat("the mesh has no parametric coordinates for the nodes inside surface ", tag,
-                                 " (save it with Mesh.SaveParametric = 1)"));
-          v.on = {v.x, tag, Eigen::Vector2d(par[2 * i], par[2 * i + 1])};
-        } else {  // on a smooth curve or point: a surface vertex of a face it touches
-          const GeometryPoint on{v.x, tag, Eigen::Vector2d(dim == 1 && !par.empty() ? par[i] : 0.0, 0.0)};
-          v.on = {v.x, fn->second, g.boundary_uv(fn->second, dim == 1 ? VertexKind::curve : VertexKind::corner, on)};
-        }
-        index[tags[i]] = m.add_vertex(v);
+        const auto fn = face_of_node_.find(tags[i]);
+        if (fn == face_of_node_.end()) continue;  // not on a triangle
+        index_[tags[i]] = m_.add_vertex(vertex(dim, tag, tags, xyz, par, i, fn->second));
       }
     }
   }
-  for (std::size_t t = 0; t < tri_nodes.size(); ++t) {
-    RemeshTriangle tr{{0, 0, 0}, tri_patch[t], true};
-    for (int k = 0; k < 3; ++k) {
-      const auto it = index.find(tri_nodes[t][k]);
-      if (it == index.end()) throw InputError(cat("triangle node ", tri_nodes[t][k], " is not classified on the model"));
-      tr.v[k] = it->second;
+
+  // Node i of entity (dim, tag): a corner, a vertex on a feature curve, a
+  // surface vertex of its face, or, on a smooth curve or point, a surface
+  // vertex of `face`, a face it touches.
+  RemeshVertex vertex(int dim, int tag, const std::vector<std::size_t>& tags, const std::vector<double>& xyz,
+                      const std::vector<double>& par, std::size_t i, int face) const {
+    RemeshVertex v;
+    v.x = vec3(xyz, i);
+    if (dim == 0 && f_.is_corner(tag)) {
+      v.kind = VertexKind::corner;
+      v.on = {v.x, tag, Eigen::Vector2d::Zero()};
+    } else if (dim == 1 && f_.is_feature(tag)) {
+      if (par.size() != tags.size()) throw InputError(cat("the mesh has no parametric coordinates on curve ", tag));
+      v.kind = VertexKind::curve;
+      v.on = {v.x, tag, Eigen::Vector2d(par[i], 0.0)};
+    } else if (dim == 2) {
+      if (par.size() != 2 * tags.size())
+        throw InputError(cat("the mesh has no parametric coordinates for the nodes inside surface ", tag,
+                             " (save it with Mesh.SaveParametric = 1)"));
+      v.on = {v.x, tag, Eigen::Vector2d(par[2 * i], par[2 * i + 1])};
+    } else {
+      const GeometryPoint on{v.x, tag, Eigen::Vector2d(dim == 1 && !par.empty() ? par[i] : 0.0, 0.0)};
+      v.on = {v.x, face, g_.boundary_uv(face, dim == 1 ? VertexKind::curve : VertexKind::corner, on)};
     }
-    m.add_triangle(tr);
+    return v;
   }
-  // Normals of every vertex on each patch of its triangles.
-  for (std::size_t v = 0; v < m.vertices.size(); ++v)
-    for (int t : m.triangles_of(static_cast<int>(v))) {
-      RemeshVertex& vv = m.vertices[v];
-      const int p = m.triangles[t].patch;
-      if (vv.normal(p).isZero()) vv.normals.emplace_back(p, g.patch_normal(p, vv.kind, vv.on));
+
+  void add_triangles() {
+    for (std::size_t t = 0; t < tri_nodes_.size(); ++t) {
+      RemeshTriangle tr{{0, 0, 0}, tri_patch_[t], true};
+      for (int k = 0; k < 3; ++k) {
+        const auto it = index_.find(tri_nodes_[t][k]);
+        if (it == index_.end())
+          throw InputError(cat("triangle node ", tri_nodes_[t][k], " is not classified on the model"));
+        tr.v[k] = it->second;
+      }
+      m_.add_triangle(tr);
     }
+  }
+
+  // Normals of every vertex on each patch of its triangles.
+  void add_normals() {
+    for (std::size_t v = 0; v < m_.vertices.size(); ++v)
+      for (int t : m_.triangles_of(static_cast<int>(v))) {
+        RemeshVertex& vv = m_.vertices[v];
+        const int p = m_.triangles[t].patch;
+        if (vv.normal(p).isZero()) vv.normals.emplace_back(p, g_.patch_normal(p, vv.kind, vv.on));
+      }
+  }
+
   // Feature edges: Gmsh's line elements on feature curves, else triangle edges
   // whose end points are both on the same feature curve (or its corners).
-  for (int curve : f.feature_curves) {
-    std::vector<std::size_t> elems, nodes;
-    gmsh::model::mesh::getElementsByType(1, elems, nodes, curve);
-    for (std::size_t e = 0; e < elems.size(); ++e) {
-      const auto a = index.find(nodes[2 * e]), b = index.find(nodes[2 * e + 1]);
-      if (a != index.end() && b != index.end() && m.has_edge(a->second, b->second))
-        m.feature_edges[RemeshMesh::key(a->second, b->second)] = curve;
+  void mark_feature_edges() {
+    for (int curve : f_.feature_curves) {
+      std::vector<std::size_t> elems, nodes;
+      gmsh::model::mesh::getElementsByType(1, elems, nodes, curve);
+      for (std::size_t e = 0; e < elems.size(); ++e) {
+        const auto a = index_.find(nodes[2 * e]), b = index_.find(nodes[2 * e + 1]);
+        if (a != index_.end() && b != index_.end() && m_.has_edge(a->second, b->second))
+          m_.feature_edges[RemeshMesh::key(a->second, b->second)] = curve;
+      }
     }
-  }
-  if (m.feature_edges.empty() && !f.feature_curves.empty())
-    for (const auto& [a, b] : m.edges()) {
-      const RemeshVertex &va = m.vertices[a], &vb = m.vertices[b];
+    if (!m_.feature_edges.empty() || f_.feature_curves.empty()) return;
+    for (const auto& [a, b] : m_.edges()) {
+      const RemeshVertex &va = m_.vertices[a], &vb = m_.vertices[b];
       if (va.kind == VertexKind::curve && vb.kind != VertexKind::surface &&
           (vb.kind == VertexKind::corner || vb.on.entity == va.on.entity))
-        m.feature_edges[RemeshMesh::key(a, b)] = va.on.entity;
+        m_.feature_edges[RemeshMesh::key(a, b)] = va.on.entity;
       else if (vb.kind == VertexKind::curve && va.kind == VertexKind::corner)
-        m.feature_edges[RemeshMesh::key(a, b)] = vb.on.entity;
+        m_.feature_edges[RemeshMesh::key(a, b)] = vb.on.entity;
     }
-  return m;
-}
+  }
+
+  const GmshRemeshGeometry& g_;
+  const CadFeatures& f_;
+  RemeshMesh m_;
+  std::unordered_map<std::size_t, int> index_;         // node tag -> vertex
+  std::unordered_map<std::size_t, int> face_of_node_;  // node tag -> a face of a triangle using it
+  std::vector<int> tri_patch_;
+  std::vector<std::array<std::size_t, 3>> tri_nodes_;
+};
+
+}  // namespace
+
+RemeshMesh read_remesh_mesh(const GmshRemeshGeometry& g) { return RemeshMeshReader(g).read(); }
 
 CentroidProjection project_centroids(const RemeshMesh& m, const GmshRemeshGeometry& g) {
   CentroidProjection out;
