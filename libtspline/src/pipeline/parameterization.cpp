@@ -118,10 +118,11 @@ FrontResult run_corner_trial(const Polygon& poly, const Corners& corners, Parame
   return optimize_front(BoundaryMap(poly, corners), o);
 }
 
-CornerTrials try_corners(const Polygon& poly, std::vector<Corners> cands, const ParameterizationOptions& opt) {
-  // Trials at most at the default resolution (level <= 5, tolerance no finer
-  // than the default 1e-5 diag^2): for the default options that is the run
-  // itself; for fine user settings it keeps the trials cheap.
+// The options of a corner trial: at most the default resolution (level <= 5,
+// tolerance no finer than the default 1e-5 diag^2): for the default options
+// that is the run itself (`trial_is_run`); for fine user settings it keeps the
+// trials cheap.
+ParameterizationOptions trial_options(const Polygon& poly, const ParameterizationOptions& opt, bool& trial_is_run) {
   ParameterizationOptions topt = opt;
   topt.smoothing.progress = nullptr;
   topt.corner_trials = 1;
@@ -129,7 +130,31 @@ CornerTrials try_corners(const Polygon& poly, std::vector<Corners> cands, const 
   const double d = bounding_box_diagonal(poly);
   const double tol = opt.tolerance_absolute ? *opt.tolerance_absolute : opt.tolerance_relative * d * d;
   topt.tolerance_absolute = std::max(tol, 1e-5 * d * d);
-  const bool trial_is_run = topt.initial_level == opt.initial_level && *topt.tolerance_absolute == tol;
+  trial_is_run = topt.initial_level == opt.initial_level && *topt.tolerance_absolute == tol;
+  return topt;
+}
+
+// One row per candidate: its corners and its front's figures; a trial that
+// failed (needed more than max_cells) ranks last.
+std::vector<CornerTrial> trial_rows(const std::vector<Corners>& cands,
+                                    const std::vector<std::optional<FrontResult>>& results) {
+  std::vector<CornerTrial> rows;
+  for (std::size_t k = 0; k < cands.size(); ++k) {
+    constexpr double kWorst = -std::numeric_limits<double>::infinity();
+    if (!results[k]) {
+      rows.push_back({cands[k].index, std::numeric_limits<std::size_t>::max(), kWorst, kWorst});
+      continue;
+    }
+    const FrontResult& t = *results[k];
+    rows.push_back({cands[k].index, t.quality_optimized.inverted_cells, t.quality_optimized.min_quality,
+                    t.quality_optimized.mean_quality});
+  }
+  return rows;
+}
+
+CornerTrials try_corners(const Polygon& poly, std::vector<Corners> cands, const ParameterizationOptions& opt) {
+  bool trial_is_run = false;
+  const ParameterizationOptions topt = trial_options(poly, opt, trial_is_run);
   std::vector<std::optional<FrontResult>> results(cands.size());
   std::vector<std::vector<ProgressEvent>> events(cands.size());
   std::mutex report_mutex;
@@ -159,16 +184,7 @@ CornerTrials try_corners(const Polygon& poly, std::vector<Corners> cands, const 
     if (opt.progress) report(s.str());
   });
   CornerTrials out;
-  for (std::size_t k = 0; k < cands.size(); ++k) {
-    constexpr double kWorst = -std::numeric_limits<double>::infinity();
-    if (!results[k]) {
-      out.trials.push_back({cands[k].index, std::numeric_limits<std::size_t>::max(), kWorst, kWorst});
-      continue;
-    }
-    const FrontResult& t = *results[k];
-    out.trials.push_back({cands[k].index, t.quality_optimized.inverted_cells, t.quality_optimized.min_quality,
-                          t.quality_optimized.mean_quality});
-  }
+  out.trials = trial_rows(cands, results);
   const std::size_t best = best_corner_trial(out.trials);
   if (!results[best]) std::rethrow_exception(over_budget[best]);  // every trial needed more cells
   if (trial_is_run) {
