@@ -18,6 +18,7 @@
 #include "tspline/boundary/polygon_validation.h"
 #include "tspline/errors.h"
 #include "tspline/io/gis_reader.h"
+#include "tspline/io/polygon_reader.h"
 #include "tspline/layout/quad_layout.h"
 #include "tspline/layout/quad_mesher.h"
 #include "tspline/layout/ring_nodes.h"
@@ -376,5 +377,63 @@ TEST_SUITE("quad_layout") {
                    "cannot be one patch"));
     CHECK(contains(message_of<tspline::InputError>([] { (void)tspline::parse_layout_mode("quads"); }),
                    "auto, single, quad"));
+  }
+
+  TEST_CASE("a quad layout's map below the thresholds: a second layout with larger patches, the better map kept") {
+    // The flower (curved petals: no map of it has a scaled Jacobian of 1).
+    const tspline::Domain flower{tspline::io::read_polygon(test_support::polygon_file("flower.txt")), {}};
+    tspline::ParameterizationOptions po;
+    const tspline::AdaptiveOptions ad;
+    tspline::DomainParameterizationOptions c;
+    c.layout = tspline::LayoutMode::Quad;
+    const tspline::DomainParameterization first = tspline::parameterize_domain(flower, po, ad, c);
+    REQUIRE(first.patches);
+    CHECK(first.patches->certified_valid());
+    CHECK_FALSE(contains(first.reason, "second quad layout"));  // good: no second layout
+    // A threshold no map of it reaches: the second layout is made; the
+    // map kept is certified, and is the second only where it is better.
+    c.good_scaled_jacobian = 0.999;
+    const tspline::DomainParameterization again = tspline::parameterize_domain(flower, po, ad, c);
+    REQUIRE(again.patches);
+    CHECK(again.patches->certified_valid());
+    INFO(again.reason);
+    CHECK(contains(again.reason, "below the thresholds, a second quad layout with patches 1.2 times larger"));
+    auto worse = [](const tspline::MultiPatchResult& R) {
+      return std::min(R.min_scaled_jacobian_dense(), R.min_mean_ratio_dense());
+    };
+    if (contains(again.reason, "gave a better map")) {
+      CHECK(worse(*again.patches) > worse(*first.patches));
+      CHECK(again.patches->patches.size() != first.patches->patches.size());
+    } else {
+      CHECK(contains(again.reason, "the first kept"));
+      CHECK(worse(*again.patches) == worse(*first.patches));
+    }
+    // A factor of 1: no second layout.
+    c.retry_size_factor = 1.0;
+    const tspline::DomainParameterization once = tspline::parameterize_domain(flower, po, ad, c);
+    CHECK_FALSE(contains(once.reason, "second quad layout"));
+    CHECK(worse(*once.patches) == worse(*first.patches));
+  }
+
+  TEST_CASE("auto's choice between a certified layout and one patch: the layout where it is good") {
+    const tspline::DomainParameterizationOptions c;  // scaled Jacobian >= 0.3 and J_r >= 0.1
+    auto figures = [](double sj, double jr) {
+      tspline::DenseMapQuality q;
+      q.min_scaled = sj;
+      q.min_mean_ratio = jr;
+      return q;
+    };
+    CHECK(tspline::reaches_good_quality(figures(0.3, 0.1), c));
+    CHECK_FALSE(tspline::reaches_good_quality(figures(0.29, 0.5), c));
+    CHECK_FALSE(tspline::reaches_good_quality(figures(0.5, 0.09), c));
+    // A mirrored Corsica: one patch SJ 0.282 / J_r 0.279 (certified, below the
+    // thresholds), the layout SJ 0.448 / J_r 0.275. The layout is good: kept,
+    // though the worse of its figures is 0.004 lower than one patch's.
+    CHECK(tspline::keep_layout_over_single(figures(0.448, 0.275), figures(0.282, 0.279), true, c));
+    // Neither good: the better worse figure wins (a layout can split a tip one patch keeps whole).
+    CHECK_FALSE(tspline::keep_layout_over_single(figures(0.25, 0.2), figures(0.28, 0.26), true, c));
+    CHECK(tspline::keep_layout_over_single(figures(0.28, 0.26), figures(0.25, 0.2), true, c));
+    // One patch not certified: the layout, whatever its figures.
+    CHECK(tspline::keep_layout_over_single(figures(0.05, 0.05), figures(0.9, 0.9), false, c));
   }
 }

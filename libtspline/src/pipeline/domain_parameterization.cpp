@@ -65,6 +65,16 @@ std::string figures(const DenseMapQuality& q) {
 
 }  // namespace
 
+bool reaches_good_quality(const DenseMapQuality& q, const DomainParameterizationOptions& c) {
+  return q.min_scaled >= c.good_scaled_jacobian && q.min_mean_ratio >= c.good_mean_ratio;
+}
+
+bool keep_layout_over_single(const DenseMapQuality& layout, const DenseMapQuality& single, bool single_certified,
+                             const DomainParameterizationOptions& c) {
+  return !single_certified || reaches_good_quality(layout, c) ||
+         std::min(layout.min_scaled, layout.min_mean_ratio) >= std::min(single.min_scaled, single.min_mean_ratio);
+}
+
 DomainParameterization parameterize_domain(const Domain& input, const ParameterizationOptions& options,
                                            const AdaptiveOptions& adaptive, const DomainParameterizationOptions& c,
                                            const IterationCallback& on_iteration, const PatchCallback& on_patch) {
@@ -121,6 +131,56 @@ DomainParameterization parameterize_domain(const Domain& input, const Parameteri
   HeldEvents held;
   std::atomic<bool> cancel{false};  // the run ahead's: set where it is not wanted
   std::future<LayoutAhead> ahead;
+  auto good_patches = [&](const MultiPatchResult& R) {
+    return (!adaptive.certify || R.certified_valid()) && R.min_scaled_jacobian_dense() >= c.good_scaled_jacobian &&
+           R.min_mean_ratio_dense() >= c.good_mean_ratio;
+  };
+  auto patch_figures = [](const MultiPatchResult& R) {
+    std::ostringstream q;
+    q.precision(3);
+    q << "scaled Jacobian " << R.min_scaled_jacobian_dense() << ", J_r " << R.min_mean_ratio_dense();
+    return q.str();
+  };
+  // A certified map of a quad layout below the thresholds: one more layout of
+  // `valid` with patches c.retry_size_factor times larger (another mesh of
+  // the domain, whose worst corners fall elsewhere), kept where its map is
+  // certified and the worse of its two figures is higher.
+  auto retry_with_larger_patches = [&](const Domain& valid) {
+    const MultiPatchResult& first = *out.patches;
+    if (!(c.retry_size_factor > 0.0) || c.retry_size_factor == 1.0 || good_patches(first) ||
+        (adaptive.certify && !first.certified_valid()))
+      return;
+    auto worse = [](const MultiPatchResult& R) {
+      return std::min(R.min_scaled_jacobian_dense(), R.min_mean_ratio_dense());
+    };
+    std::ostringstream larger;
+    larger << "a second quad layout with patches " << c.retry_size_factor << " times larger";
+    report_step(serial.progress, "layout",
+                "the layout's map is certified but below the thresholds (" + patch_figures(first) + "): " +
+                    larger.str());
+    std::string outcome;
+    try {
+      QuadLayoutOptions q = c.quad;
+      q.size.factor *= c.retry_size_factor;
+      q.progress = layout_progress("quad layout, larger patches: ");
+      QuadLayout L = build_quad_layout(valid, q);
+      const std::string explanation = L.explanation();
+      report_step(serial.progress, "layout", explanation);
+      MultiPatchResult R = run_multipatch_parameterization(valid, std::move(L.layout), explanation, patch_options,
+                                                           adaptive, c.multi, on_patch);
+      if ((!adaptive.certify || R.certified_valid()) && worse(R) > worse(first)) {
+        outcome = larger.str() + " gave a better map (" + patch_figures(R) + "): kept";
+        out.patches.emplace(std::move(R));
+        out.quad_stats = L.stats;
+      } else {
+        outcome = larger.str() + " gave no better certified map (" + patch_figures(R) + "): the first kept";
+      }
+    } catch (const NumericalError& e) {
+      outcome = larger.str() + " failed (" + e.what() + "): the first kept";
+    }
+    report_step(serial.progress, "layout", outcome);
+    out.reason += "; below the thresholds, " + outcome;
+  };
   auto run_quad = [&](const std::string& reason) {
     LayoutAhead a;
     if (ahead.valid()) {
@@ -137,16 +197,12 @@ DomainParameterization parameterize_domain(const Domain& input, const Parameteri
     out.layout = "quad";
     out.reason = reason;
     out.quad_stats = a.layout.stats;
-    if (a.patches) {
+    if (a.patches)
       out.patches.emplace(std::move(*a.patches));
-      return;
-    }
-    out.patches.emplace(run_multipatch_parameterization(a.valid, std::move(a.layout.layout), a.explanation,
-                                                        patch_options, adaptive, c.multi, on_patch));
-  };
-  auto good_patches = [&](const MultiPatchResult& R) {
-    return (!adaptive.certify || R.certified_valid()) && R.min_scaled_jacobian_dense() >= c.good_scaled_jacobian &&
-           R.min_mean_ratio_dense() >= c.good_mean_ratio;
+    else
+      out.patches.emplace(run_multipatch_parameterization(a.valid, std::move(a.layout.layout), a.explanation,
+                                                          patch_options, adaptive, c.multi, on_patch));
+    retry_with_larger_patches(a.valid);
   };
   if (c.layout == LayoutMode::Quad) {
     run_quad("layout quad was asked for");
@@ -264,8 +320,7 @@ DomainParameterization parameterize_domain(const Domain& input, const Parameteri
   ParameterizationResult single = run_parameterization(domain.outer, serial, first, on_iteration);
   const DenseMapQuality& q = single.dense_quality;
   const bool certified = !adaptive.certify || single.certified_valid();
-  const bool good = certified && single.map && q.min_scaled >= c.good_scaled_jacobian &&
-                    q.min_mean_ratio >= c.good_mean_ratio;
+  const bool good = certified && single.map && reaches_good_quality(q, c);
   // A first try cut short by its round limit is run again in full, so that
   // auto gives what layout single gives wherever it keeps one patch.
   const bool cut_short = first.max_adapt < adaptive.max_adapt &&
@@ -287,16 +342,13 @@ DomainParameterization parameterize_domain(const Domain& input, const Parameteri
   try {
     run_quad(why);
     if (!adaptive.certify || out.patches->certified_valid()) {
-      // Kept unless one patch was certified and better (the worse of the
-      // scaled Jacobian and J_r over the whole map, dense samples): a layout
-      // can split a sharp tip the single patch keeps whole.
       DenseMapQuality lq;
       lq.min_scaled = lq.min_mean_ratio = std::numeric_limits<double>::infinity();
       for (const auto& r : out.patches->patches) {
         lq.min_scaled = std::min(lq.min_scaled, r.dense_quality.min_scaled);
         lq.min_mean_ratio = std::min(lq.min_mean_ratio, r.dense_quality.min_mean_ratio);
       }
-      if (!certified || std::min(lq.min_scaled, lq.min_mean_ratio) >= std::min(q.min_scaled, q.min_mean_ratio)) {
+      if (keep_layout_over_single(lq, q, certified, c)) {
         out.rejected_single = q;
         return out;
       }

@@ -47,6 +47,14 @@ struct DomainParameterizationOptions {
   /// Auto: domains with at most this many holes try the automatic cuts
   /// (automatic_cuts.h: few, large patches) first and keep them where good.
   int first_try_max_holes = 4;
+  /// Auto and quad: where a quad layout's certified map misses the two
+  /// thresholds above, one more layout with patches this many times larger
+  /// (size field factor) is made, and its map kept where certified and better
+  /// (the worse of the two figures). 1 (or 0): no second layout. (On rotated,
+  /// mirrored and rescaled copies of the bundled coastlines and seas, 4 maps
+  /// of 62 missed the scaled Jacobian 0.3; with patches 1.2 times larger all
+  /// four reached it, with 0.85 times one.)
+  double retry_size_factor = 1.2;
   /// Initial T-mesh level of the patches of a quad layout (they are small and
   /// nearly square; refinement adds what they need); unset: the options' own.
   std::optional<int> patch_initial_level = 2;
@@ -61,6 +69,20 @@ struct DomainParameterization {
   /// The single-patch first try of `auto` that was not kept (whole-map figures), if any.
   std::optional<DenseMapQuality> rejected_single;
 };
+
+/// Whether whole-map figures (dense samples) reach auto's thresholds: scaled
+/// Jacobian >= good_scaled_jacobian and J_r >= good_mean_ratio.
+bool reaches_good_quality(const DenseMapQuality& q, const DomainParameterizationOptions& c);
+
+/// Auto's choice once both a certified quad layout's map (`layout`) and the
+/// single patch's first try (`single`, certified or not) exist: the layout is
+/// kept where it reaches the thresholds (the single patch, which was tried
+/// first, did not), where one patch is not certified, or where the worse of
+/// its two figures is no lower than one patch's. One patch is kept only where
+/// neither is good and it is better: a layout can split a sharp tip that one
+/// patch keeps whole.
+bool keep_layout_over_single(const DenseMapQuality& layout, const DenseMapQuality& single, bool single_certified,
+                             const DomainParameterizationOptions& c);
 
 /// \param on_iteration for the single-patch run (as run_parameterization's).
 /// \throw InputError for invalid input or options; NumericalError as the runs.
