@@ -63,6 +63,17 @@ std::string figures(const DenseMapQuality& q) {
   return s.str();
 }
 
+// A multi-patch map's whole-map figures (dense samples): the least over its patches.
+DenseMapQuality dense_figures(const MultiPatchResult& R) {
+  DenseMapQuality q;
+  q.min_scaled = R.min_scaled_jacobian_dense();
+  q.min_mean_ratio = R.min_mean_ratio_dense();
+  return q;
+}
+
+// The worse of the two figures: how maps that are not both good are ranked.
+double worse_figure(const DenseMapQuality& q) { return std::min(q.min_scaled, q.min_mean_ratio); }
+
 }  // namespace
 
 bool reaches_good_quality(const DenseMapQuality& q, const DomainParameterizationOptions& c) {
@@ -71,8 +82,7 @@ bool reaches_good_quality(const DenseMapQuality& q, const DomainParameterization
 
 bool keep_layout_over_single(const DenseMapQuality& layout, const DenseMapQuality& single, bool single_certified,
                              const DomainParameterizationOptions& c) {
-  return !single_certified || reaches_good_quality(layout, c) ||
-         std::min(layout.min_scaled, layout.min_mean_ratio) >= std::min(single.min_scaled, single.min_mean_ratio);
+  return !single_certified || reaches_good_quality(layout, c) || worse_figure(layout) >= worse_figure(single);
 }
 
 DomainParameterization parameterize_domain(const Domain& input, const ParameterizationOptions& options,
@@ -132,15 +142,9 @@ DomainParameterization parameterize_domain(const Domain& input, const Parameteri
   std::atomic<bool> cancel{false};  // the run ahead's: set where it is not wanted
   std::future<LayoutAhead> ahead;
   auto good_patches = [&](const MultiPatchResult& R) {
-    return (!adaptive.certify || R.certified_valid()) && R.min_scaled_jacobian_dense() >= c.good_scaled_jacobian &&
-           R.min_mean_ratio_dense() >= c.good_mean_ratio;
+    return (!adaptive.certify || R.certified_valid()) && reaches_good_quality(dense_figures(R), c);
   };
-  auto patch_figures = [](const MultiPatchResult& R) {
-    std::ostringstream q;
-    q.precision(3);
-    q << "scaled Jacobian " << R.min_scaled_jacobian_dense() << ", J_r " << R.min_mean_ratio_dense();
-    return q.str();
-  };
+  auto patch_figures = [](const MultiPatchResult& R) { return figures(dense_figures(R)); };
   // A certified map of a quad layout below the thresholds: one more layout of
   // `valid` with patches c.retry_size_factor times larger (another mesh of
   // the domain, whose worst corners fall elsewhere), kept where its map is
@@ -150,9 +154,6 @@ DomainParameterization parameterize_domain(const Domain& input, const Parameteri
     if (!(c.retry_size_factor > 0.0) || c.retry_size_factor == 1.0 || good_patches(first) ||
         (adaptive.certify && !first.certified_valid()))
       return;
-    auto worse = [](const MultiPatchResult& R) {
-      return std::min(R.min_scaled_jacobian_dense(), R.min_mean_ratio_dense());
-    };
     std::ostringstream larger;
     larger << "a second quad layout with patches " << c.retry_size_factor << " times larger";
     report_step(serial.progress, "layout",
@@ -168,7 +169,7 @@ DomainParameterization parameterize_domain(const Domain& input, const Parameteri
       report_step(serial.progress, "layout", explanation);
       MultiPatchResult R = run_multipatch_parameterization(valid, std::move(L.layout), explanation, patch_options,
                                                            adaptive, c.multi, on_patch);
-      if ((!adaptive.certify || R.certified_valid()) && worse(R) > worse(first)) {
+      if ((!adaptive.certify || R.certified_valid()) && worse_figure(dense_figures(R)) > worse_figure(dense_figures(first))) {
         outcome = larger.str() + " gave a better map (" + patch_figures(R) + "): kept";
         out.patches.emplace(std::move(R));
         out.quad_stats = L.stats;
@@ -219,16 +220,14 @@ DomainParameterization parameterize_domain(const Domain& input, const Parameteri
         MultiPatchResult R = run_multipatch_parameterization(domain, build_patch_layout(domain, std::move(a.cuts)),
                                                              "automatic: " + a.explanation, options, adaptive,
                                                              c.multi, on_patch);
-        std::ostringstream q;
-        q.precision(3);
-        q << "scaled Jacobian " << R.min_scaled_jacobian_dense() << ", J_r " << R.min_mean_ratio_dense();
+        const std::string q = patch_figures(R);
         if (good_patches(R)) {
           out.layout = "automatic cuts";
-          out.reason = "the automatic cuts between the holes are certified and good over the whole map (" + q.str() + ")";
+          out.reason = "the automatic cuts between the holes are certified and good over the whole map (" + q + ")";
           out.patches.emplace(std::move(R));
           return out;
         }
-        why = "the automatic cuts between the holes are certified but poor, or not certified (" + q.str() + ")";
+        why = "the automatic cuts between the holes are certified but poor, or not certified (" + q + ")";
         if (!adaptive.certify || R.certified_valid()) by_cuts.emplace(std::move(R));
       } catch (const InputError& e) {
         why = std::string("the domain has holes, and no automatic cuts were found (") + e.what() + ")";
@@ -342,12 +341,7 @@ DomainParameterization parameterize_domain(const Domain& input, const Parameteri
   try {
     run_quad(why);
     if (!adaptive.certify || out.patches->certified_valid()) {
-      DenseMapQuality lq;
-      lq.min_scaled = lq.min_mean_ratio = std::numeric_limits<double>::infinity();
-      for (const auto& r : out.patches->patches) {
-        lq.min_scaled = std::min(lq.min_scaled, r.dense_quality.min_scaled);
-        lq.min_mean_ratio = std::min(lq.min_mean_ratio, r.dense_quality.min_mean_ratio);
-      }
+      const DenseMapQuality lq = dense_figures(*out.patches);
       if (keep_layout_over_single(lq, q, certified, c)) {
         out.rejected_single = q;
         return out;
