@@ -9,6 +9,7 @@
 #include "tspline/deform/layout_reparameterization.h"
 #include "tspline/deform/reparameterization.h"
 #include "tspline/errors.h"
+#include "tspline/io/layout_output.h"
 #include "tspline/io/multipatch_file.h"
 #include "tspline/io/multipatch_output.h"
 #include "tspline/io/output_files.h"
@@ -29,31 +30,7 @@ json multipatch_report(const ParamRun& run) {
   json report = tspline::io::multipatch_report(R, run.source, run.seconds);
   report["input_geometry"] = run.domain.description;
   report["input_cleaning"] = {{"notes", run.cleaning_notes}};
-  report["layout"] = {{"chosen", P.layout}, {"reason", P.reason}, {"explanation", R.cuts_explanation}};
-  if (P.quad_stats) {
-    const tspline::QuadLayoutStats& s = *P.quad_stats;
-    report["layout"]["quad"] = {{"patches", s.patches},
-                                {"ring_nodes", s.ring_nodes},
-                                {"inner_nodes", s.inner_nodes},
-                                {"inner_valence", s.valence},
-                                {"straight_min_scaled_jacobian", s.min_corner_scaled_jacobian},
-                                {"straight_mean_scaled_jacobian", s.mean_corner_scaled_jacobian},
-                                {"repair_rounds", s.repair_rounds},
-                                {"pillowed_rings", s.pillowed_rings},
-                                {"optimization_level", s.optimization_level},
-                                {"rotations", s.rotations},
-                                {"openings", s.openings},
-                                {"optimization_sweeps", s.optimization_sweeps},
-                                {"corner_mean_ratio", s.corner_mean_ratio},
-                                {"corner_scaled_jacobian", s.corner_scaled_jacobian},
-                                {"min_size", s.min_size},
-                                {"max_size", s.max_size},
-                                {"seconds", s.seconds}};
-  }
-  if (P.rejected_single)
-    report["layout"]["single_patch_first_try"] = {
-        {"min_scaled_jacobian_dense", P.rejected_single->min_scaled},
-        {"min_mean_ratio_dense", P.rejected_single->min_mean_ratio}};
+  report["layout"] = tspline::io::layout_report(P);
   return report;
 }
 
@@ -69,7 +46,7 @@ json single_report(const ParamRun& run) {
       for (const auto& n : notes) all.push_back(n);
     notes = std::move(all);
   }
-  report["layout"] = {{"chosen", run.result.layout}, {"reason", run.result.reason}};
+  report["layout"] = tspline::io::layout_report(run.result);
   return report;
 }
 

@@ -200,8 +200,8 @@ TEST_SUITE("quad_layout") {
       CHECK(hi <= 4.0 * 0.5);
     }
     CHECK(in_neck >= 2);  // the neck is 2 long and 0.5 wide: several patches along it
-    CHECK(L.stats.min_corner_scaled_jacobian > 0.2);
-    for (std::size_t v = 0; v <= 2; ++v) CHECK(L.stats.valence[v] == 0);  // no inner node of valence 2 or less
+    CHECK(L.stats.straight_min_scaled_jacobian > 0.2);
+    for (std::size_t v = 0; v <= 2; ++v) CHECK(L.stats.inner_valence[v] == 0);  // no inner node of valence 2 or less
   }
 
   TEST_CASE("layout of a square with 16 holes: every ring joined, patches tiling the domain") {
@@ -213,7 +213,7 @@ TEST_SUITE("quad_layout") {
     const tspline::QuadLayout L = tspline::build_quad_layout(d);
     check_layout_tiles(d, L.layout);
     CHECK(L.stats.patches == L.layout.patches.size());
-    CHECK(L.stats.min_corner_scaled_jacobian > 0.2);
+    CHECK(L.stats.straight_min_scaled_jacobian > 0.2);
     // Every hole is a side of some patch.
     for (std::size_t h = 0; h < d.holes.size(); ++h) {
       const Eigen::Vector2d corner = d.holes[h].vertices[0];

@@ -164,8 +164,8 @@ std::string QuadLayout::explanation() const {
   std::ostringstream s;
   s << "quad layout: " << stats.patches << " patches, " << stats.ring_nodes << " nodes on the rings, "
     << stats.inner_nodes << " inside (valence";
-  for (std::size_t v = 0; v < stats.valence.size(); ++v)
-    if (stats.valence[v]) s << ' ' << v << (v == 7 ? "+" : "") << ": " << stats.valence[v];
+  for (std::size_t v = 0; v < stats.inner_valence.size(); ++v)
+    if (stats.inner_valence[v]) s << ' ' << v << (v == 7 ? "+" : "") << ": " << stats.inner_valence[v];
   s << ")";
   if (stats.pillowed_rings) s << ", " << stats.pillowed_rings << " ring(s) pillowed";
   s.precision(3);
@@ -637,16 +637,16 @@ void QuadLayoutBuilder::fill_stats(const LayoutMesh& m, const LayoutTopology& t)
     if (m.ring[n] >= 0)
       ++st.ring_nodes;
     else
-      ++st.inner_nodes, ++st.valence[std::min<std::size_t>(k, 7)];
+      ++st.inner_nodes, ++st.inner_valence[std::min<std::size_t>(k, 7)];
   }
   double sum = 0.0;
-  st.min_corner_scaled_jacobian = 1.0;
+  st.straight_min_scaled_jacobian = 1.0;
   for (const auto& q : m.quads) {
     const double sj = quad_corner_scaled_jacobian({m.x[q[0]], m.x[q[1]], m.x[q[2]], m.x[q[3]]});
-    st.min_corner_scaled_jacobian = std::min(st.min_corner_scaled_jacobian, sj);
+    st.straight_min_scaled_jacobian = std::min(st.straight_min_scaled_jacobian, sj);
     sum += sj;
   }
-  st.mean_corner_scaled_jacobian = sum / static_cast<double>(m.quads.size());
+  st.straight_mean_scaled_jacobian = sum / static_cast<double>(m.quads.size());
   const LayoutCornerQuality w = worst_layout_quality(m, t, quality_);
   st.corner_mean_ratio = w.mean_ratio;
   st.corner_scaled_jacobian = w.scaled_jacobian;

@@ -59,9 +59,10 @@ struct QuadLayoutStats {
   std::size_t patches = 0;
   std::size_t ring_nodes = 0;                ///< layout nodes on the rings
   std::size_t inner_nodes = 0;               ///< layout nodes inside the domain
-  std::array<std::size_t, 8> valence{};      ///< inner nodes by valence (7: 7 or more)
-  double min_corner_scaled_jacobian = 1.0;   ///< of the quads with straight sides (chords on the rings)
-  double mean_corner_scaled_jacobian = 1.0;
+  std::array<std::size_t, 8> inner_valence{};  ///< inner nodes by valence (7: 7 or more)
+  /// Scaled Jacobian of the quads with straight sides (chords on the rings).
+  double straight_min_scaled_jacobian = 1.0;
+  double straight_mean_scaled_jacobian = 1.0;
   int repair_rounds = 0;
   std::size_t pillowed_rings = 0;            ///< rings given a layer of quads (a flat single-quad corner)
   /// How far the layout was optimized: 2 all (node optimization and edge

@@ -1,0 +1,26 @@
+#include "tspline/io/layout_output.h"
+
+namespace tspline {
+
+// The report's keys are the field names (one list, here; from_json comes with
+// the macro and is unused).
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(QuadLayoutStats, patches, ring_nodes, inner_nodes, inner_valence,
+                                   straight_min_scaled_jacobian, straight_mean_scaled_jacobian, repair_rounds,
+                                   pillowed_rings, optimization_level, rotations, openings, optimization_sweeps,
+                                   corner_mean_ratio, corner_scaled_jacobian, min_size, max_size, seconds)
+
+}  // namespace tspline
+
+namespace tspline::io {
+
+nlohmann::json layout_report(const DomainParameterization& result) {
+  nlohmann::json out = {{"chosen", result.layout}, {"reason", result.reason}};
+  if (result.patches) out["explanation"] = result.patches->cuts_explanation;
+  if (result.quad_stats) out["quad"] = *result.quad_stats;
+  if (result.rejected_single)
+    out["single_patch_first_try"] = {{"min_scaled_jacobian_dense", result.rejected_single->min_scaled},
+                                     {"min_mean_ratio_dense", result.rejected_single->min_mean_ratio}};
+  return out;
+}
+
+}  // namespace tspline::io
