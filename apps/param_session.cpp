@@ -226,6 +226,9 @@ ParamRun run_param(tspline::io::DomainInput domain, std::string source, const Pa
                          "report: certified bounds of J_r and the scaled Jacobian on every Bezier element of " +
                              std::to_string(run.result.patches->patches.size()) + " patches");
   run.report = run.result.patches ? multipatch_report(run) : single_report(run);
+  // The run's options by `tspline param`'s names (Python's with '_' for '-'),
+  // every option of the table: what a rerun needs.
+  run.report["options"] = settings_json(run.settings);
   return run;
 }
 

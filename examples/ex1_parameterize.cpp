@@ -40,7 +40,7 @@ namespace {
 std::size_t print_mesh(const char* step, const tspline::TMesh& mesh, const std::vector<Eigen::Vector2d>& x) {
   const tspline::MeshQualityStats q = tspline::mesh_quality(mesh, x);
   std::printf("%s: %zu cells, %zu inverted, min/mean triangle quality %.4f / %.4f\n", step, mesh.num_cells(),
-              q.inverted_cells, q.min_quality, q.mean_quality);
+              q.inverted_cells, q.min_mean_ratio, q.mean_mean_ratio);
   return q.inverted_cells;
 }
 

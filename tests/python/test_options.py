@@ -110,4 +110,4 @@ def test_python_types_and_unknown_keywords():
     m = tspline.parameterize(square, init_level=np.int64(2), max_adapt=1, tol_rel=np.float64(1e-5), corners=None,
                              layout="single")
     assert m.certified_valid and m.patches == 1
-    assert m.report["options"]["initial_level"] == 2
+    assert m.report["options"]["init-level"]["initial_level"] == 2

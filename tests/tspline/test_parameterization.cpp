@@ -20,12 +20,12 @@ TEST_SUITE("parameterization") {
       const tspline::FrontResult r = tspline::run_front(poly, {});
       MESSAGE(name << ": " << r.mesh.num_cells() << " cells, inverted after Coons "
                    << r.quality_coons.inverted_cells << ", after optimization " << r.quality_optimized.inverted_cells
-                   << ", min/mean quality " << r.quality_optimized.min_quality << "/"
-                   << r.quality_optimized.mean_quality << ", sweeps " << r.total_sweeps << ", repair rounds " << r.repair_refined_cells.size());
+                   << ", min/mean quality " << r.quality_optimized.min_mean_ratio << "/"
+                   << r.quality_optimized.mean_mean_ratio << ", sweeps " << r.total_sweeps << ", repair rounds " << r.repair_refined_cells.size());
       CHECK(r.quality_optimized.inverted_cells == 0);
       CHECK(r.refinement.edges_over_tolerance == 0);
       CHECK(r.mesh.check_invariants() == "");
-      CHECK(r.quality_optimized.min_quality > 0.0);
+      CHECK(r.quality_optimized.min_mean_ratio > 0.0);
       // Boundary vertices stay exactly where the chord-length map puts them.
       for (int v = 0; v < static_cast<int>(r.mesh.num_vertices()); ++v)
         if (r.mesh.vertex_on_boundary(v))
@@ -61,7 +61,7 @@ TEST_SUITE("parameterization") {
     }
     MESSAGE("largest node distance nested vs direct: " << worst);
     CHECK(worst < 1e-3);
-    CHECK(nested.quality_optimized.mean_quality == doctest::Approx(direct.quality_optimized.mean_quality).epsilon(1e-4));
+    CHECK(nested.quality_optimized.mean_mean_ratio == doctest::Approx(direct.quality_optimized.mean_mean_ratio).epsilon(1e-4));
   }
 }
 
@@ -79,13 +79,13 @@ TEST_SUITE("parameterization") {
     for (const auto& t : r.corner_trials) {
       CHECK(r.corner_trials[best].inverted_cells <= t.inverted_cells);
       if (t.inverted_cells == r.corner_trials[best].inverted_cells)
-        CHECK(r.corner_trials[best].min_quality + r.corner_trials[best].mean_quality >=
-              t.min_quality + t.mean_quality);
+        CHECK(r.corner_trials[best].min_mean_ratio + r.corner_trials[best].mean_mean_ratio >=
+              t.min_mean_ratio + t.mean_mean_ratio);
     }
     CHECK(contains(r.boundary.corners().explanation, "(choice " + std::to_string(best + 1) + ")"));
     // With the default initial level the trial is the final run: identical numbers.
-    CHECK(r.quality_optimized.min_quality == r.corner_trials[best].min_quality);
-    CHECK(r.quality_optimized.mean_quality == r.corner_trials[best].mean_quality);
+    CHECK(r.quality_optimized.min_mean_ratio == r.corner_trials[best].min_mean_ratio);
+    CHECK(r.quality_optimized.mean_mean_ratio == r.corner_trials[best].mean_mean_ratio);
     // The four choices are distinct.
     for (std::size_t i = 0; i < 4; ++i)
       for (std::size_t j = i + 1; j < 4; ++j) CHECK(r.corner_trials[i].corners != r.corner_trials[j].corners);

@@ -103,8 +103,7 @@ TEST_SUITE("parameterization_run") {
       ad.max_adapt = 1;
       ad.polish_below = 1.1;
       ad.polish_stages = stages;
-      ad.polish_skip_scaled = skip_scaled;
-      ad.polish_skip_mean_ratio = skip_mean_ratio;
+      ad.polish_skip = {skip_scaled, skip_mean_ratio};
       return tspline::run_parameterization(poly, opt, ad);
     };
     std::string ran, skipped_sj, skipped_jr;
@@ -142,7 +141,7 @@ TEST_SUITE("parameterization_run") {
               {"`min_jacobian`", [](auto&, auto& a) { a.min_jacobian = 0.0; }},
               {"`certification.max_depth`", [](auto&, auto& a) { a.certification.max_depth = 21; }},
               {"`untangling.quality_power`", [](auto&, auto& a) { a.untangling.quality_power = 0.5; }},
-              {"`polish_skip_scaled`", [](auto&, auto& a) { a.polish_skip_scaled = std::nan(""); }}};
+              {"`polish_skip.scaled_jacobian`", [](auto&, auto& a) { a.polish_skip.scaled_jacobian = std::nan(""); }}};
     for (const auto& name_spoil : cases) {
       const std::string& name = name_spoil.first;
       const auto& spoil = name_spoil.second;

@@ -392,7 +392,7 @@ TEST_SUITE("quad_layout") {
     CHECK_FALSE(contains(first.reason, "second quad layout"));  // good: no second layout
     // A threshold no map of it reaches: the second layout is made; the
     // map kept is certified, and is the second only where it is better.
-    c.good_scaled_jacobian = 0.999;
+    c.good.scaled_jacobian = 0.999;
     const tspline::DomainParameterization again = tspline::parameterize_domain(flower, po, ad, c);
     REQUIRE(again.patches);
     CHECK(again.patches->certified_valid());

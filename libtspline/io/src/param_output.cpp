@@ -233,46 +233,6 @@ nlohmann::json untangling_json(const MapUntanglingReport& u) {
           {"seconds", u.seconds}};
 }
 
-// The options the result was computed with (what a rerun needs).
-nlohmann::json options_json(const ParameterizationOptions& o, const AdaptiveOptions& a) {
-  using nlohmann::json;
-  json corners = nullptr;
-  if (o.corners) corners = json(*o.corners);
-  const MapUntanglingOptions& u = a.untangling;
-  return {{"corners", corners},
-          {"corner_trials", o.corner_trials},
-          {"tolerance_absolute", o.tolerance_absolute ? json(*o.tolerance_absolute) : json(nullptr)},
-          {"tolerance_relative", o.tolerance_relative},
-          {"initial_level", o.initial_level},
-          {"max_level", o.max_level},
-          {"max_repair_rounds", o.max_repair_rounds},
-          {"nested_optimization", o.nested_optimization},
-          {"smoothing",
-           {{"max_sweeps", o.smoothing.max_sweeps},
-            {"sweep_tolerance", o.smoothing.relative_displacement_tolerance},
-            {"omega", o.smoothing.over_relaxation}}},
-          {"min_jacobian", a.min_jacobian},
-          {"max_adapt", a.max_adapt},
-          {"gauss", a.gauss},
-          {"stall_rounds", a.stall_rounds},
-          {"min_quality_gain", a.min_quality_gain},
-          {"max_quality_fraction", a.max_quality_fraction},
-          {"max_cells", o.max_cells},
-          {"map_untangling", a.optimize_control_points},
-          {"untangling",
-           {{"max_stages", u.max_stages},
-            {"iterations_per_stage", u.max_iterations_per_stage},
-            {"quality_power", u.quality_power},
-            {"eps_floor", u.eps_floor},
-            {"min_decrease", u.min_decrease},
-            {"samples_per_direction", u.energy.gauss},
-            {"lobatto", u.energy.lobatto},
-            {"max_sample_level", u.energy.max_sample_level}}},
-          {"dense_samples", a.dense_samples},
-          {"certify", a.certify},
-          {"certification_depth", a.certification.max_depth}};
-}
-
 }  // namespace
 
 QualityBoundOptions report_quality_bound_options() {
@@ -485,7 +445,6 @@ nlohmann::json param_report(const ParameterizationResult& r, const std::string& 
   double total = 0.0;
   for (const auto& t : r.front.times) rep["seconds"][t.stage] = t.seconds, total += t.seconds;
   rep["seconds"]["total"] = total;
-  rep["options"] = options_json(r.options, r.adaptive);
   return rep;
 }
 

@@ -347,10 +347,10 @@ class AdaptiveRun {
     // A warm start's optimization already ran at the polish power (untangling_options).
     if (warm_ && warm_->reference_mean_ratio < ad_.polish_below) return;
     if (ad_.certify && !b.certification.certified_valid()) return;
-    if (b.dense.min_scaled < ad_.polish_skip_scaled || b.dense.min_mean_ratio < ad_.polish_skip_mean_ratio) {
+    if (!ad_.polish_skip.met_by(b.dense)) {
       std::ostringstream s;
       s << "polish: skipped, whole-map scaled Jacobian " << b.dense.min_scaled << " and J_r " << b.dense.min_mean_ratio
-        << " (below " << ad_.polish_skip_scaled << " or " << ad_.polish_skip_mean_ratio << ")";
+        << " (below " << ad_.polish_skip.scaled_jacobian << " or " << ad_.polish_skip.mean_ratio << ")";
       log("polish", s.str());
       return;
     }

@@ -77,7 +77,7 @@ double worse_figure(const DenseMapQuality& q) { return std::min(q.min_scaled, q.
 }  // namespace
 
 bool reaches_good_quality(const DenseMapQuality& q, const DomainParameterizationOptions& c) {
-  return q.min_scaled >= c.good_scaled_jacobian && q.min_mean_ratio >= c.good_mean_ratio;
+  return c.good.met_by(q);
 }
 
 bool keep_layout_over_single(const DenseMapQuality& layout, const DenseMapQuality& single, bool single_certified,
@@ -312,10 +312,11 @@ DomainParameterization parameterize_domain(const Domain& input, const Parameteri
   };
   AdaptiveOptions first = adaptive;
   first.max_adapt = std::min(adaptive.max_adapt, c.first_try_rounds);
-  // No polish where it cannot make the try good (AdaptiveOptions::polish_skip_scaled):
+  // No polish where it cannot make the try good (AdaptiveOptions::polish_skip):
   // a try whose polish is skipped is poor, so no kept map lacks its polish.
-  first.polish_skip_scaled = std::max(first.polish_skip_scaled, 0.5 * c.good_scaled_jacobian);
-  first.polish_skip_mean_ratio = std::max(first.polish_skip_mean_ratio, 0.25 * c.good_mean_ratio);
+  QualityFloor& skip = first.polish_skip;
+  skip.scaled_jacobian = std::max(skip.scaled_jacobian, 0.5 * c.good.scaled_jacobian);
+  skip.mean_ratio = std::max(skip.mean_ratio, 0.25 * c.good.mean_ratio);
   ParameterizationResult single = run_parameterization(domain.outer, serial, first, on_iteration);
   const DenseMapQuality& q = single.dense_quality;
   const bool certified = !adaptive.certify || single.certified_valid();

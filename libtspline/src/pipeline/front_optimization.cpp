@@ -121,8 +121,8 @@ void FrontOptimizer::optimize(const std::string& what) {
   std::ostringstream s;
   s << "optimization (" << what << ", " << r_.mesh.num_cells() << " cells): " << r_.smoothing.sweeps << " sweeps"
     << (r_.smoothing.converged ? "" : " (not converged)") << ", " << r_.quality_optimized.inverted_cells
-    << " inverted cells, min/mean quality " << r_.quality_optimized.min_quality << " / "
-    << r_.quality_optimized.mean_quality;
+    << " inverted cells, min/mean quality " << r_.quality_optimized.min_mean_ratio << " / "
+    << r_.quality_optimized.mean_mean_ratio;
   log("optimization", s.str());
 }
 

@@ -46,8 +46,8 @@ void validate_options(const AdaptiveOptions& ad) {
   if (ad.max_adapt < 0) fail("`max_adapt` must be >= 0, got " + std::to_string(ad.max_adapt));
   if (ad.polish_stages < 0 || !(ad.polish_power >= 1.0) || !std::isfinite(ad.polish_below))
     fail("`polish_stages` must be >= 0, `polish_power` >= 1 and `polish_below` finite");
-  if (!std::isfinite(ad.polish_skip_scaled) || !std::isfinite(ad.polish_skip_mean_ratio))
-    fail("`polish_skip_scaled` and `polish_skip_mean_ratio` must be finite");
+  if (!std::isfinite(ad.polish_skip.scaled_jacobian) || !std::isfinite(ad.polish_skip.mean_ratio))
+    fail("`polish_skip.scaled_jacobian` and `polish_skip.mean_ratio` must be finite");
   if (ad.gauss < 1 || ad.gauss > 6) fail("`gauss` (Gauss points per direction) must be in [1, 6], got " +
                                          std::to_string(ad.gauss));
   if (ad.dense_samples < 1 || ad.dense_samples > 64)

@@ -57,7 +57,7 @@ std::size_t best_corner_trial(const std::vector<CornerTrial>& trials) {
     const CornerTrial& a = trials[k];
     const CornerTrial& b = trials[best];
     if (a.inverted_cells < b.inverted_cells ||
-        (a.inverted_cells == b.inverted_cells && a.min_quality + a.mean_quality > b.min_quality + b.mean_quality))
+        (a.inverted_cells == b.inverted_cells && a.min_mean_ratio + a.mean_mean_ratio > b.min_mean_ratio + b.mean_mean_ratio))
       best = k;
   }
   return best;
@@ -146,8 +146,8 @@ std::vector<CornerTrial> trial_rows(const std::vector<Corners>& cands,
       continue;
     }
     const FrontResult& t = *results[k];
-    rows.push_back({cands[k].index, t.quality_optimized.inverted_cells, t.quality_optimized.min_quality,
-                    t.quality_optimized.mean_quality});
+    rows.push_back({cands[k].index, t.quality_optimized.inverted_cells, t.quality_optimized.min_mean_ratio,
+                    t.quality_optimized.mean_mean_ratio});
   }
   return rows;
 }
@@ -178,8 +178,8 @@ CornerTrials try_corners(const Polygon& poly, std::vector<Corners> cands, const 
     const FrontResult& t = *results[k];
     std::ostringstream s;
     s << " done (choice " << k + 1 << "): " << t.quality_optimized.inverted_cells
-      << " inverted cells, min/mean quality " << t.quality_optimized.min_quality << " / "
-      << t.quality_optimized.mean_quality;
+      << " inverted cells, min/mean quality " << t.quality_optimized.min_mean_ratio << " / "
+      << t.quality_optimized.mean_mean_ratio;
     const std::lock_guard<std::mutex> lock(report_mutex);
     if (opt.progress) report(s.str());
   });

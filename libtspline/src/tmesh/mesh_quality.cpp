@@ -46,7 +46,7 @@ std::vector<CellQuality> cell_qualities(const TMesh& mesh, const std::vector<Eig
     CellQuality& q = out[c];
     for_each_triangle_quality(mesh, c, x, [&](double sigma, double quality) {
       if (!(sigma > 0.0)) q.valid = false;
-      q.min_quality = std::min(q.min_quality, quality);
+      q.min_mean_ratio = std::min(q.min_mean_ratio, quality);
     });
   }
   return out;
@@ -61,12 +61,12 @@ MeshQualityStats mesh_quality(const TMesh& mesh, const std::vector<Eigen::Vector
     for_each_triangle_quality(mesh, c, x, [&](double sigma, double quality) {
       ++s.triangles;
       if (!(sigma > 0.0)) valid = false, ++s.inverted_triangles;
-      s.min_quality = std::min(s.min_quality, quality);
+      s.min_mean_ratio = std::min(s.min_mean_ratio, quality);
       sum += quality;
     });
     if (!valid) ++s.inverted_cells;
   }
-  s.mean_quality = s.triangles ? sum / static_cast<double>(s.triangles) : 0.0;
+  s.mean_mean_ratio = s.triangles ? sum / static_cast<double>(s.triangles) : 0.0;
   return s;
 }
 

@@ -65,15 +65,14 @@ struct AdaptiveOptions {
   double polish_below = 0.3;
   int polish_stages = 12;
   double polish_power = 8.0;
-  /// No polish where the whole-map scaled Jacobian is below polish_skip_scaled
-  /// or J_r below polish_skip_mean_ratio (dense sample; 0: never skipped).
+  /// No polish where the whole map misses polish_skip (dense sample; the
+  /// default 0 and 0: never skipped).
   /// Auto's first try of one patch sets them to a half (scaled Jacobian) and
   /// a quarter (J_r) of what it calls good: there a polish cannot make the map
   /// good (it raised the scaled Jacobian by 1.6x at most, J_r by 1.9x, on the
   /// bundled coastlines' single patches) and would only delay the layout
   /// (1-2 s of a coastline's try).
-  double polish_skip_scaled = 0.0;
-  double polish_skip_mean_ratio = 0.0;
+  QualityFloor polish_skip;
   /// dense_map_quality: (k + 1)^2 samples per Bezier element.
   int dense_samples = 8;
   /// Certify det J > 0 on every Bezier element after each fit; refine the cells

@@ -40,8 +40,7 @@ struct DomainParameterizationOptions {
   QuadLayoutOptions quad;
   MultiPatchOptions multi;
   /// Auto: a single patch is kept when its whole map reaches both.
-  double good_scaled_jacobian = 0.3;
-  double good_mean_ratio = 0.1;
+  QualityFloor good{0.3, 0.1};
   /// Auto: adaptive rounds of the single-patch first try at most.
   int first_try_rounds = 3;
   /// Auto: domains with at most this many holes try the automatic cuts
@@ -71,7 +70,7 @@ struct DomainParameterization {
 };
 
 /// Whether whole-map figures (dense samples) reach auto's thresholds: scaled
-/// Jacobian >= good_scaled_jacobian and J_r >= good_mean_ratio.
+/// Jacobian >= good.scaled_jacobian and J_r >= good.mean_ratio.
 bool reaches_good_quality(const DenseMapQuality& q, const DomainParameterizationOptions& c);
 
 /// Auto's choice once both a certified quad layout's map (`layout`) and the

@@ -63,8 +63,8 @@ struct StageTime {
 struct CornerTrial {
   std::array<std::size_t, 4> corners{};  ///< indices into the CCW polygon
   std::size_t inverted_cells = 0;
-  double min_quality = 0.0;
-  double mean_quality = 0.0;
+  double min_mean_ratio = 0.0;
+  double mean_mean_ratio = 0.0;
 };
 
 /// The rule that keeps one of the corner trials: the fewest inverted cells,

@@ -21,7 +21,7 @@ std::vector<std::array<int, 3>> cell_triangles(const TMesh& mesh, int c);
 
 struct CellQuality {
   bool valid = true;
-  double min_quality = 1.0;  ///< smallest triangle mean ratio (negative if inverted)
+  double min_mean_ratio = 1.0;  ///< smallest triangle mean ratio (negative if inverted)
 };
 
 struct MeshQualityStats {
@@ -29,8 +29,8 @@ struct MeshQualityStats {
   std::size_t inverted_cells = 0;
   std::size_t triangles = 0;
   std::size_t inverted_triangles = 0;
-  double min_quality = 1.0;   ///< over all triangles
-  double mean_quality = 0.0;  ///< over all triangles
+  double min_mean_ratio = 1.0;   ///< over all triangles
+  double mean_mean_ratio = 0.0;  ///< over all triangles
 };
 
 /// Quality of every cell for physical vertex positions x (indexed by vertex id).

@@ -55,6 +55,16 @@ struct DenseMapQuality {
   int samples_per_edge = 0;                            ///< k
 };
 
+/// A pair of whole-map thresholds: the scaled Jacobian and J_r that a map's
+/// dense-sample minima must reach (0 and 0: every valid map does).
+struct QualityFloor {
+  double scaled_jacobian = 0.0;
+  double mean_ratio = 0.0;
+  bool met_by(const DenseMapQuality& q) const {
+    return q.min_scaled >= scaled_jacobian && q.min_mean_ratio >= mean_ratio;
+  }
+};
+
 /// \pre k >= 1.
 DenseMapQuality dense_map_quality(const TSplineMap& map, int k = 8);
 /// The same from a Bezier extraction and control points (one per blending function).
