@@ -172,7 +172,7 @@ TEST_SUITE("check_app") {
     // The kept map comes from the global untangling, certified there.
     const auto& u = its[rep["adaptive"]["kept_iteration"].get<int>()]["untangling"];
     CHECK(u["certified"] == true);
-    CHECK(u["samples_nonpositive_after"] == 0);
+    CHECK(u["after"]["nonpositive"] == 0);
     CHECK(u["free_points"].get<int>() > 0);
     for (const auto& it : its) CHECK(it["certification"].contains("elements_certified"));
     const auto k = run_app("check '" + map.string() + "'", d);

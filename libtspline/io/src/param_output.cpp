@@ -22,7 +22,22 @@
 #include "tspline/validity/map_certification.h"
 #include "tspline/validity/map_quality.h"
 #include "tspline/validity/map_quality_bounds.h"
+#include "tspline/validity/map_untangling.h"
 #include "toolkit/errors.h"
+
+namespace tspline {
+
+// One adaptive round's untangling of the control points: every field of the
+// report by its name (map_untangling.h; from_json comes with the macros and is
+// unused). The certification is left out: the round's own is in the report.
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(SampleStats, points, nonpositive, min_det, min_mean_ratio, mean_mean_ratio)
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(MapUntanglingReport, free_points, fixed_points, elements, samples, stages, iterations,
+                                   evaluations, factorizations, shifted_factorizations, line_search_certifications,
+                                   hessian_seconds, solve_seconds, cg_iterations, sample_refinements, local_repairs,
+                                   local_repairs_certified, local_repair_iterations, local_repair_seconds, before,
+                                   after, certified, stop_reason, seconds)
+
+}  // namespace tspline
 
 namespace tspline::io {
 
@@ -215,23 +230,6 @@ nlohmann::json certification_json(const MapCertification& c) {
           {"seconds", c.seconds}};
 }
 
-// One adaptive round's untangling of the control points.
-nlohmann::json untangling_json(const MapUntanglingReport& u) {
-  return {{"free_points", u.free_points},
-          {"elements", u.elements},
-          {"samples", u.samples},
-          {"stages", u.stages},
-          {"lbfgs_iterations", u.iterations},
-          {"evaluations", u.evaluations},
-          {"sample_refinements", u.sample_refinements},
-          {"local_repairs", u.local_repairs},
-          {"local_repairs_certified", u.local_repairs_certified},
-          {"samples_nonpositive_before", u.before.nonpositive},
-          {"samples_nonpositive_after", u.after.nonpositive},
-          {"certified", u.certified},
-          {"stop_reason", u.stop_reason},
-          {"seconds", u.seconds}};
-}
 
 }  // namespace
 
@@ -405,7 +403,7 @@ nlohmann::json iterations_json(const ParameterizationResult& r) {
                    {"cells_refined_after", it.refined_cells},
                    {"interpolation_relative_residual", it.fit.relative_residual},
                    {"control_points_optimized", it.control_points_optimized},
-                   {"untangling", untangling_json(it.untangling)},
+                   {"untangling", it.untangling},
                    {"jacobian", map_quality_json(it.quality)},
                    {"seconds", it.seconds}});
   if (r.adaptive.certify)
