@@ -90,6 +90,11 @@ struct PoissonArgs {
   CLI::Option *f_opt = nullptr, *g_opt = nullptr, *exact_opt = nullptr, *problem_opt = nullptr;
 };
 
+// report.json's "options": the numerical options by their field names (the
+// flags' names with '_'); from_json comes with the macro and is unused.
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(PoissonArgs, refine, steps, gamma, max_dofs, samples, solver, preconditioner, rtol,
+                                   max_iterations, direct_below)
+
 // ------------------------------------------------------------------ problems
 
 struct ProblemSetup {
@@ -225,18 +230,7 @@ int run_poisson_process(const PoissonArgs& args, const PetscSession& session,
       {"command", "poisson"},
       {"input", args.file},
       {"problem", setup.description},
-      {"options",
-       {{"refine", args.refine},
-        {"steps", args.steps},
-        {"gamma", args.gamma},
-        {"max_dofs", args.max_dofs},
-        {"samples", args.samples},
-        {"solver", args.solver},
-        {"preconditioner", args.preconditioner},
-        {"rtol", args.rtol},
-        {"max_iterations", args.max_iterations},
-        {"direct_below", args.direct_below},
-        {"processes", session.size()}}},
+      {"options", args},
       {"geometry",
        {{"patches", maps.patches.size()},
         {"interfaces", maps.interfaces.size()},
@@ -249,6 +243,7 @@ int run_poisson_process(const PoissonArgs& args, const PetscSession& session,
       {"dirichlet", "L2 projection of g onto the traces of the Dirichlet functions on the domain's boundary "
                     "(physical arc length)"},
       {"quadrature", {{"assembly", "4x4 Gauss"}, {"errors", "6x6 Gauss"}, {"estimator", "4x4 Gauss"}}}};
+  report["options"]["processes"] = session.size();
   Progress progress(root ? output_mode(args.quiet, args.json) : OutputMode::Quiet);
   tspline::io::PoissonOutputWriter output(args.out_dir, args.samples, setup.problem, std::move(report));
   tspline::AdaptiveSolveResult run;
