@@ -1,4 +1,4 @@
-// meshopt: command-line front end of libmeshopt on CAD surfaces (issue 5).
+// meshopt: command-line front end of libmeshopt on CAD surfaces.
 // Thin by design: it parses options, runs meshopt_runs.h (the model and mesh
 // through the Gmsh adapter, smooth_surface or remesh, the outputs), prints the
 // summary and maps errors to exit codes.

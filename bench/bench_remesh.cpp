@@ -1,4 +1,4 @@
-// Benchmark of `meshopt remesh` (issue 13): the fused torus and pipe of
+// Benchmark of `meshopt remesh`: the fused torus and pipe of
 // bench_smooth_cad (OpenCASCADE, several faces, sharp intersection curves)
 // meshed by Gmsh at size 4 L, then remeshed (Dassi et al. 2014, K = 3, I = J = 4)
 // with target 6D length L and anisotropy S. Prints one row:

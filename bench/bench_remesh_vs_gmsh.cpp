@@ -1,4 +1,4 @@
-// Triangles needed for a given chordal deviation (issue 13): the remesher
+// Triangles needed for a given chordal deviation: the remesher
 // (Dassi et al. 2014) against Gmsh's isotropic meshes of the same CAD part, the
 // fused torus and pipe of bench_smooth_cad (OpenCASCADE, 5 faces, sharp
 // intersection curves). The deviation is the one `meshopt remesh` reports: the

@@ -1,4 +1,4 @@
-// Benchmark of `meshopt smooth` on a CAD model (issue 13): a torus (R 2, r 0.6)
+// Benchmark of `meshopt smooth` on a CAD model: a torus (R 2, r 0.6)
 // fused with a pipe (a cylinder of radius 0.3 through its tube), OpenCASCADE,
 // meshed by Gmsh, then every STRIDE-th node inside a face moved by a random
 // parametric offset (a fifth of the triangles tangled for the defaults), then

@@ -1,4 +1,4 @@
-// Benchmark of libmeshopt on surfaces (issue 5): node visits per second of the
+// Benchmark of libmeshopt on surfaces: node visits per second of the
 // Gauss-Seidel sweeps of smooth_surface on a torus patch with analytic phi, for a
 // structured triangle mesh of N x N nodes whose interior nodes are randomly
 // displaced in parametric space (about 10% of them start tangled).

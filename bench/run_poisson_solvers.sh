@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# IGA Poisson solvers at scale (issue 14): direct (CHOLMOD) vs iterative (PETSc CG +
+# IGA Poisson solvers at scale: direct (CHOLMOD) vs iterative (PETSc CG +
 # AMG) with 1 and 2 MPI ranks, on the unit square (bench_poisson: identity map,
 # uniform 2^L x 2^L cubic analysis mesh), then on a curved domain (the disk) with
 # `tspline poisson --refine uniform` up to about 1.7e5 DOFs (direct) and 6.6e5 (iterative).

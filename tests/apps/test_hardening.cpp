@@ -1,4 +1,4 @@
-// Bad input as a new user, or a mutation fuzzer, gives it (issue 16): every
+// Bad input as a new user, or a mutation fuzzer, gives it: every
 // case ends with exit 0-3 and one clear line, never a signal, an internal
 // error or a silent hang; Ctrl-C stops a long run without half-written files.
 #include <doctest/doctest.h>

@@ -1,4 +1,4 @@
-// Projected Newton for the untangling of the map (issue 23; map_energy.h,
+// Projected Newton for the untangling of the map (map_energy.h,
 // map_untangling.h): the per-sample term's gradient and Hessian in J against
 // finite differences, its analytic projection against a numerical eigenvalue
 // clamp (positive semi-definite, and equal to the exact Hessian where that is

@@ -235,7 +235,7 @@ nlohmann::json certification_json(const MapCertification& c) {
 
 QualityBoundOptions report_quality_bound_options() {
   QualityBoundOptions o;
-  o.samples_per_edge = 25;  // 26 x 26 points per element, as in issue 21
+  o.samples_per_edge = 25;  // 26 x 26 points per element
   return o;
 }
 

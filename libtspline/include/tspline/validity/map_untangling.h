@@ -25,7 +25,7 @@
 // The map returned is the last certified one if there was one, else the last
 // iterate (then report.certified is false).
 //
-// Projected Newton (issue 23; Teran et al. 2005, Smith et al. 2019): each
+// Projected Newton (Teran et al. 2005, Smith et al. 2019): each
 // iteration assembles the energy's Hessian over the free control points with
 // every sample's 4 x 4 Hessian in J projected to positive semi-definite
 // (MapEnergy::hessian), factors it by CHOLMOD's supernodal Cholesky (the
@@ -50,7 +50,7 @@ namespace tspline {
 enum class MapOptimizer {
   Newton,  ///< projected Newton, CHOLMOD: fewer iterations, but each costs a sparse Cholesky
   LBFGS,   ///< L-BFGS, curvature pairs kept across the stages (detail/lbfgs.h)
-  CeresLBFGS  ///< Ceres' L-BFGS, restarted every stage (the method before issue 23)
+  CeresLBFGS  ///< Ceres' L-BFGS, restarted every stage (the method before projected Newton)
 };
 
 /// The linear solve of each Newton step.

@@ -1,6 +1,6 @@
 #pragma once
-// One pool of worker threads for the whole process (issue 23: the map's
-// energy, gradient and Hessian ran on threads created for every evaluation).
+// One pool of worker threads for the whole process (before it, the map's
+// energy, gradient and Hessian started threads for every evaluation).
 // The workers are started on first use and live until exit; a parallel call
 // hands each worker one contiguous range and waits for all of them.
 //
