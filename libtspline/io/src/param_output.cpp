@@ -30,6 +30,9 @@ namespace tspline {
 // One adaptive round's untangling of the control points: every field of the
 // report by its name (map_untangling.h; from_json comes with the macros and is
 // unused). The certification is left out: the round's own is in the report.
+// The options of the certified quality bounds by their names (map_quality_bounds.h).
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(QualityBoundOptions, relative_gap, absolute_gap, max_depth, max_patches,
+                                   samples_per_edge)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(SampleStats, points, nonpositive, min_det, min_mean_ratio, mean_mean_ratio)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(MapUntanglingReport, free_points, fixed_points, elements, samples, stages, iterations,
                                    evaluations, factorizations, shifted_factorizations, line_search_certifications,
@@ -256,13 +259,12 @@ nlohmann::json whole_map_quality_json(const MapQualityBounds& q, const QualityBo
           {"certified_bounds",
            {{"method", "Bernstein bounds of det J, |S_xi|, |S_eta| with subdivision (map_quality_bounds.h)"},
             {"elements", q.elements},
-            {"relative_gap_target", o.relative_gap},
-            {"absolute_gap_target", o.absolute_gap},
-            {"depth_limit", o.max_depth},
             {"max_subdivision_depth", q.max_depth_used},
             {"sub_patches", q.patches},
             {"elements_stopped_at_a_limit", q.elements_not_converged},
-            {"seconds", q.seconds}}}};
+            {"seconds", q.seconds},
+            // The gap targets and both limits (max_depth, max_patches) an element may stop at.
+            {"options", o}}}};
 }
 
 nlohmann::json boundary_corner_json(const BoundaryCornerQuality& c) {
