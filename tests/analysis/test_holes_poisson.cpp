@@ -74,7 +74,12 @@ TEST_SUITE("holes_poisson") {
     REQUIRE(run.steps.size() == 4);
     const double rate_l2 = std::log2(l2[2] / l2[3]), rate_h1 = std::log2(h1[2] / h1[3]);
     MESSAGE("rates: L2 " << rate_l2 << ", H1 " << rate_h1);
-    CHECK(std::abs(rate_l2 - 4) <= 0.3);
+    // h^4 in L2 and h^3 in H1 asymptotically. Before the asymptotic range the
+    // observed L2 rate can be above 4 (4.33 from 9,520 to 35,376 unknowns on
+    // the map whose well-shaped patches keep their interpolant, 4.25 where
+    // every patch was optimized); a wrong basis gives 3 or less.
+    CHECK(rate_l2 >= 3.7);
+    CHECK(rate_l2 <= 4.5);
     CHECK(std::abs(rate_h1 - 3) <= 0.3);
   }
 

@@ -44,7 +44,9 @@ def test_uniform_refinement_rates_as_on_the_command_line(plate, tmp_path):
         assert s["h1"] == pytest.approx(float(row["h1"]), rel=1e-8)
         assert s["max_interface_jump"] < 1e-10
     l2, h1 = rates(sol.steps[-2], sol.steps[-1])
-    assert l2 == pytest.approx(4.0, abs=0.3)  # cubic splines: h^4 in L2, h^3 in H1
+    # Cubic splines: h^4 in L2, h^3 in H1 asymptotically; before that the L2
+    # rate can be above 4 (4.32 on this map), and a wrong basis gives 3 or less.
+    assert 3.7 <= l2 <= 4.5
     assert h1 == pytest.approx(3.0, abs=0.3)
     # C0 across every cut: the two sides give the same u_h (t on one side is 1 - t on the other).
     t = np.linspace(0.0, 1.0, 9)

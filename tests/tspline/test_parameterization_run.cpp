@@ -10,6 +10,7 @@
 #include <array>
 #include <functional>
 #include <map>
+#include <optional>
 #include <set>
 #include <string>
 
@@ -123,6 +124,49 @@ TEST_SUITE("parameterization_run") {
     if (!test_support::contains(ran, "not kept")) CHECK(polished.map->control_points() != none.map->control_points());
   }
 
+  TEST_CASE("keep_interpolant: a certified interpolant whose whole map meets the floor is kept without optimization") {
+    // A trapezoid's interpolating map is nearly bilinear (whole-map J_r and
+    // scaled Jacobian far above the default floor): kept as it is by default, control point
+    // for control point the map of a run without optimization; unset, or with
+    // a floor it does not meet, the optimizer runs on it.
+    tspline::Polygon poly;
+    poly.vertices = {Eigen::Vector2d(0, 0), Eigen::Vector2d(4, 0), Eigen::Vector2d(3, 2), Eigen::Vector2d(1, 2)};
+    poly.file_index = {0, 1, 2, 3};
+    tspline::ParameterizationOptions opt;
+    opt.corners = std::array<long long, 4>{0, 1, 2, 3};
+    std::string kept_line;
+    auto run = [&](std::optional<tspline::QualityFloor> keep, bool optimize, std::string* line) {
+      tspline::ParameterizationOptions o = opt;
+      o.progress = [line](const ProgressEvent& e) {
+        if (line && e.stage == "map" && test_support::contains(e.text, "without optimizing")) *line = e.text;
+      };
+      tspline::AdaptiveOptions ad;
+      ad.max_adapt = 0;
+      ad.keep_interpolant = keep;
+      ad.optimize_control_points = optimize;
+      return tspline::run_parameterization(poly, o, ad);
+    };
+    const tspline::ParameterizationResult kept = run(tspline::AdaptiveOptions{}.keep_interpolant, true, &kept_line);
+    const tspline::ParameterizationResult plain = run(std::nullopt, false, nullptr);
+    const tspline::ParameterizationResult optimized = run(std::nullopt, true, nullptr);
+    const tspline::ParameterizationResult unmet = run(tspline::QualityFloor{0.6, 1.01}, true, nullptr);
+    REQUIRE(kept.map);
+    REQUIRE(kept.certified_valid());
+    const tspline::QualityFloor floor = *tspline::AdaptiveOptions{}.keep_interpolant;
+    CHECK(kept.dense_quality.min_mean_ratio >= floor.mean_ratio);
+    CHECK(kept.dense_quality.min_scaled >= floor.scaled_jacobian);
+    CHECK(test_support::contains(kept_line, "kept the interpolating map without optimizing it"));
+    REQUIRE(kept.iterations.size() == 1);
+    CHECK_FALSE(kept.iterations[0].control_points_optimized);
+    CHECK(kept.iterations[0].untangling.free_points == 0);  // the optimizer never ran
+    CHECK(kept.map->control_points() == plain.map->control_points());
+    for (const tspline::ParameterizationResult* r : {&optimized, &unmet}) {
+      REQUIRE(r->iterations.size() == 1);
+      CHECK(r->iterations[0].untangling.free_points > 0);
+      CHECK(r->certified_valid());
+    }
+  }
+
   TEST_CASE("options out of range are input errors that name the option's field, before any work") {
     const tspline::Polygon poly = tspline::io::read_polygon(test_support::polygon_file("square.txt"));
     auto message = [&](const tspline::ParameterizationOptions& o, const tspline::AdaptiveOptions& a) -> std::string {
@@ -141,7 +185,8 @@ TEST_SUITE("parameterization_run") {
               {"`min_jacobian`", [](auto&, auto& a) { a.min_jacobian = 0.0; }},
               {"`certification.max_depth`", [](auto&, auto& a) { a.certification.max_depth = 21; }},
               {"`untangling.quality_power`", [](auto&, auto& a) { a.untangling.quality_power = 0.5; }},
-              {"`polish_skip.scaled_jacobian`", [](auto&, auto& a) { a.polish_skip.scaled_jacobian = std::nan(""); }}};
+              {"`polish_skip.scaled_jacobian`", [](auto&, auto& a) { a.polish_skip.scaled_jacobian = std::nan(""); }},
+              {"`keep_interpolant.mean_ratio`", [](auto&, auto& a) { a.keep_interpolant = tspline::QualityFloor{0.6, INFINITY}; }}};
     for (const auto& name_spoil : cases) {
       const std::string& name = name_spoil.first;
       const auto& spoil = name_spoil.second;

@@ -279,6 +279,28 @@ class AdaptiveRun {
       if (interpolant_cert.certified_valid()) interpolant = map;
       t_certify_ += seconds_since(t1);
     }
+    // The interpolant's figures: kept as it is where they meet keep_interpolant,
+    // else compared with the optimized map's below.
+    std::optional<MapQualityStats> iq;
+    std::vector<CellMapQuality> icells;
+    if (interpolant && ad_.keep_interpolant) {
+      const auto t1 = std::chrono::steady_clock::now();
+      iq = map_quality(map, extraction, ad_.gauss, &icells);
+      const DenseMapQuality dense = whole_map_quality(map, icells, &extraction);
+      t_check_ += seconds_since(t1);
+      if (ad_.keep_interpolant->met_by(dense)) {
+        std::ostringstream s;
+        s << "kept the interpolating map without optimizing it: certified, and its whole-map scaled Jacobian "
+          << dense.min_scaled << " and J_r " << dense.min_mean_ratio << " reach " << ad_.keep_interpolant->scaled_jacobian
+          << " and " << ad_.keep_interpolant->mean_ratio;
+        log("map", s.str());
+        cert = std::move(interpolant_cert);
+        cells = std::move(icells);
+        rec.control_points_optimized = false;
+        rec.dense_quality = dense;
+        return *iq;
+      }
+    }
     if (ad_.optimize_control_points) {
       const auto t1 = std::chrono::steady_clock::now();
       const MapUntanglingReport u = untangle_map(map, untangling_options(), ad_.certification);
@@ -305,15 +327,14 @@ class AdaptiveRun {
     const auto t2 = std::chrono::steady_clock::now();
     MapQualityStats quality = map_quality(map, extraction, ad_.gauss, &cells);
     if (interpolant) {
-      std::vector<CellMapQuality> icells;
-      const MapQualityStats iq = map_quality(*interpolant, extraction, ad_.gauss, &icells);
-      if (!cert.certified_valid() || iq.min_mean_ratio > quality.min_mean_ratio) {
+      if (!iq) iq = map_quality(*interpolant, extraction, ad_.gauss, &icells);
+      if (!cert.certified_valid() || iq->min_mean_ratio > quality.min_mean_ratio) {
         log("map", "kept the interpolating map: certified, and its min J_r at Gauss points " +
-                       std::to_string(iq.min_mean_ratio) + " is higher than the untangled map's " +
+                       std::to_string(iq->min_mean_ratio) + " is higher than the untangled map's " +
                        std::to_string(quality.min_mean_ratio));
         map = std::move(*interpolant);
         cert = std::move(interpolant_cert);
-        quality = iq;
+        quality = *iq;
         cells = std::move(icells);
         rec.control_points_optimized = false;
       }

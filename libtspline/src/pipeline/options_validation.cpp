@@ -46,6 +46,9 @@ void validate_options(const AdaptiveOptions& ad) {
   if (ad.max_adapt < 0) fail("`max_adapt` must be >= 0, got " + std::to_string(ad.max_adapt));
   if (ad.polish_stages < 0 || !(ad.polish_power >= 1.0) || !std::isfinite(ad.polish_below))
     fail("`polish_stages` must be >= 0, `polish_power` >= 1 and `polish_below` finite");
+  if (ad.keep_interpolant &&
+      !(std::isfinite(ad.keep_interpolant->scaled_jacobian) && std::isfinite(ad.keep_interpolant->mean_ratio)))
+    fail("`keep_interpolant.scaled_jacobian` and `keep_interpolant.mean_ratio` must be finite");
   if (!std::isfinite(ad.polish_skip.scaled_jacobian) || !std::isfinite(ad.polish_skip.mean_ratio))
     fail("`polish_skip.scaled_jacobian` and `polish_skip.mean_ratio` must be finite");
   if (ad.gauss < 1 || ad.gauss > 6) fail("`gauss` (Gauss points per direction) must be in [1, 6], got " +
