@@ -27,12 +27,13 @@
 
 namespace tspline {
 
-// One adaptive round's untangling of the control points: every field of the
-// report by its name (map_untangling.h; from_json comes with the macros and is
-// unused). The certification is left out: the round's own is in the report.
-// The options of the certified quality bounds by their names (map_quality_bounds.h).
+// The report's keys are the field names (from_json comes with the macros and
+// is unused).
+// The options of the certified quality bounds (map_quality_bounds.h).
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(QualityBoundOptions, relative_gap, absolute_gap, max_depth, max_patches,
                                    samples_per_edge)
+// One adaptive round's untangling of the control points (map_untangling.h).
+// The certification is left out: the round's own is in the report.
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(SampleStats, points, nonpositive, min_det, min_mean_ratio, mean_mean_ratio)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(MapUntanglingReport, free_points, fixed_points, elements, samples, stages, iterations,
                                    evaluations, factorizations, shifted_factorizations, line_search_certifications,

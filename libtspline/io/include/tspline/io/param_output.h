@@ -103,8 +103,9 @@ nlohmann::json combine_whole_map_quality_json(const std::vector<nlohmann::json>&
 /// Full report: the front-half report plus the T-spline (functions, control
 /// points, interpolation residual), J_r min/mean, quadrature points with
 /// det J <= 0, the whole-map figures (certified bounds and a dense sample,
-/// whole_map_quality_json), the adaptive iterations and the per-stage times
-/// (the options are those stored in the result).
+/// whole_map_quality_json), the adaptive iterations and the per-stage times.
+/// The options are not written: a front end adds its own (`tspline param`
+/// and Python: every option of their table, by name).
 nlohmann::json param_report(const ParameterizationResult& result, const std::string& input_path);
 
 /// The map of a result as Bezier cells (bezier_vtu.h), with the result's
