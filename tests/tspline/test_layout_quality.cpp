@@ -517,6 +517,78 @@ TEST_SUITE("layout_quality") {
     CHECK(tspline::rings_with_flat_corners(m, Q)[0] == 0);
   }
 
+  TEST_CASE("a sheet of quads through a flat single-quad corner gives it two quads and ends on the ring") {
+    // The right triangle of the pillow test: one quad, its corner at (1, 1) flat.
+    const tspline::LayoutRings ring = one_ring({V(0, 0), V(2, 0), V(0, 2)});
+    const tspline::LayoutQuality Q(ring);
+    tspline::LayoutMesh m = ring_mesh(ring.curves[0], {V(0, 0), V(2, 0), V(1, 1), V(0, 2)}, {}, {{0, 1, 2, 3}});
+    const std::vector<int> flat = tspline::flat_ring_corners(m, Q);
+    REQUIRE(flat == std::vector<int>{2});
+    // Too few quads allowed: nothing changes.
+    const tspline::LayoutMesh before = m;
+    CHECK(tspline::insert_corner_sheets(m, ring, flat, 1) == 0);
+    CHECK(m.quads == before.quads);
+    CHECK(m.x == before.x);
+    // The quad cut in three; both ends of the sheet are ring edges, halved by new ring nodes.
+    CHECK(tspline::insert_corner_sheets(m, ring, flat, 100) == 2);
+    REQUIRE(m.quads.size() == 3);
+    REQUIRE(m.size() == 7);
+    const tspline::LayoutTopology t(m);
+    CHECK(t.valence(2) == 2);
+    int on_ring = 0;
+    for (std::size_t n = 0; n < m.size(); ++n) {
+      if (m.ring[n] < 0) continue;
+      ++on_ring;
+      // A ring node lies where its arc length says.
+      CHECK((ring.curves[0].point(m.arc[n]) - m.x[n]).norm() < 1e-14);
+    }
+    CHECK(on_ring == 6);  // (1, 0) and (0, 1), the midpoints of the two legs, are ring nodes now
+    CHECK(std::count(m.x.begin(), m.x.end(), V(1, 0)) == 1);
+    CHECK(std::count(m.x.begin(), m.x.end(), V(0, 1)) == 1);
+    double area = 0.0;
+    for (const auto& q : m.quads) {
+      double a = 0.0;
+      for (int k = 0; k < 4; ++k) {
+        const V &p = m.x[q[k]], &s2 = m.x[q[(k + 1) % 4]];
+        a += 0.5 * (p.x() * s2.y() - p.y() * s2.x());
+      }
+      CHECK(a > 0.0);
+      area += a;
+    }
+    CHECK(area == doctest::Approx(2.0));
+    CHECK(tspline::flat_ring_corners(m, Q).empty());
+  }
+
+  TEST_CASE("a sheet that crosses itself cuts that quad in four and keeps the mesh conforming") {
+    // The triangle (0, 0), (4, 0), (0, 4): a quad at the flat corner (2, 2) of the
+    // hypotenuse and the quad (0, 0), (4, 0), (1, 1), (0, 4) beside it, which the
+    // sheet leaving the first quad by both of its inner edges crosses twice.
+    const tspline::LayoutRings ring = one_ring({V(0, 0), V(4, 0), V(0, 4)});
+    const tspline::LayoutQuality Q(ring);
+    tspline::LayoutMesh m = ring_mesh(ring.curves[0], {V(0, 0), V(4, 0), V(2, 2), V(0, 4)}, {V(1, 1)},
+                                      {{2, 3, 4, 1}, {0, 1, 4, 3}});
+    REQUIRE(tspline::flat_ring_corners(m, Q) == std::vector<int>{2});
+    CHECK(tspline::insert_corner_sheets(m, ring, {2}, 100) == 5);  // 3 from the corner's quad, 4 from the other
+    REQUIRE(m.quads.size() == 7);
+    const tspline::LayoutTopology t(m);
+    int ring_edges = 0;
+    for (int q = 0; q < static_cast<int>(m.quads.size()); ++q)
+      for (int j = 0; j < 4; ++j) {
+        ring_edges += t.on_ring(q, j) ? 1 : 0;
+        CHECK((t.on_ring(q, j) || t.across(q, j).first >= 0));
+      }
+    CHECK(ring_edges == 6);  // the two legs halved: (2, 0) and (0, 2) are ring nodes
+    CHECK(t.valence(2) == 2);
+    double area = 0.0;
+    for (const auto& q : m.quads)
+      for (int k = 0; k < 4; ++k) {
+        const V &p = m.x[q[k]], &s2 = m.x[q[(k + 1) % 4]];
+        area += 0.5 * (p.x() * s2.y() - p.y() * s2.x());
+      }
+    CHECK(area == doctest::Approx(8.0));
+    CHECK(tspline::flat_ring_corners(m, Q).empty());
+  }
+
   TEST_CASE("pillowing keeps convex corners whole: a 3 x 3 grid's corners stay single-quad corners") {
     const tspline::LayoutRings ring = one_ring({V(0, 0), V(3, 0), V(3, 3), V(0, 3)});
     // Ring nodes counter-clockwise from (0, 0), then the inner nodes (1, 1), (2, 1), (2, 2), (1, 2).

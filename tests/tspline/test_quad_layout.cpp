@@ -225,6 +225,41 @@ TEST_SUITE("quad_layout") {
     }
   }
 
+  TEST_CASE("a flat ring corner of Bali's layout: a sheet through it, or its ring pillowed; restarted from the ring nodes") {
+    if (!tspline::quad_mesher_available()) return;
+    tspline::DomainCleaningOptions how;
+    how.blunt_tips_below_degrees = 17.5;  // as `tspline param` cleans it
+    const tspline::Domain d = tspline::validate_domain(
+        {tspline::io::read_polygon(std::string(TSPLINE_TEST_DATA_DIR) + "/coastlines/bali.txt"), {}}, how);
+    const tspline::QuadLayout sheets = tspline::build_quad_layout(d);
+    check_layout_tiles(d, sheets.layout);
+    REQUIRE(sheets.stats.corner_sheets >= 1);
+    CHECK(sheets.stats.pillowed_rings == 0);
+    CHECK(contains(sheets.explanation(), "sheet(s) of quads through flat ring corners"));
+    tspline::QuadLayoutOptions o;
+    o.corner_sheets = false;
+    const tspline::QuadLayout pillowed = tspline::build_quad_layout(d, o);
+    check_layout_tiles(d, pillowed.layout);
+    CHECK(pillowed.stats.pillowed_rings == 1);
+    CHECK(pillowed.stats.corner_sheets == 0);
+    // A sheet adds fewer patches than a layer along the whole coast.
+    CHECK(sheets.stats.patches < pillowed.stats.patches);
+    // The first layout's ring nodes (its repairs included) give the same layout, with no repair.
+    REQUIRE(sheets.ring_nodes.size() == 1);
+    o.corner_sheets = true;
+    o.start_ring_nodes = sheets.ring_nodes;
+    const tspline::QuadLayout again = tspline::build_quad_layout(d, o);
+    CHECK(again.stats.repair_rounds == 0);
+    CHECK(again.stats.patches == sheets.stats.patches);
+    CHECK(again.ring_nodes == sheets.ring_nodes);
+    o.start_ring_nodes.push_back({0.0});
+    CHECK(contains(message_of<tspline::InputError>([&] { (void)tspline::build_quad_layout(d, o); }),
+                   "start_ring_nodes has 2 list(s) for 1 ring(s)"));
+    o.start_ring_nodes = {{1.0, 0.5}};
+    CHECK(contains(message_of<tspline::InputError>([&] { (void)tspline::build_quad_layout(d, o); }),
+                   "not ascending arc lengths"));
+  }
+
   TEST_CASE("quad layout of a domain whose holes have needles at vertex 0: cleaned, then laid out and mapped") {
     if (!tspline::quad_mesher_available()) return;
     const tspline::io::DomainInput in =

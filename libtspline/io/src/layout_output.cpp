@@ -6,7 +6,7 @@ namespace tspline {
 // the macro and is unused).
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(QuadLayoutStats, patches, ring_nodes, inner_nodes, inner_valence,
                                    straight_min_scaled_jacobian, straight_mean_scaled_jacobian, repair_rounds,
-                                   pillowed_rings, optimization_level, rotations, openings, optimization_sweeps,
+                                   pillowed_rings, corner_sheets, optimization_level, rotations, openings, optimization_sweeps,
                                    corner_mean_ratio, corner_scaled_jacobian, min_size, max_size, seconds)
 
 }  // namespace tspline

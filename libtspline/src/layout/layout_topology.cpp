@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cstdlib>
 #include <array>
+#include <cmath>
 #include <utility>
 #include <vector>
 
@@ -96,9 +97,9 @@ LocalLayout local_layout(const LayoutMesh& m, const LayoutTopology& t, const std
 
 using namespace layout_local;
 
-std::vector<char> rings_with_flat_corners(const LayoutMesh& m, const LayoutQuality& Q) {
+std::vector<int> flat_ring_corners(const LayoutMesh& m, const LayoutQuality& Q) {
   const LayoutTopology t(m);
-  std::vector<char> flat(Q.rings().curves.size(), 0);
+  std::vector<int> flat;
   for (std::size_t v = 0; v < m.size(); ++v) {
     if (m.ring[v] < 0 || t.valence(static_cast<int>(v)) != 1) continue;
     const auto [q, j] = t.corners_of(static_cast<int>(v)).front();
@@ -107,10 +108,148 @@ std::vector<char> rings_with_flat_corners(const LayoutMesh& m, const LayoutQuali
     for (const double scale : LayoutQuality::corner_scales) {
       const auto [e1, e2] = Q.corner_vectors(m, t, q, j, scale);
       const double sn = corner_sj(Eigen::Vector2d::Zero(), e1, e2);
-      if (sn < 0.0 || (sn <= 0.5 && e1.dot(e2) < 0.0)) flat[m.ring[v]] = 1;
+      if (sn < 0.0 || (sn <= 0.5 && e1.dot(e2) < 0.0)) {
+        flat.push_back(static_cast<int>(v));
+        break;
+      }
     }
   }
   return flat;
+}
+
+std::vector<char> rings_with_flat_corners(const LayoutMesh& m, const LayoutQuality& Q) {
+  std::vector<char> flat(Q.rings().curves.size(), 0);
+  for (const int v : flat_ring_corners(m, Q)) flat[m.ring[v]] = 1;
+  return flat;
+}
+
+namespace {
+
+// One sheet of quads through the single quad at a flat ring corner v
+// (insert_corner_sheets). The quad (v, b, X, a) is cut into three: (a, v, v', a'),
+// (v, b, b', v') and (v', b', X, a'), with a' and b' at the midpoints of X-a and
+// b-X and v' between v and X; from each of a' and b' the sheet runs on through
+// the quads across, each cut in two between the midpoints of the edge it enters
+// by and of the opposite edge, until it reaches a ring, where the midpoint (by
+// arc length) of the ring piece becomes a ring node of two quads.
+class CornerSheet {
+ public:
+  CornerSheet(LayoutMesh& m, const LayoutRings& R) : m_(m), R_(R) {}
+
+  // The quads the sheet adds (0: none; m unchanged), or none where it would
+  // run through one quad twice in the same direction, or through the corner's
+  // quad again, or cut more than max_quads quads. A sheet that crosses itself
+  // (through a quad in both directions) cuts that quad in four.
+  std::size_t insert(int v, std::size_t max_quads) {
+    const LayoutTopology t(m_);
+    if (t.valence(v) != 1) return 0;
+    const auto [q, j] = t.corners_of(v).front();
+    crossed_.assign(m_.quads.size(), 0);
+    entry_.assign(m_.quads.size(), {0, 0});
+    crossed_[q] = kCornerQuad;
+    for (const int exit : {(j + 2) % 4, (j + 1) % 4})
+      if (!walk(t, q, exit, max_quads)) return 0;
+    const std::array<int, 4> Qv = m_.quads[q];
+    const int b = Qv[(j + 1) % 4], X = Qv[(j + 2) % 4], a = Qv[(j + 3) % 4];
+    const int ap = edge_node(t, q, (j + 2) % 4), bp = edge_node(t, q, (j + 1) % 4);
+    // The quad is a triangle a, b, X with v on its side a-b: v' at its centroid.
+    const int vp = add_node((m_.x[a] + m_.x[b] + m_.x[X]) / 3.0, -1, 0.0);
+    const std::size_t before = m_.quads.size();
+    m_.quads[q] = {a, v, vp, ap};
+    m_.quads.push_back({v, b, bp, vp});
+    m_.quads.push_back({vp, bp, X, ap});
+    for (const int n : order_) {
+      const std::array<int, 4> N = m_.quads[n];
+      if (crossed_[n] == 3) {  // both directions: four quads around a new middle node
+        std::array<int, 4> mid;
+        for (int e = 0; e < 4; ++e) mid[e] = edge_node(t, n, e);
+        const int c = add_node(0.25 * (m_.x[N[0]] + m_.x[N[1]] + m_.x[N[2]] + m_.x[N[3]]), -1, 0.0);
+        m_.quads[n] = {N[0], mid[0], c, mid[3]};
+        m_.quads.push_back({mid[0], N[1], mid[1], c});
+        m_.quads.push_back({c, mid[1], N[2], mid[2]});
+        m_.quads.push_back({mid[3], c, mid[2], N[3]});
+        continue;
+      }
+      const int k = entry_[n][crossed_[n] == 1 ? 0 : 1];
+      const int p = edge_node(t, n, k), r = edge_node(t, n, (k + 2) % 4);
+      m_.quads[n] = {N[k], p, r, N[(k + 3) % 4]};
+      m_.quads.push_back({p, N[(k + 1) % 4], N[(k + 2) % 4], r});
+    }
+    return m_.quads.size() - before;
+  }
+
+ private:
+  static constexpr char kCornerQuad = 4;
+
+  // From quad q out through its edge e, quad after quad across the opposite
+  // edges, to a ring.
+  bool walk(const LayoutTopology& t, int q, int e, std::size_t max_quads) {
+    while (!t.on_ring(q, e)) {
+      const auto [n, k] = t.across(q, e);
+      const char axis = static_cast<char>(1 << (k % 2));
+      if (n < 0 || (crossed_[n] & (axis | kCornerQuad)) || order_.size() + 2 > max_quads) return false;
+      if (!crossed_[n]) order_.push_back(n);
+      crossed_[n] |= axis;
+      entry_[n][k % 2] = k;
+      q = n, e = (k + 2) % 4;
+    }
+    return true;
+  }
+
+  int add_node(const Eigen::Vector2d& x, int ring, double arc) {
+    m_.x.push_back(x);
+    m_.ring.push_back(ring);
+    m_.arc.push_back(arc);
+    return static_cast<int>(m_.x.size()) - 1;
+  }
+
+  // The node at the midpoint of edge e of quad q (made once per edge): on a
+  // ring edge, the point halfway along the ring piece between its two nodes.
+  int edge_node(const LayoutTopology& t, int q, int e) {
+    const int u = m_.quads[q][e], w = m_.quads[q][(e + 1) % 4];
+    const std::pair<int, int> key = std::minmax(u, w);
+    for (const auto& [k, node] : made_)
+      if (k == key) return node;
+    int node;
+    if (t.on_ring(q, e)) {
+      const int r = m_.ring[u];
+      const RingCurve& ring = R_.curves[static_cast<std::size_t>(r)];
+      const double L = ring.length();
+      // A counter-clockwise quad runs along the outer ring forwards, along a hole backwards.
+      double s0 = m_.arc[u], s1 = m_.arc[w];
+      if (R_.direction(r) < 0.0) std::swap(s0, s1);
+      double len = s1 - s0;
+      if (len <= 0.0) len += L;
+      const double s = ring.snap_to_vertex(std::fmod(s0 + 0.5 * len, L), 0.01 * len);
+      node = add_node(ring.point(s), r, s);
+    } else {
+      node = add_node(0.5 * (m_.x[u] + m_.x[w]), -1, 0.0);
+    }
+    made_.push_back({key, node});
+    return node;
+  }
+
+  LayoutMesh& m_;
+  const LayoutRings& R_;
+  std::vector<std::pair<std::pair<int, int>, int>> made_;  // (edge, its midpoint node), a handful per sheet
+  std::vector<char> crossed_;                 // per quad: directions the sheet runs through it (bits 1, 2), or kCornerQuad
+  std::vector<std::array<int, 2>> entry_;     // per quad and direction: the edge the sheet enters by
+  std::vector<int> order_;                    // the quads the sheet runs through, each once
+};
+
+}  // namespace
+
+std::size_t insert_corner_sheets(LayoutMesh& m, const LayoutRings& R, const std::vector<int>& corners,
+                                 std::size_t max_quads) {
+  LayoutMesh trial = m;
+  std::size_t added = 0;
+  for (const int v : corners) {
+    const std::size_t k = CornerSheet(trial, R).insert(v, max_quads - added);
+    added += k;
+    if (k == 0 || added > max_quads) return 0;  // (the walk counts a quad cut in four as one)
+  }
+  m = std::move(trial);
+  return added;
 }
 
 namespace {

@@ -4,7 +4,6 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <cstdlib>
 #include <limits>
 #include <numbers>
 #include <optional>
@@ -88,18 +87,20 @@ void report_optimization(const LayoutOptimizationReport& rep, QuadLayoutStats& s
 // it; 1: node optimization; 2: and edge rotations where quads stay poor):
 //  1. K* untangling of the inner nodes, then a short node optimization;
 //  2. edge rotations, which also walk flat single-quad ring corners away;
-//  3. rings that still have a flat single-quad corner are pillowed;
+//  3. a flat single-quad ring corner gets a sheet of quads through it, or
+//     where that adds more quads (or corner_sheets is off), its ring is pillowed;
 //  4. the node optimization in full, then rotations and the optimization
 //     again while rotations are kept.
 // `start` becomes the mesh the checks fall back to (the mesher's nodes, after
 // any pillowing).
 void optimize_layout(LayoutMesh& m, LayoutMesh& start, const LayoutRings& R, const LayoutQuality& Q,
-                     const LayoutAdmissible& admissible, int level, QuadLayoutStats& st,
+                     const LayoutAdmissible& admissible, int level, bool corner_sheets, QuadLayoutStats& st,
                      const std::atomic<bool>* cancel) {
   st.rotations = 0;
   st.openings = 0;
   st.optimization_sweeps = 0;
   st.pillowed_rings = 0;
+  st.corner_sheets = 0;
   // Every sweep and rotation batch checks the cancel flag.
   LayoutOptimizationOptions full;
   full.cancel = cancel;
@@ -120,11 +121,29 @@ void optimize_layout(LayoutMesh& m, LayoutMesh& start, const LayoutRings& R, con
     report_optimization(optimize_layout_nodes(m, Q, admissible, {}, quick), st);
     if (level >= 2) rotate();
   }
-  const std::vector<char> flat = rings_with_flat_corners(m, Q);
-  st.pillowed_rings = static_cast<std::size_t>(std::count(flat.begin(), flat.end(), 1));
-  if (st.pillowed_rings > 0) {
+  const std::vector<int> flat_corners = flat_ring_corners(m, Q);
+  if (!flat_corners.empty()) {
     if (level == 0) m = start;
-    pillow_rings(m, flat);
+    // A sheet through each flat corner where the sheets add fewer quads than
+    // the pillow layers of their rings would (one per quad edge along them).
+    std::vector<char> flat(R.curves.size(), 0);
+    for (const int v : flat_corners) flat[m.ring[v]] = 1;
+    std::size_t layer_quads = 0;
+    const LayoutTopology t(m);
+    for (std::size_t q = 0; q < m.quads.size(); ++q)
+      for (int j = 0; j < 4; ++j) layer_quads += t.on_ring(static_cast<int>(q), j) && flat[m.ring[m.quads[q][j]]];
+    const std::size_t sheet_quads = corner_sheets ? insert_corner_sheets(m, R, flat_corners, layer_quads) : 0;
+    if (debugging()) {
+      std::fprintf(stderr, "layout flat corners: %zu, sheets add %zu quads (pillow layers %zu)\n", flat_corners.size(),
+                   sheet_quads, layer_quads);
+      for (const int v : flat_corners) std::fprintf(stderr, "  flat corner (%.4f, %.4f)\n", m.x[v].x(), m.x[v].y());
+    }
+    if (sheet_quads > 0) {
+      st.corner_sheets = flat_corners.size();
+    } else {
+      st.pillowed_rings = static_cast<std::size_t>(std::count(flat.begin(), flat.end(), 1));
+      pillow_rings(m, flat);
+    }
     start = m;
     if (level >= 1) smooth_layout_kstar(m, R);
   }
@@ -168,6 +187,7 @@ std::string QuadLayout::explanation() const {
     if (stats.inner_valence[v]) s << ' ' << v << (v == 7 ? "+" : "") << ": " << stats.inner_valence[v];
   s << ")";
   if (stats.pillowed_rings) s << ", " << stats.pillowed_rings << " ring(s) pillowed";
+  if (stats.corner_sheets) s << ", " << stats.corner_sheets << " sheet(s) of quads through flat ring corners";
   s.precision(3);
   s << ", worst corner J_r " << stats.corner_mean_ratio << " scaled Jacobian " << stats.corner_scaled_jacobian
     << (stats.optimization_level == 2   ? ""
@@ -283,6 +303,21 @@ QuadLayoutBuilder::QuadLayoutBuilder(const Domain& d, const QuadLayoutOptions& o
       admissible_(admissible_in(geometry_, tol_)) {
   // Ring pieces are two quad edges long.
   const auto piece_size = [this](const Eigen::Vector2d& x) { return 2.0 * h_(x); };
+  if (!o.start_ring_nodes.empty()) {
+    if (o.start_ring_nodes.size() != rings().size())
+      throw InputError("quad layout: start_ring_nodes has " + std::to_string(o.start_ring_nodes.size()) +
+                       " list(s) for " + std::to_string(rings().size()) + " ring(s)");
+    for (std::size_t r = 0; r < rings().size(); ++r) {
+      const std::vector<double>& s = o.start_ring_nodes[r];
+      const double L = rings()[r].length();
+      const bool ascending = std::adjacent_find(s.begin(), s.end(), std::greater_equal<>()) == s.end();
+      if (s.empty() || !ascending || !(s.front() >= 0.0) || !(s.back() < L))
+        throw InputError("quad layout: start_ring_nodes of ring " + std::to_string(r) +
+                         " are not ascending arc lengths in [0, the ring's length)");
+    }
+    nodes_ = o.start_ring_nodes;
+    return;
+  }
   for (const RingCurve& r : rings()) nodes_.push_back(ring_nodes(r, node_options_, piece_size));
 }
 
@@ -317,7 +352,7 @@ QuadLayout QuadLayoutBuilder::build() {
     note(mesh_name() + ": " + std::to_string(m.quads.size()) + " quads from the mesher; optimizing them" +
          (level_ == 2 ? "" : " without edge rotations"));
     const auto t_opt = std::chrono::steady_clock::now();
-    optimize_layout(m, start, R_, quality_, admissible_, level_, out_.stats, o_.cancel);
+    optimize_layout(m, start, R_, quality_, admissible_, level_, o_.corner_sheets, out_.stats, o_.cancel);
     if (debugging())
       std::fprintf(stderr, "layout round %d: mesh %zu quads at %.2f s, optimized in %.2f s\n", round, m.quads.size(),
                    std::chrono::duration<double>(t_opt - t0_).count(), toolkit::seconds_since(t_opt));
@@ -334,6 +369,7 @@ QuadLayout QuadLayoutBuilder::build() {
       continue;
     }
     fill_stats(m, t);
+    out_.ring_nodes = nodes_;
     return std::move(out_);
   }
 }

@@ -146,24 +146,33 @@ DomainParameterization parameterize_domain(const Domain& input, const Parameteri
   };
   auto patch_figures = [](const MultiPatchResult& R) { return figures(dense_figures(R)); };
   // A certified map of a quad layout below the thresholds: one more layout of
-  // `valid` with patches c.retry_size_factor times larger (another mesh of
-  // the domain, whose worst corners fall elsewhere), kept where its map is
-  // certified and the worse of its two figures is higher.
-  auto retry_with_larger_patches = [&](const Domain& valid) {
+  // `valid`, kept where its map is certified and the worse of its two figures
+  // is higher. Where the first gave flat ring corners sheets of quads, the
+  // second pillows their rings instead (the same ring nodes); else its
+  // patches are c.retry_size_factor times larger (another mesh of the domain,
+  // whose worst corners fall elsewhere).
+  auto retry_with_another_layout = [&](const Domain& valid, const QuadLayout& first_layout) {
     const MultiPatchResult& first = *out.patches;
-    if (!(c.retry_size_factor > 0.0) || c.retry_size_factor == 1.0 || good_patches(first) ||
-        (adaptive.certify && !first.certified_valid()))
-      return;
+    const bool pillow = out.quad_stats && out.quad_stats->corner_sheets > 0;
+    if (!(c.retry_size_factor > 0.0) || c.retry_size_factor == 1.0) return;
+    if (good_patches(first) || (adaptive.certify && !first.certified_valid())) return;
     std::ostringstream larger;
-    larger << "a second quad layout with patches " << c.retry_size_factor << " times larger";
+    if (pillow)
+      larger << "a second quad layout with the rings of its flat corners pillowed instead of sheets through them";
+    else
+      larger << "a second quad layout with patches " << c.retry_size_factor << " times larger";
     report_step(serial.progress, "layout",
                 "the layout's map is certified but below the thresholds (" + patch_figures(first) + "): " +
                     larger.str());
     std::string outcome;
     try {
       QuadLayoutOptions q = c.quad;
-      q.size.factor *= c.retry_size_factor;
-      q.progress = layout_progress("quad layout, larger patches: ");
+      if (pillow) {
+        q.corner_sheets = false;
+        q.start_ring_nodes = first_layout.ring_nodes;  // its repairs done already
+      } else
+        q.size.factor *= c.retry_size_factor;
+      q.progress = layout_progress(pillow ? "quad layout, pillowed: " : "quad layout, larger patches: ");
       QuadLayout L = build_quad_layout(valid, q);
       const std::string explanation = L.explanation();
       report_step(serial.progress, "layout", explanation);
@@ -203,7 +212,7 @@ DomainParameterization parameterize_domain(const Domain& input, const Parameteri
     else
       out.patches.emplace(run_multipatch_parameterization(a.valid, std::move(a.layout.layout), a.explanation,
                                                           patch_options, adaptive, c.multi, on_patch));
-    retry_with_larger_patches(a.valid);
+    retry_with_another_layout(a.valid, a.layout);
   };
   if (c.layout == LayoutMode::Quad) {
     run_quad("layout quad was asked for");

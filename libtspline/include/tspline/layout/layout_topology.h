@@ -57,6 +57,19 @@ struct LayoutRotationReport {
 /// degrees or more, where no map is valid (det J at a corner of the square is
 /// the cross product of the two boundary tangents).
 std::vector<char> rings_with_flat_corners(const LayoutMesh& m, const LayoutQuality& quality);
+/// Those ring nodes (the flat single-quad corners), in node order.
+std::vector<int> flat_ring_corners(const LayoutMesh& m, const LayoutQuality& quality);
+
+/// Gives each of the flat single-quad ring corners `corners` a second quad by
+/// a sheet of quads (a chord of the dual mesh inserted; the local alternative
+/// to pillowing its whole ring): the corner's quad is cut into three around
+/// it, and from there the sheet runs through the quads on both sides, each cut
+/// in two, until it meets a ring, where a new ring node halves the ring piece.
+/// New nodes start at midpoints (the layout optimizer moves them). All or
+/// nothing: returns the quads added, or 0 with `m` unchanged where a sheet
+/// would cross itself or the sheets would add more than max_quads quads.
+std::size_t insert_corner_sheets(LayoutMesh& m, const LayoutRings& rings, const std::vector<int>& corners,
+                                 std::size_t max_quads);
 
 /// Pillows the rings marked: every node of such a ring moves a third of the
 /// way inside, a copy takes its place on the ring, and each quad edge along

@@ -42,6 +42,15 @@ struct QuadLayoutOptions {
   /// Features narrower than this times the bounding-box diagonal are not
   /// resolved by patches (unless size.min_size is set).
   double min_size_fraction = 2e-3;
+  /// A flat single-quad ring corner (a patch corner of about 180 degrees)
+  /// gets a sheet of quads through it (insert_corner_sheets, layout_topology.h)
+  /// where the sheets add fewer quads than pillowing its ring; false: the ring
+  /// is pillowed (a layer of quads along all of it).
+  bool corner_sheets = true;
+  /// Per ring, the arc lengths of the ring nodes to start from instead of
+  /// computing them (QuadLayout::ring_nodes of an earlier layout of the same
+  /// domain: its repairs done already); empty: computed (ring_nodes.h).
+  std::vector<std::vector<double>> start_ring_nodes;
   /// Rounds of "add nodes where the true geometry breaks the layout, mesh again".
   int max_repair_rounds = 40;
   /// Set by another thread when the layout is no longer wanted (parameterize_domain
@@ -65,6 +74,7 @@ struct QuadLayoutStats {
   double straight_mean_scaled_jacobian = 1.0;
   int repair_rounds = 0;
   std::size_t pillowed_rings = 0;            ///< rings given a layer of quads (a flat single-quad corner)
+  std::size_t corner_sheets = 0;             ///< flat single-quad ring corners given a sheet of quads instead
   /// How far the layout was optimized: 2 all (node optimization and edge
   /// rotations, layout_optimizer.h and layout_topology.h), 1 nodes only, 0 the
   /// mesher's own nodes. Where level 2 leaves a patch corner outside 1-170
@@ -88,6 +98,9 @@ struct QuadLayout {
   PatchLayout layout;
   /// Patch corners on rings that no cut ends at (a quad corner at a sharp tip).
   std::vector<Eigen::Vector2d> ring_corners;
+  /// Per ring, the arc lengths of the nodes the layout was meshed with (the
+  /// repair rounds' included), ascending.
+  std::vector<std::vector<double>> ring_nodes;
   QuadLayoutStats stats;
   std::string explanation() const;
 };

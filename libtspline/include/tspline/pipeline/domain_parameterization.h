@@ -52,7 +52,10 @@ struct DomainParameterizationOptions {
   /// (the worse of the two figures). 1 (or 0): no second layout. (On rotated,
   /// mirrored and rescaled copies of the bundled coastlines and seas, 4 maps
   /// of 62 missed the scaled Jacobian 0.3; with patches 1.2 times larger all
-  /// four reached it, with 0.85 times one.)
+  /// four reached it, with 0.85 times one.) Where the first layout gave flat
+  /// ring corners sheets of quads (QuadLayoutOptions::corner_sheets), the
+  /// second pillows their rings instead, from the first's ring nodes (any
+  /// factor other than 1 or 0).
   double retry_size_factor = 1.2;
   /// Initial T-mesh level of the patches of a quad layout (they are small and
   /// nearly square; refinement adds what they need); unset: the options' own.
