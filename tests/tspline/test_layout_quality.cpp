@@ -508,11 +508,7 @@ TEST_SUITE("layout_quality") {
     CHECK(unused == 1);
     // The signed areas of the quads add up to the triangle's, 2: the boundary is kept.
     double area = 0.0;
-    for (const auto& q : m.quads)
-      for (int k = 0; k < 4; ++k) {
-        const V &p = m.x[q[k]], &s2 = m.x[q[(k + 1) % 4]];
-        area += 0.5 * (p.x() * s2.y() - p.y() * s2.x());
-      }
+    for (const auto& q : m.quads) area += quad_area(m, q);
     CHECK(area == doctest::Approx(2.0));
     CHECK(tspline::rings_with_flat_corners(m, Q)[0] == 0);
   }
@@ -547,11 +543,7 @@ TEST_SUITE("layout_quality") {
     CHECK(std::count(m.x.begin(), m.x.end(), V(0, 1)) == 1);
     double area = 0.0;
     for (const auto& q : m.quads) {
-      double a = 0.0;
-      for (int k = 0; k < 4; ++k) {
-        const V &p = m.x[q[k]], &s2 = m.x[q[(k + 1) % 4]];
-        a += 0.5 * (p.x() * s2.y() - p.y() * s2.x());
-      }
+      const double a = quad_area(m, q);
       CHECK(a > 0.0);
       area += a;
     }
@@ -580,11 +572,7 @@ TEST_SUITE("layout_quality") {
     CHECK(ring_edges == 6);  // the two legs halved: (2, 0) and (0, 2) are ring nodes
     CHECK(t.valence(2) == 2);
     double area = 0.0;
-    for (const auto& q : m.quads)
-      for (int k = 0; k < 4; ++k) {
-        const V &p = m.x[q[k]], &s2 = m.x[q[(k + 1) % 4]];
-        area += 0.5 * (p.x() * s2.y() - p.y() * s2.x());
-      }
+    for (const auto& q : m.quads) area += quad_area(m, q);
     CHECK(area == doctest::Approx(8.0));
     CHECK(tspline::flat_ring_corners(m, Q).empty());
   }
@@ -621,11 +609,7 @@ TEST_SUITE("layout_quality") {
     CHECK(threes == 4);
     CHECK(unused == 4);  // the moved corner nodes
     for (const auto& q : m.quads) {
-      double a = 0.0;
-      for (int k = 0; k < 4; ++k) {
-        const V &p = m.x[q[k]], &s2 = m.x[q[(k + 1) % 4]];
-        a += 0.5 * (p.x() * s2.y() - p.y() * s2.x());
-      }
+      const double a = quad_area(m, q);
       CHECK(a > 0.0);
       area += a;
     }
