@@ -153,17 +153,17 @@ DomainParameterization parameterize_domain(const Domain& input, const Parameteri
   // whose worst corners fall elsewhere).
   auto retry_with_another_layout = [&](const Domain& valid, const QuadLayout& first_layout) {
     const MultiPatchResult& first = *out.patches;
-    const bool pillow = out.quad_stats && out.quad_stats->corner_sheets > 0;
+    const bool pillow = first_layout.stats.corner_sheets > 0;
     if (!(c.retry_size_factor > 0.0) || c.retry_size_factor == 1.0) return;
     if (good_patches(first) || (adaptive.certify && !first.certified_valid())) return;
-    std::ostringstream larger;
+    std::ostringstream second;
     if (pillow)
-      larger << "a second quad layout with the rings of its flat corners pillowed instead of sheets through them";
+      second << "a second quad layout with the rings of its flat corners pillowed instead of sheets through them";
     else
-      larger << "a second quad layout with patches " << c.retry_size_factor << " times larger";
+      second << "a second quad layout with patches " << c.retry_size_factor << " times larger";
     report_step(serial.progress, "layout",
                 "the layout's map is certified but below the thresholds (" + patch_figures(first) + "): " +
-                    larger.str());
+                    second.str());
     std::string outcome;
     try {
       QuadLayoutOptions q = c.quad;
@@ -179,14 +179,14 @@ DomainParameterization parameterize_domain(const Domain& input, const Parameteri
       MultiPatchResult R = run_multipatch_parameterization(valid, std::move(L.layout), explanation, patch_options,
                                                            adaptive, c.multi, on_patch);
       if ((!adaptive.certify || R.certified_valid()) && worse_figure(dense_figures(R)) > worse_figure(dense_figures(first))) {
-        outcome = larger.str() + " gave a better map (" + patch_figures(R) + "): kept";
+        outcome = second.str() + " gave a better map (" + patch_figures(R) + "): kept";
         out.patches.emplace(std::move(R));
         out.quad_stats = L.stats;
       } else {
-        outcome = larger.str() + " gave no better certified map (" + patch_figures(R) + "): the first kept";
+        outcome = second.str() + " gave no better certified map (" + patch_figures(R) + "): the first kept";
       }
     } catch (const NumericalError& e) {
-      outcome = larger.str() + " failed (" + e.what() + "): the first kept";
+      outcome = second.str() + " failed (" + e.what() + "): the first kept";
     }
     report_step(serial.progress, "layout", outcome);
     out.reason += "; below the thresholds, " + outcome;
