@@ -261,12 +261,20 @@ TEST_SUITE("layout_quality") {
   TEST_CASE("node optimization: a centre outside its star (inverted corners) is untangled") {
     const tspline::LayoutRings ring = one_ring({V(0, 0), V(1, 0), V(1, 1), V(0, 1)});
     const tspline::LayoutQuality Q(ring);
-    tspline::LayoutMesh m = square_2x2(ring.curves[0], V(0.9, 0.1), 0.5);
-    const tspline::LayoutTopology t(m);
-    CHECK(tspline::worst_layout_quality(m, t, Q).scaled_jacobian < 0.0);  // a reflex corner at (0.5, 0)
-    const tspline::LayoutOptimizationReport r = tspline::optimize_layout_nodes(m, Q, anywhere);
-    CHECK(r.before.scaled_jacobian < 0.0);
-    CHECK(r.after.scaled_jacobian > 0.99);
+    // Also where no move may put more patch corners out of range than before
+    // it (keep_patch_corners_in_range): the guard counts, it does not pin a
+    // node whose corners are out of range already.
+    for (const bool keep : {false, true}) {
+      CAPTURE(keep);
+      tspline::LayoutMesh m = square_2x2(ring.curves[0], V(0.9, 0.1), 0.5);
+      const tspline::LayoutTopology t(m);
+      CHECK(tspline::worst_layout_quality(m, t, Q).scaled_jacobian < 0.0);  // a reflex corner at (0.5, 0)
+      tspline::LayoutOptimizationOptions o;
+      o.keep_patch_corners_in_range = keep;
+      const tspline::LayoutOptimizationReport r = tspline::optimize_layout_nodes(m, Q, anywhere, {}, o);
+      CHECK(r.before.scaled_jacobian < 0.0);
+      CHECK(r.after.scaled_jacobian > 0.99);
+    }
   }
 
   TEST_CASE("node optimization: an untangled layout stays untangled, even to relieve a pinched side") {
@@ -574,6 +582,46 @@ TEST_SUITE("layout_quality") {
     double area = 0.0;
     for (const auto& q : m.quads) area += quad_area(m, q);
     CHECK(area == doctest::Approx(8.0));
+    CHECK(tspline::flat_ring_corners(m, Q).empty());
+  }
+
+  TEST_CASE("a sheet that comes back into its corner's quad is closed: it cuts the loop of quads around a hole") {
+    // The square (0, 0)-(4, 4) with the triangular hole (2, 1), (3, 3), (1, 3): four
+    // quads around the hole, the bottom one with the flat corner (2, 0) on the
+    // outer ring. The sheet leaving it through X-a runs around the hole and comes
+    // back through b-X: no ring is reached, no ring node is made.
+    tspline::LayoutRings R;
+    R.curves.emplace_back(std::vector<V>{V(0, 0), V(4, 0), V(4, 4), V(0, 4)});
+    R.curves.emplace_back(std::vector<V>{V(2, 1), V(3, 3), V(1, 3)});
+    const tspline::LayoutQuality Q(R);
+    tspline::LayoutMesh m = ring_mesh(R.curves[0], {V(0, 0), V(2, 0), V(4, 0), V(4, 4), V(0, 4)}, {},
+                                      {{1, 2, 5, 0}, {2, 3, 6, 5}, {3, 4, 7, 6}, {4, 0, 5, 7}});
+    for (std::size_t i = 0; i < 3; ++i) {  // nodes 5, 6, 7: the hole's vertices
+      m.x.push_back(R.curves[1].vertex(i));
+      m.ring.push_back(1);
+      m.arc.push_back(R.curves[1].arc(i));
+    }
+    REQUIRE(tspline::flat_ring_corners(m, Q) == std::vector<int>{1});
+    // 2 quads more from the corner's quad, one from each of the other three.
+    CHECK(tspline::insert_corner_sheets(m, R, {1}, 100) == 5);
+    REQUIRE(m.quads.size() == 9);
+    CHECK(m.size() == 13);  // v', the midpoints of X-a and b-X and of the two other radial edges
+    CHECK(std::count_if(m.ring.begin(), m.ring.end(), [](int r) { return r >= 0; }) == 8);
+    const tspline::LayoutTopology t(m);
+    CHECK(t.valence(1) == 2);
+    int ring_edges = 0;
+    double area = 0.0;
+    for (int q = 0; q < static_cast<int>(m.quads.size()); ++q) {
+      for (int j = 0; j < 4; ++j) {
+        ring_edges += t.on_ring(q, j) ? 1 : 0;
+        CHECK((t.on_ring(q, j) || t.across(q, j).first >= 0));  // conforming
+      }
+      const double a = quad_area(m, m.quads[q]);
+      CHECK(a > 0.0);
+      area += a;
+    }
+    CHECK(ring_edges == 8);  // 5 outer ring pieces, 3 of the hole
+    CHECK(area == doctest::Approx(14.0));  // 16 less the hole's 2
     CHECK(tspline::flat_ring_corners(m, Q).empty());
   }
 

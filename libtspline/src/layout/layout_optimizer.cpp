@@ -7,6 +7,7 @@
 #include <numbers>
 #include "tspline/boundary/plane.h"
 #include "tspline/layout/layout_energy.h"
+#include "layout_local.h"
 
 namespace tspline {
 namespace {
@@ -17,9 +18,9 @@ namespace {
 // angles jump; the nearest max_ring_vertices), a uniform grid, then a local
 // refinement. `best` is the energy where it stands on entry, the energy
 // where it ends on return.
-template <class Local>
+template <class Local, class Allowed>
 void slide_ring_node(LayoutMesh& m, const LayoutTopology& t, const LayoutQuality& Q, int n, const Local& local,
-                     const LayoutAdmissible& admissible, const LayoutOptimizationOptions& o, double& best) {
+                     const Allowed& allowed, const LayoutOptimizationOptions& o, double& best) {
   const std::size_t nn = static_cast<std::size_t>(n);
   const int r = m.ring[n];
   const RingCurve& c = Q.rings().curves[r];
@@ -30,9 +31,6 @@ void slide_ring_node(LayoutMesh& m, const LayoutTopology& t, const LayoutQuality
     if (t.on_ring(q, (j + 3) % 4)) back = Q.side_length(m, t, q, (j + 3) % 4);
   }
   if (!(back > 0.0 && ahead > 0.0)) return;
-  // A node whose cuts already cross a ring may move anywhere its energy falls
-  // (the check would otherwise pin it where it is wrong).
-  const bool was_admissible = admissible(m, t, n);
   const double s0 = m.arc[nn];
   const Eigen::Vector2d x0 = m.x[nn];
   // Candidates u in (-0.9 back, 0.9 ahead): the node at arc s0 + d u.
@@ -69,7 +67,7 @@ void slide_ring_node(LayoutMesh& m, const LayoutTopology& t, const LayoutQuality
     if (!(u > lo - 1e-12 && u < hi + 1e-12) || u == 0.0) continue;
     place(u);
     const double f = local(n, best);
-    if (f < best && (!was_admissible || admissible(m, t, n))) best = f, best_u = u;
+    if (f < best && allowed()) best = f, best_u = u;
   }
   // Local refinement around the best (the energy is smooth between vertices).
   double h = (hi - lo) / o.ring_samples;
@@ -78,7 +76,7 @@ void slide_ring_node(LayoutMesh& m, const LayoutTopology& t, const LayoutQuality
       if (!(u > lo && u < hi)) continue;
       place(u);
       const double f = local(n, best);
-      if (f < best && (!was_admissible || admissible(m, t, n))) best = f, best_u = u;
+      if (f < best && allowed()) best = f, best_u = u;
     }
   if (best_u == 0.0) m.arc[nn] = s0, m.x[nn] = x0;
   else place(best_u);
@@ -133,6 +131,19 @@ LayoutOptimizationReport optimize_layout_nodes(LayoutMesh& m, const LayoutQualit
     return w;
   };
   report.before = worst();
+  // Whether node n may stay where it was just moved: where the caller's check
+  // held before the move, it must hold after it (a node whose cuts already
+  // cross a ring may move anywhere its energy falls: the check would otherwise
+  // pin it where it is wrong); with keep_patch_corners_in_range, no more
+  // patch corners of its quads out of range than before.
+  auto move_check = [&](int n) {
+    const bool was_admissible = admissible(m, t, n);
+    const int rejected = o.keep_patch_corners_in_range ? layout_local::rejected_corners(m, t, Q, {n}) : 0;
+    return [&m, &t, &Q, &admissible, &o, n, was_admissible, rejected]() {
+      return (!was_admissible || admissible(m, t, n)) &&
+             (!o.keep_patch_corners_in_range || layout_local::rejected_corners(m, t, Q, {n}) <= rejected);
+    };
+  };
   // Untangling first: while corners are inverted, eps follows the worst of
   // them (Garanzha et al. 2021: eps above the most negative det keeps the
   // energy moderate, so that every corner can move), with the plain sum (p = 1);
@@ -219,8 +230,8 @@ LayoutOptimizationReport optimize_layout_nodes(LayoutMesh& m, const LayoutQualit
         return incremental ? moving_part(best_so_far) : local(v);
       };
       double best_v = incremental ? v0 : f0;
+      const auto allowed = move_check(n);
       if (m.ring[n] < 0) {
-        const bool was_admissible = admissible(m, t, n);
         // Inner node: pattern search, the best of eight directions per step.
         for (int it = 0; it < 4 && step[nn] > 0.0; ++it) {
           const Eigen::Vector2d start = m.x[nn];
@@ -228,14 +239,14 @@ LayoutOptimizationReport optimize_layout_nodes(LayoutMesh& m, const LayoutQualit
           for (int k = 0; k < 8; ++k) {
             m.x[nn] = start + step[nn] * kDirections[k];
             const double f = energy(n, best_v);
-            if (f < best_v && (!was_admissible || admissible(m, t, n))) best_v = f, best_x = m.x[nn];
+            if (f < best_v && allowed()) best_v = f, best_x = m.x[nn];
           }
           m.x[nn] = best_x;
           if (best_x == start) step[nn] *= 0.5;
           else step[nn] *= 1.5;
         }
       } else {
-        slide_ring_node(m, t, Q, n, energy, admissible, o, best_v);
+        slide_ring_node(m, t, Q, n, energy, allowed, o, best_v);
       }
       const double best = incremental ? f0 - (v0 - best_v) : best_v;
       if (best < f0) {

@@ -4,6 +4,7 @@
 #include <cstdlib>
 #include <array>
 #include <cmath>
+#include <optional>
 #include <utility>
 #include <vector>
 
@@ -131,24 +132,34 @@ namespace {
 // b-X and v' between v and X; from each of a' and b' the sheet runs on through
 // the quads across, each cut in two between the midpoints of the edge it enters
 // by and of the opposite edge, until it reaches a ring, where the midpoint (by
-// arc length) of the ring piece becomes a ring node of two quads.
+// arc length) of the ring piece becomes a ring node of two quads. A sheet
+// whose walk out through X-a comes back into the corner's quad through b-X is
+// closed: it cuts the quads of that loop and reaches no ring.
 class CornerSheet {
  public:
   CornerSheet(LayoutMesh& m, const LayoutRings& R) : m_(m), R_(R) {}
 
-  // The quads the sheet adds (0: none; m unchanged), or none where it would
-  // run through one quad twice in the same direction, or through the corner's
-  // quad again, or cut more than max_quads quads. A sheet that crosses itself
-  // (through a quad in both directions) cuts that quad in four.
-  std::size_t insert(int v, std::size_t max_quads) {
+  // The quads the sheet adds: 0 where v is the corner of more than one quad
+  // already (an earlier sheet ran through its quad; m unchanged), none where
+  // the sheet would run through one quad twice in the same direction, or
+  // through the corner's quad again other than as a closed loop, or cut more
+  // than max_quads quads (m unchanged). A sheet that crosses itself (through a quad in both
+  // directions) cuts that quad in four.
+  std::optional<std::size_t> insert(int v, std::size_t max_quads) {
     const LayoutTopology t(m_);
     if (t.valence(v) != 1) return 0;
     const auto [q, j] = t.corners_of(v).front();
     crossed_.assign(m_.quads.size(), 0);
     entry_.assign(m_.quads.size(), {0, 0});
     crossed_[q] = kCornerQuad;
-    for (const int exit : {(j + 2) % 4, (j + 1) % 4})
-      if (!walk(t, q, exit, max_quads)) return 0;
+    // Out through X-a first. A sheet that comes back into the corner's quad
+    // through b-X is a closed loop: the same path as the walk out through b-X.
+    switch (walk(t, q, (j + 2) % 4, (j + 1) % 4, max_quads)) {
+      case Walk::kFailed: return std::nullopt;
+      case Walk::kClosed: break;
+      case Walk::kToRing:
+        if (walk(t, q, (j + 1) % 4, -1, max_quads) != Walk::kToRing) return std::nullopt;
+    }
     const std::array<int, 4> Qv = m_.quads[q];
     const int b = Qv[(j + 1) % 4], X = Qv[(j + 2) % 4], a = Qv[(j + 3) % 4];
     const int ap = edge_node(t, q, (j + 2) % 4), bp = edge_node(t, q, (j + 1) % 4);
@@ -181,19 +192,23 @@ class CornerSheet {
  private:
   static constexpr char kCornerQuad = 4;
 
+  enum class Walk { kToRing, kClosed, kFailed };
+
   // From quad q out through its edge e, quad after quad across the opposite
-  // edges, to a ring.
-  bool walk(const LayoutTopology& t, int q, int e, std::size_t max_quads) {
+  // edges, to a ring; or back into the corner's quad through its edge
+  // `closing` (a closed sheet).
+  Walk walk(const LayoutTopology& t, int q, int e, int closing, std::size_t max_quads) {
     while (!t.on_ring(q, e)) {
       const auto [n, k] = t.across(q, e);
+      if (n >= 0 && crossed_[n] == kCornerQuad && k == closing) return Walk::kClosed;
       const char axis = static_cast<char>(1 << (k % 2));
-      if (n < 0 || (crossed_[n] & (axis | kCornerQuad)) || order_.size() + 2 > max_quads) return false;
+      if (n < 0 || (crossed_[n] & (axis | kCornerQuad)) || order_.size() + 2 > max_quads) return Walk::kFailed;
       if (!crossed_[n]) order_.push_back(n);
       crossed_[n] |= axis;
       entry_[n][k % 2] = k;
       q = n, e = (k + 2) % 4;
     }
-    return true;
+    return Walk::kToRing;
   }
 
   int add_node(const Eigen::Vector2d& x, int ring, double arc) {
@@ -244,9 +259,10 @@ std::size_t insert_corner_sheets(LayoutMesh& m, const LayoutRings& R, const std:
   LayoutMesh trial = m;
   std::size_t added = 0;
   for (const int v : corners) {
-    const std::size_t k = CornerSheet(trial, R).insert(v, max_quads - added);
-    added += k;
-    if (k == 0 || added > max_quads) return 0;  // (the walk counts a quad cut in four as one)
+    const std::optional<std::size_t> k = CornerSheet(trial, R).insert(v, max_quads - added);
+    if (!k) return 0;
+    added += *k;
+    if (added > max_quads) return 0;  // (the walk counts a quad cut in four as one)
   }
   m = std::move(trial);
   return added;

@@ -94,7 +94,8 @@ void report_optimization(const LayoutOptimizationReport& rep, QuadLayoutStats& s
 // `start` becomes the mesh the checks fall back to (the mesher's nodes, after
 // any pillowing).
 void optimize_layout(LayoutMesh& m, LayoutMesh& start, const LayoutRings& R, const LayoutQuality& Q,
-                     const LayoutAdmissible& admissible, int level, bool corner_sheets, QuadLayoutStats& st,
+                     const LayoutAdmissible& admissible, int level, bool corner_sheets, bool guard_corners,
+                     QuadLayoutStats& st,
                      const std::atomic<bool>* cancel) {
   st.rotations = 0;
   st.openings = 0;
@@ -104,6 +105,7 @@ void optimize_layout(LayoutMesh& m, LayoutMesh& start, const LayoutRings& R, con
   // Every sweep and rotation batch checks the cancel flag.
   LayoutOptimizationOptions full;
   full.cancel = cancel;
+  full.keep_patch_corners_in_range = guard_corners;
   LayoutRotationOptions rotation;
   rotation.cancel = cancel;
   auto rotate = [&]() {
@@ -253,6 +255,10 @@ class QuadLayoutBuilder {
   QuadLayout out_;
   int meshes_ = 0;  // made by the mesher (rounds that only add ring nodes make none)
   int level_ = 2;
+  // Node moves may not put patch corners out of range (LayoutOptimizationOptions::
+  // keep_patch_corners_in_range): from the first layout rejected for such a
+  // corner on (the guard also pins nodes where the energy would have them pass).
+  bool guard_corners_ = false;
   int repairs_ = 0;  // rounds that added nodes (dropping an optimization level is not one)
   std::vector<Eigen::Vector2d> repaired_at_;  // where a rejected layout got a ring node more
   std::vector<std::set<std::size_t>> to_split_;  // per ring: the pieces that get a node more this round
@@ -352,7 +358,8 @@ QuadLayout QuadLayoutBuilder::build() {
     note(mesh_name() + ": " + std::to_string(m.quads.size()) + " quads from the mesher; optimizing them" +
          (level_ == 2 ? "" : " without edge rotations"));
     const auto t_opt = std::chrono::steady_clock::now();
-    optimize_layout(m, start, R_, quality_, admissible_, level_, o_.corner_sheets, out_.stats, o_.cancel);
+    optimize_layout(m, start, R_, quality_, admissible_, level_, o_.corner_sheets, guard_corners_, out_.stats,
+                    o_.cancel);
     if (debugging())
       std::fprintf(stderr, "layout round %d: mesh %zu quads at %.2f s, optimized in %.2f s\n", round, m.quads.size(),
                    std::chrono::duration<double>(t_opt - t0_).count(), toolkit::seconds_since(t_opt));
@@ -619,7 +626,9 @@ void QuadLayoutBuilder::make_patch_layout(const LayoutMesh& m, const LayoutTopol
     }
 }
 
-// After make_patch_layout rejected this round's mesh (`what`): level 2 becomes
+// After make_patch_layout rejected this round's mesh (`what`): the first
+// patch corner out of range makes the node moves keep corners in range from
+// then on (the same mesh again, guard_corners_); after that level 2 becomes
 // level 1 (the same mesh without edge rotations: the optimization left a
 // corner flat or reflex, or cuts crossing near rings much closer than the
 // patch size). Else ring nodes more near the place named, and a new mesh
@@ -629,6 +638,11 @@ void QuadLayoutBuilder::make_patch_layout(const LayoutMesh& m, const LayoutTopol
 // \throw NumericalError when level 0 fails too.
 void QuadLayoutBuilder::recover_from_rejected_layout(const std::string& what) {
   if (debugging()) std::fprintf(stderr, "layout rejected at level %d: %s\n", level_, what.c_str());
+  if (level_ == 2 && !guard_corners_ && what.find("patch corner") != std::string::npos) {
+    note(mesh_name() + ": " + what + "; the same mesh, no node move allowed to put a patch corner out of range");
+    guard_corners_ = true;
+    return;
+  }
   if (level_ == 2) {
     note(mesh_name() + ": " + what + "; the same mesh without edge rotations");
     out_.stats.optimization_level = level_ = 1;

@@ -37,6 +37,11 @@ struct LayoutOptimizationOptions {
   int stall_sweeps = 8;
   int ring_samples = 24;  ///< uniform samples of a ring node's reach (plus its vertices, at most max_ring_vertices)
   int max_ring_vertices = 160;
+  /// A move may not put more patch corners of the node's quads out of range
+  /// at the nodes themselves (patch_corner_in_range, the final layout's check)
+  /// than were before it: the energy sees the corners at larger scales, where
+  /// a cut leaving a ring node nearly along the ring's first edge looks fine.
+  bool keep_patch_corners_in_range = false;
   /// Checked before every sweep: once set (by another thread), LayoutCancelled is thrown.
   const std::atomic<bool>* cancel = nullptr;
 };
