@@ -259,6 +259,7 @@ class QuadLayoutBuilder {
   // keep_patch_corners_in_range): from the first layout rejected for such a
   // corner on (the guard also pins nodes where the energy would have them pass).
   bool guard_corners_ = false;
+  std::vector<Eigen::Vector2d> level2_failed_at_;  // where a layout optimized in full was rejected
   int repairs_ = 0;  // rounds that added nodes (dropping an optimization level is not one)
   std::vector<Eigen::Vector2d> repaired_at_;  // where a rejected layout got a ring node more
   std::vector<std::set<std::size_t>> to_split_;  // per ring: the pieces that get a node more this round
@@ -631,32 +632,39 @@ void QuadLayoutBuilder::make_patch_layout(const LayoutMesh& m, const LayoutTopol
 // then on (the same mesh again, guard_corners_); after that level 2 becomes
 // level 1 (the same mesh without edge rotations: the optimization left a
 // corner flat or reflex, or cuts crossing near rings much closer than the
-// patch size). Else ring nodes more near the place named, and a new mesh
+// patch size), except at a place where level 2 failed before. Else ring nodes more near the place named, and a new mesh
 // optimized in full; once the repairs are used up, or a node more at the
 // same place did not mend it, the mesher's own nodes (level 0) are the last
 // try (its cuts may cross where the true rings are far from their chords).
 // \throw NumericalError when level 0 fails too.
 void QuadLayoutBuilder::recover_from_rejected_layout(const std::string& what) {
   if (debugging()) std::fprintf(stderr, "layout rejected at level %d: %s\n", level_, what.c_str());
-  if (level_ == 2 && !guard_corners_ && what.find("patch corner") != std::string::npos) {
-    note(mesh_name() + ": " + what + "; the same mesh, no node move allowed to put a patch corner out of range");
-    guard_corners_ = true;
-    return;
-  }
-  if (level_ == 2) {
-    note(mesh_name() + ": " + what + "; the same mesh without edge rotations");
-    out_.stats.optimization_level = level_ = 1;
-    return;
-  }
   const std::size_t at = what.find("near (");
   Eigen::Vector2d place(0.0, 0.0);
-  bool again = false;  // this place failed a repair before: a node more there did not mend it
+  bool again = false;      // this place failed a repair before: a node more there did not mend it
+  bool level2_again = false;  // a layout optimized in full failed here before
   if (at != std::string::npos) {
     char* end = nullptr;
     place.x() = std::strtod(what.c_str() + at + 6, &end);
     place.y() = end && *end == ',' ? std::strtod(end + 1, nullptr) : 0.0;
     const double same = std::max(1e-6 * diam_, 2e-6);  // (the message gives 6 decimals)
     for (const Eigen::Vector2d& p : repaired_at_) again = again || (p - place).norm() <= same;
+    for (const Eigen::Vector2d& p : level2_failed_at_) level2_again = level2_again || (p - place).norm() <= same;
+  }
+  if (level_ == 2 && !guard_corners_ && what.find("patch corner") != std::string::npos) {
+    note(mesh_name() + ": " + what + "; the same mesh, no node move allowed to put a patch corner out of range");
+    guard_corners_ = true;
+    if (at != std::string::npos) level2_failed_at_.push_back(place);
+    return;
+  }
+  // A place where a layout optimized in full failed before gets a ring node
+  // more (below); elsewhere level 2 first becomes level 1, which would fail
+  // elsewhere and come back to level 2 and this place with its next repair.
+  if (level_ == 2 && !(level2_again && !again && repairs_ < o_.max_repair_rounds)) {
+    if (at != std::string::npos) level2_failed_at_.push_back(place);
+    note(mesh_name() + ": " + what + "; the same mesh without edge rotations");
+    out_.stats.optimization_level = level_ = 1;
+    return;
   }
   if (at != std::string::npos && repairs_ < o_.max_repair_rounds && !again) {
     repaired_at_.push_back(place);
