@@ -143,8 +143,8 @@ class CornerSheet {
   // already (an earlier sheet ran through its quad; m unchanged), none where
   // the sheet would run through one quad twice in the same direction, or
   // through the corner's quad again other than as a closed loop, or cut more
-  // than max_quads quads (m unchanged). A sheet that crosses itself (through a quad in both
-  // directions) cuts that quad in four.
+  // than max_quads quads (m unchanged). A sheet that crosses itself (through
+  // a quad in both directions) cuts that quad in four.
   std::optional<std::size_t> insert(int v, std::size_t max_quads) {
     const LayoutTopology t(m_);
     if (t.valence(v) != 1) return 0;

@@ -632,8 +632,8 @@ void QuadLayoutBuilder::make_patch_layout(const LayoutMesh& m, const LayoutTopol
 // then on (the same mesh again, guard_corners_); after that level 2 becomes
 // level 1 (the same mesh without edge rotations: the optimization left a
 // corner flat or reflex, or cuts crossing near rings much closer than the
-// patch size), except at a place where level 2 failed before. Else ring nodes more near the place named, and a new mesh
-// optimized in full; once the repairs are used up, or a node more at the
+// patch size), except at a place where level 2 failed before. Else ring
+// nodes more near the place named, and a new mesh optimized in full; once the repairs are used up, or a node more at the
 // same place did not mend it, the mesher's own nodes (level 0) are the last
 // try (its cuts may cross where the true rings are far from their chords).
 // \throw NumericalError when level 0 fails too.

@@ -66,13 +66,13 @@ std::vector<int> flat_ring_corners(const LayoutMesh& m, const LayoutQuality& qua
 /// it, and from there the sheet runs through the quads on both sides, each cut
 /// in two, until it meets a ring, where a new ring node halves the ring piece,
 /// or until it comes back into the corner's quad from the other side (a closed
-/// sheet). A quad the sheet crosses in both directions is cut in four. New nodes start
-/// at midpoints (the layout optimizer moves them). All or nothing: returns the
-/// quads added, or 0 with `m` unchanged where a sheet would run through a quad
-/// twice in one direction or back into its corner's quad other than as a
-/// closed sheet, or where the sheets
-/// would add more than max_quads quads. A corner that an earlier sheet has
-/// already given a second quad needs no sheet of its own and is skipped.
+/// sheet). A quad the sheet crosses in both directions is cut in four. New
+/// nodes start at midpoints (the layout optimizer moves them). All or nothing:
+/// returns the quads added, or 0 with `m` unchanged where a sheet would run
+/// through a quad twice in one direction or back into its corner's quad other
+/// than as a closed sheet, or where the sheets would add more than max_quads
+/// quads. A corner that an earlier sheet has already given a second quad
+/// needs no sheet of its own and is skipped.
 std::size_t insert_corner_sheets(LayoutMesh& m, const LayoutRings& rings, const std::vector<int>& corners,
                                  std::size_t max_quads);
 
