@@ -641,15 +641,19 @@ void QuadLayoutBuilder::recover_from_rejected_layout(const std::string& what) {
   if (debugging()) std::fprintf(stderr, "layout rejected at level %d: %s\n", level_, what.c_str());
   const std::size_t at = what.find("near (");
   Eigen::Vector2d place(0.0, 0.0);
-  bool again = false;      // this place failed a repair before: a node more there did not mend it
+  bool again = false;         // this place failed a repair before: a node more there did not mend it
   bool level2_again = false;  // a layout optimized in full failed here before
   if (at != std::string::npos) {
     char* end = nullptr;
     place.x() = std::strtod(what.c_str() + at + 6, &end);
     place.y() = end && *end == ',' ? std::strtod(end + 1, nullptr) : 0.0;
     const double same = std::max(1e-6 * diam_, 2e-6);  // (the message gives 6 decimals)
-    for (const Eigen::Vector2d& p : repaired_at_) again = again || (p - place).norm() <= same;
-    for (const Eigen::Vector2d& p : level2_failed_at_) level2_again = level2_again || (p - place).norm() <= same;
+    const auto near_one_of = [&](const std::vector<Eigen::Vector2d>& places) {
+      return std::any_of(places.begin(), places.end(),
+                         [&](const Eigen::Vector2d& p) { return (p - place).norm() <= same; });
+    };
+    again = near_one_of(repaired_at_);
+    level2_again = near_one_of(level2_failed_at_);
   }
   if (level_ == 2 && !guard_corners_ && what.find("patch corner") != std::string::npos) {
     note(mesh_name() + ": " + what + "; the same mesh, no node move allowed to put a patch corner out of range");
