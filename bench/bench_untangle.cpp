@@ -12,7 +12,9 @@
 // is frozen, all corner trials), instead of the fit of the front half alone.
 // UNTANGLE_OPTIMIZER=newton|lbfgs selects the optimizer (default: the library's, L-BFGS).
 // UNTANGLE_THREADS=N: threads of the energy (default: all cores).
-// UNTANGLE_NEWTON_SOLVER=cholesky|cg|auto, UNTANGLE_NEWTON_MIN_DECREASE=S: Newton's linear solve and eps rule.
+// UNTANGLE_NEWTON_SOLVER=cholesky|cg|auto, UNTANGLE_NEWTON_MIN_DECREASE=S,
+// UNTANGLE_NEWTON_STALLED_MIN_DECREASE=S: Newton's linear solve and eps rule;
+// UNTANGLE_NEWTON_AFTER_STALLED_STAGES=K: L-BFGS hands over to Newton after K stalled stages (0: never).
 // UNTANGLE_SOLVE_TEST=EPS: the projected Hessian at the starting map (eps 0.2 |min det J| if folded,
 // else EPS) solved by CHOLMOD and by CG with diagonal and incomplete-Cholesky preconditioners
 // to relative residuals 1e-1, 1e-2, 1e-4 (time, iterations, distance to the exact step), and exits.
@@ -104,6 +106,9 @@ int main(int argc, char** argv) {
                          : std::strcmp(v, "cholesky") == 0 ? tspline::NewtonSolver::Cholesky
                                                            : tspline::NewtonSolver::Auto;
   if (const char* v = std::getenv("UNTANGLE_NEWTON_MIN_DECREASE")) uopt.newton_min_decrease = std::atof(v);
+  if (const char* v = std::getenv("UNTANGLE_NEWTON_AFTER_STALLED_STAGES")) uopt.newton_after_stalled_stages = std::atoi(v);
+  if (const char* v = std::getenv("UNTANGLE_NEWTON_STALLED_MIN_DECREASE"))
+    uopt.newton_stalled_min_decrease = std::atof(v);
   if (const char* v = std::getenv("UNTANGLE_THREADS")) uopt.energy.threads = std::atoi(v);
   if (const char* v = std::getenv("UNTANGLE_OPTIMIZER"))
     uopt.optimizer = std::strcmp(v, "newton") == 0  ? tspline::MapOptimizer::Newton
@@ -199,6 +204,7 @@ int main(int argc, char** argv) {
               r.local_repairs_certified, r.local_repair_iterations, r.local_repair_seconds);
   rusage ru{};
   getrusage(RUSAGE_SELF, &ru);
+  if (r.newton_from_stage >= 0) std::printf("L-BFGS stalled: Newton from stage %d\n", r.newton_from_stage);
   std::printf("%s: hessians %d (%.2f s), shifted %d, solves %.2f s (CG iterations %d), certified trial steps %d; CPU %.2f s; peak RSS %.0f MiB; mean Jr %.4f\n",
               uopt.optimizer == tspline::MapOptimizer::Newton ? "newton"
               : uopt.optimizer == tspline::MapOptimizer::CeresLBFGS ? "ceres"

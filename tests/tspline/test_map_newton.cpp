@@ -11,8 +11,10 @@
 
 #include <Eigen/Dense>
 
+#include <algorithm>
 #include <cmath>
 #include <random>
+#include <vector>
 
 #include "separable_maps.h"
 #include "perturbed_map.h"
@@ -284,6 +286,41 @@ TEST_SUITE("map_newton") {
         if (k == 1) CHECK(r.factorizations == 0);
       }
       CHECK(iters[0] < iters[1]);
+    }
+  }
+
+  TEST_CASE("L-BFGS hands over to Newton where the folded samples stall, and only there") {
+    // A map with a third of its samples folded and one L-BFGS iteration per
+    // stage: the second stage unfolds 1 % of them (962 -> 952), so with a
+    // window of one stage Newton takes over (and unfolds the rest in a stage).
+    for (const int window : {0, 1}) {
+      TSplineMap map = perturbed(1, 0.45);
+      tspline::MapUntanglingOptions uo;
+      uo.optimizer = tspline::MapOptimizer::LBFGS;
+      uo.max_iterations_per_stage = 1;
+      uo.newton_after_stalled_stages = window;
+      std::vector<tspline::UntanglingProgress> stages;
+      uo.progress = [&](const tspline::UntanglingProgress& p) { stages.push_back(p); };
+      const tspline::MapUntanglingReport r = tspline::untangle_map(map, uo);
+      CAPTURE(window);
+      CHECK(r.certified);
+      if (window == 0) {
+        CHECK(r.newton_from_stage == -1);
+        CHECK(r.factorizations == 0);
+        continue;
+      }
+      // The first stage whose folded count is above 9/10 of the stage before's.
+      int expected = -1;
+      for (std::size_t k = 1; k < stages.size() && expected < 0; ++k)
+        if (stages[k].samples.nonpositive > 0 &&
+            10 * stages[k].samples.nonpositive > 9 * stages[k - 1].samples.nonpositive)
+          expected = static_cast<int>(k) + 1;
+      REQUIRE(expected > 0);  // the one-iteration stages do stall
+      CHECK(r.newton_from_stage == expected);
+      CHECK(r.factorizations > 0);  // Newton ran the stages after it
+      // The stage after the handover starts Newton's continuation over: eps = 0.2 |D_min|.
+      const tspline::UntanglingProgress& last_lbfgs = stages[expected - 1];
+      CHECK(stages[expected].eps == doctest::Approx(std::clamp(0.2 * std::abs(last_lbfgs.samples.min_det), 1e-3, 1.0)));
     }
   }
 

@@ -313,6 +313,7 @@ class AdaptiveRun {
       s << "untangling: " << u.free_points << " free control points, " << u.elements << " elements, " << u.stages
         << " stages, " << u.iterations << " optimizer iterations, samples with det J <= 0 " << u.before.nonpositive
         << " -> " << u.after.nonpositive;
+      if (u.newton_from_stage >= 0) s << ", Newton from stage " << u.newton_from_stage << " (L-BFGS stalled)";
       if (u.local_repairs > 0)
         s << ", " << u.local_repairs << " local repairs of folds between samples (" << u.local_repairs_certified
           << " certified the map)";

@@ -77,6 +77,12 @@ void validate_options(const AdaptiveOptions& ad) {
     fail("`untangling.max_newton_iterations_per_stage` must be >= 1 and `untangling.newton_stage_tolerance` >= 0");
   if (!(u.newton_min_decrease > 0.0 && u.newton_min_decrease < 1.0))
     fail("`untangling.newton_min_decrease` must be in (0, 1), got " + str(u.newton_min_decrease));
+  if (!(u.newton_stalled_min_decrease > 0.0 && u.newton_stalled_min_decrease < 1.0))
+    fail("`untangling.newton_stalled_min_decrease` must be in (0, 1), got " + str(u.newton_stalled_min_decrease));
+  if (u.newton_after_stalled_stages < 0)
+    fail("`untangling.newton_after_stalled_stages` must be >= 0, got " + std::to_string(u.newton_after_stalled_stages));
+  if (!(u.newton_fast_folded_fraction > 0.0 && u.newton_fast_folded_fraction < 1.0))
+    fail("`untangling.newton_fast_folded_fraction` must be in (0, 1), got " + str(u.newton_fast_folded_fraction));
   if (u.max_cg_iterations < 1 || u.newton_cholesky_below < 0)
     fail("`untangling.max_cg_iterations` must be >= 1 and `untangling.newton_cholesky_below` >= 0");
 }

@@ -9,6 +9,7 @@
 #include <Eigen/IterativeLinearSolvers>
 
 #include "tspline/detail/lbfgs.h"
+#include "tspline/validity/eps_rule.h"
 
 #include <algorithm>
 #include <chrono>
@@ -16,6 +17,7 @@
 #include <limits>
 #include <optional>
 #include <stdexcept>
+#include <vector>
 #include "toolkit/errors.h"
 #include "toolkit/timing.h"
 
@@ -205,8 +207,12 @@ MapUntanglingReport untangle_map(TSplineMap& map, const MapUntanglingOptions& op
     throw toolkit::InputError("untangle_map: eps_floor and energy_tolerance must be > 0");
   if (opt.max_newton_iterations_per_stage < 1 || !(opt.newton_stage_tolerance >= 0.0))
     throw toolkit::InputError("untangle_map: max_newton_iterations_per_stage must be >= 1 and newton_stage_tolerance >= 0");
-  if (!(opt.min_decrease > 0.0 && opt.min_decrease < 1.0) || !(opt.newton_min_decrease > 0.0 && opt.newton_min_decrease < 1.0))
-    throw toolkit::InputError("untangle_map: min_decrease and newton_min_decrease must be in (0, 1)");
+  for (const double s : {opt.min_decrease, opt.newton_min_decrease, opt.newton_stalled_min_decrease,
+                         opt.newton_fast_folded_fraction})
+    if (!(s > 0.0 && s < 1.0))
+      throw toolkit::InputError("untangle_map: min_decrease, newton_min_decrease, newton_stalled_min_decrease and newton_fast_folded_fraction must be in (0, 1)");
+  if (opt.newton_after_stalled_stages < 0)
+    throw toolkit::InputError("untangle_map: newton_after_stalled_stages must be >= 0");
   if (opt.max_cg_iterations < 1 || opt.newton_cholesky_below < 0)
     throw toolkit::InputError("untangle_map: max_cg_iterations must be >= 1 and newton_cholesky_below >= 0");
   const auto t0 = std::chrono::steady_clock::now();
@@ -265,6 +271,10 @@ MapUntanglingReport untangle_map(TSplineMap& map, const MapUntanglingOptions& op
   detail::Lbfgs lbfgs;
   double lbfgs_eps = -1.0, lbfgs_power = 0.0;  // of its last stage
   auto certified_valid = [&](const Eigen::VectorXd& v) { return certify(v).certified_valid(); };
+  // The optimizer of the coming stages: L-BFGS hands over to Newton where it
+  // stalls (newton_after_stalled_stages).
+  MapOptimizer optimizer = opt.optimizer;
+  std::vector<std::size_t> folded_after_stage;  // samples with det J <= 0 after each L-BFGS stage
   for (int stage = 0; stage < opt.max_stages; ++stage) {
     const bool new_samples = resampled;
     if (resampled) {
@@ -280,12 +290,13 @@ MapUntanglingReport untangle_map(TSplineMap& map, const MapUntanglingOptions& op
     const bool barrier = eps <= opt.eps_floor;
     // The quality phase (barrier) raises each term to quality_power.
     const double power = barrier ? opt.quality_power : 1.0;
-    const double E_prev = energy.evaluate(x.data(), eps, nullptr, nullptr, power);
+    std::size_t folded_before = 0;  // samples with det J <= 0 at the stage's start
+    const double E_prev = energy.evaluate(x.data(), eps, nullptr, &folded_before, power);
     double E_stage = std::numeric_limits<double>::quiet_NaN();  // E at the stage's end, if the minimizer knows it
-    if (opt.optimizer == MapOptimizer::Newton) {
+    if (optimizer == MapOptimizer::Newton) {
       newton.run(x, eps, power, opt.max_newton_iterations_per_stage, opt.newton_stage_tolerance, barrier, x_certified,
                  certified_valid, rep);
-    } else if (opt.optimizer == MapOptimizer::LBFGS) {
+    } else if (optimizer == MapOptimizer::LBFGS) {
       // The curvature pairs carry over from the last stage unless the energy
       // changed more than by a lower eps: new samples, another power, eps raised.
       if (new_samples || power != lbfgs_power || eps > lbfgs_eps) lbfgs.reset();
@@ -385,10 +396,20 @@ MapUntanglingReport untangle_map(TSplineMap& map, const MapUntanglingOptions& op
     }
     // eps update (Garanzha et al. 2021): a fresh sample set restarts nothing,
     // the rule only looks at this stage's progress and the smallest det J.
-    const double min_decrease = opt.optimizer == MapOptimizer::Newton ? opt.newton_min_decrease : opt.min_decrease;
-    const double sigma = std::max(1.0 - E / E_prev, min_decrease);
-    const double mu = (1.0 - sigma) * regularized_det(st.min_det, eps);
-    eps = st.min_det < mu ? std::max(opt.eps_floor, 2.0 * std::sqrt(mu * (mu - st.min_det))) : opt.eps_floor;
+    if (optimizer == MapOptimizer::LBFGS && opt.newton_after_stalled_stages > 0 && st.nonpositive > 0) {
+      // The folded samples fell by less than a tenth over the last
+      // newton_after_stalled_stages stages: Newton from here, its
+      // continuation started over from eps = 0.2 |D_min| as at the start.
+      folded_after_stage.push_back(st.nonpositive);
+      const std::size_t k = folded_after_stage.size(), K = opt.newton_after_stalled_stages;
+      if (k > K && 10 * st.nonpositive > 9 * folded_after_stage[k - 1 - K]) {
+        optimizer = MapOptimizer::Newton;
+        rep.newton_from_stage = stage + 1;
+        eps = std::clamp(0.2 * std::abs(st.min_det), 1e-3, 1.0);
+        continue;
+      }
+    }
+    eps = detail::next_eps({eps, E_prev, E, folded_before, st, optimizer}, opt);
   }
 
   if (best) {
