@@ -17,8 +17,9 @@ double next_eps(const EpsStage& stage, const MapUntanglingOptions& opt) {
     // of eps there left hokkaido at level 8 with 140,000 folded samples that
     // no later stage unfolded (bench/README.md, "hokkaido at level 8").
     const auto n = static_cast<double>(stage.after.nonpositive);
-    const bool unfolding_fast = 2 * stage.after.nonpositive <= stage.folded_before &&
-                                n <= opt.newton_fast_folded_fraction * static_cast<double>(stage.after.points);
+    const bool unfolding_fast =
+        2 * stage.after.nonpositive <= stage.folded_before &&
+        n <= opt.newton_fast_folded_fraction * static_cast<double>(stage.after.points);
     floor = unfolding_fast ? opt.newton_min_decrease : opt.newton_stalled_min_decrease;
   }
   const double sigma = std::max(1.0 - stage.energy_after / stage.energy_before, floor);

@@ -12,11 +12,11 @@ namespace tspline::detail {
 
 /// What the rule sees of a finished stage.
 struct EpsStage {
-  double eps = 1.0;                ///< the stage's eps
-  double energy_before = 0.0;      ///< E_eps at the stage's start
-  double energy_after = 0.0;       ///< E_eps at its end
-  std::size_t folded_before = 0;   ///< samples with det J <= 0 at its start
-  SampleStats after;               ///< the samples at its end
+  double eps = 1.0;                              ///< the stage's eps
+  double energy_before = 0.0;                    ///< E_eps at the stage's start
+  double energy_after = 0.0;                     ///< E_eps at its end
+  std::size_t folded_before = 0;                 ///< samples with det J <= 0 at its start
+  SampleStats after;                             ///< the samples at its end
   MapOptimizer optimizer = MapOptimizer::LBFGS;  ///< the stage's optimizer
 };
 
