@@ -37,9 +37,9 @@ NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(QualityBoundOptions, relative_gap, absolute_g
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(SampleStats, points, nonpositive, min_det, min_mean_ratio, mean_mean_ratio)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(MapUntanglingReport, free_points, fixed_points, elements, samples, stages, iterations,
                                    evaluations, factorizations, shifted_factorizations, line_search_certifications,
-                                   hessian_seconds, solve_seconds, cg_iterations, newton_from_stage, sample_refinements, local_repairs,
-                                   local_repairs_certified, local_repair_iterations, local_repair_seconds, before,
-                                   after, certified, stop_reason, seconds)
+                                   hessian_seconds, solve_seconds, cg_iterations, newton_from_stage, sample_refinements,
+                                   local_repairs, local_repairs_certified, local_repair_iterations, local_repair_seconds,
+                                   before, after, certified, stop_reason, seconds)
 
 }  // namespace tspline
 

@@ -197,6 +197,12 @@ MapUntanglingOptions local_repair_options(const TSplineMap& map, const MapEnergy
   return lo;
 }
 
+// The first eps of a continuation from a map with folds, D_min < 0 its
+// smallest normalized sample det J. Garanzha et al. start from eps = 1 (det J
+// is normalized to 1 on average) and their code from 0.2 |D_min|; the smaller
+// of the two keeps a map with a few shallow folds close to where it is.
+double starting_eps(double min_det) { return std::clamp(0.2 * std::abs(min_det), 1e-3, 1.0); }
+
 }  // namespace
 
 MapUntanglingReport untangle_map(TSplineMap& map, const MapUntanglingOptions& opt,
@@ -210,7 +216,9 @@ MapUntanglingReport untangle_map(TSplineMap& map, const MapUntanglingOptions& op
   for (const double s : {opt.min_decrease, opt.newton_min_decrease, opt.newton_stalled_min_decrease,
                          opt.newton_fast_folded_fraction})
     if (!(s > 0.0 && s < 1.0))
-      throw toolkit::InputError("untangle_map: min_decrease, newton_min_decrease, newton_stalled_min_decrease and newton_fast_folded_fraction must be in (0, 1)");
+      throw toolkit::InputError(
+          "untangle_map: min_decrease, newton_min_decrease, newton_stalled_min_decrease and "
+          "newton_fast_folded_fraction must be in (0, 1)");
   if (opt.newton_after_stalled_stages < 0)
     throw toolkit::InputError("untangle_map: newton_after_stalled_stages must be >= 0");
   if (opt.max_cg_iterations < 1 || opt.newton_cholesky_below < 0)
@@ -248,10 +256,7 @@ MapUntanglingReport untangle_map(TSplineMap& map, const MapUntanglingOptions& op
   }
 
   // A map valid at every sample starts at the floor (quality phase only).
-  // Garanzha et al. start from eps = 1 (det J is normalized to 1 on average)
-  // and their code from 0.2 |D_min|; the smaller of the two keeps a map with
-  // a few shallow folds close to where it is.
-  double eps = rep.before.nonpositive > 0 ? std::clamp(0.2 * std::abs(rep.before.min_det), 1e-3, 1.0) : opt.eps_floor;
+  double eps = rep.before.nonpositive > 0 ? starting_eps(rep.before.min_det) : opt.eps_floor;
   ceres::GradientProblemSolver::Options so;
   so.line_search_direction_type = ceres::LBFGS;
   so.logging_type = ceres::SILENT;
@@ -274,7 +279,7 @@ MapUntanglingReport untangle_map(TSplineMap& map, const MapUntanglingOptions& op
   // The optimizer of the coming stages: L-BFGS hands over to Newton where it
   // stalls (newton_after_stalled_stages).
   MapOptimizer optimizer = opt.optimizer;
-  std::vector<std::size_t> folded_after_stage;  // samples with det J <= 0 after each L-BFGS stage
+  std::vector<std::size_t> folded_after_stage;  // samples with det J <= 0 after each L-BFGS stage that left some
   for (int stage = 0; stage < opt.max_stages; ++stage) {
     const bool new_samples = resampled;
     if (resampled) {
@@ -398,14 +403,14 @@ MapUntanglingReport untangle_map(TSplineMap& map, const MapUntanglingOptions& op
     // the rule only looks at this stage's progress and the smallest det J.
     if (optimizer == MapOptimizer::LBFGS && opt.newton_after_stalled_stages > 0 && st.nonpositive > 0) {
       // The folded samples fell by less than a tenth over the last
-      // newton_after_stalled_stages stages: Newton from here, its
-      // continuation started over from eps = 0.2 |D_min| as at the start.
+      // newton_after_stalled_stages stages that ended with folds: Newton from
+      // here, its continuation started over as at the start.
       folded_after_stage.push_back(st.nonpositive);
       const std::size_t k = folded_after_stage.size(), K = opt.newton_after_stalled_stages;
       if (k > K && 10 * st.nonpositive > 9 * folded_after_stage[k - 1 - K]) {
         optimizer = MapOptimizer::Newton;
         rep.newton_from_stage = stage + 1;
-        eps = std::clamp(0.2 * std::abs(st.min_det), 1e-3, 1.0);
+        eps = starting_eps(st.min_det);
         continue;
       }
     }
