@@ -2,7 +2,8 @@
 // optimization) on one domain at one resolution. Prints one table row:
 //   cells vertices boundary_s tmesh_s coons_s optimization_s sweeps(all stages) peak_MiB inverted
 // Usage: bench_front POLYGON INIT_LEVEL TOL_REL [MAX_SWEEPS [CORNER_TRIALS]]
-// ("boundary" includes the automatic corner trials).
+// ("boundary" includes the automatic corner trials). On stderr: the corner
+// trials and the nested stages (FrontResult::stages).
 // Run one size per process so the peak memory (getrusage) belongs to that size.
 #include <sys/resource.h>
 
@@ -31,6 +32,19 @@ int main(int argc, char** argv) {
     if (s.stage == "tmesh") t[1] = s.seconds;
     if (s.stage == "coons") t[2] = s.seconds;
     if (s.stage == "optimization") t[3] = s.seconds;
+  }
+  // On stderr: each corner trial's figures, and where each nested stage
+  // started (carried over or Coons) with its inverted cells.
+  for (const auto& c : r.corner_trials)
+    std::fprintf(stderr, "corner trial %zu,%zu,%zu,%zu: %zu inverted cells, min/mean quality %.4g / %.4g\n",
+                 c.corners[0], c.corners[1], c.corners[2], c.corners[3], c.inverted_cells, c.min_mean_ratio,
+                 c.mean_mean_ratio);
+  for (std::size_t k = 0; k < r.stages.size(); ++k) {
+    const tspline::FrontStage& s = r.stages[k];
+    std::fprintf(stderr, "stage %zu: %zu cells, from %s with %zu inverted cells", k + 1, s.cells,
+                 s.carried ? "the previous stage" : "Coons", s.start_inverted);
+    if (s.other_start_inverted) std::fprintf(stderr, " (the other start %zu)", *s.other_start_inverted);
+    std::fprintf(stderr, ", %zu at the end, %d sweeps\n", s.end_inverted, s.sweeps);
   }
   rusage ru{};
   getrusage(RUSAGE_SELF, &ru);

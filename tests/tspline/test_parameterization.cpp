@@ -113,3 +113,44 @@ TEST_SUITE("parameterization") {
     CHECK(best_corner_trial({{c, std::numeric_limits<std::size_t>::max(), kWorst, kWorst}, {c, 40, 0.0, 0.1}}) == 1);
   }
 }
+
+TEST_SUITE("parameterization") {
+  TEST_CASE("each nested stage starts from the carried-over positions or Coons, whichever has fewer inverted cells") {
+    // Hokkaido at level 6 with a fine tolerance: stages end at their sweep
+    // cap with a few inverted cells, and the Coons start of the next has
+    // several times more. Restarting each such stage from Coons left 430
+    // inverted cells after the repair rounds; the better start leaves none.
+    const auto poly =
+        tspline::io::read_polygon(std::string(TSPLINE_TEST_DATA_DIR) + "/coastlines/hokkaido.txt");
+    tspline::ParameterizationOptions opt;
+    opt.initial_level = 6;
+    opt.tolerance_relative = 1e-7;
+    const tspline::FrontResult r = tspline::run_front(poly, opt);
+    REQUIRE(r.stages.size() >= 3);
+    CHECK_FALSE(r.stages.front().carried);
+    CHECK_FALSE(r.stages.front().other_start_inverted.has_value());
+    bool carried_with_folds = false;  // a stage that ended with inverted cells, carried over all the same
+    for (std::size_t k = 1; k < r.stages.size(); ++k) {
+      const tspline::FrontStage& s = r.stages[k];
+      const tspline::FrontStage& prev = r.stages[k - 1];
+      CAPTURE(k);
+      MESSAGE("stage " << k + 1 << ": " << s.cells << " cells, from " << std::string(s.carried ? "carried" : "Coons") << " with "
+                       << s.start_inverted << " inverted (the other "
+                       << (s.other_start_inverted ? std::to_string(*s.other_start_inverted) : "-") << "), "
+                       << s.end_inverted << " at the end, " << s.sweeps << " sweeps");
+      CHECK(s.cells >= prev.cells);
+      if (prev.end_inverted == 0) {
+        // An untangled stage is carried over without counting Coons' folds.
+        CHECK(s.carried);
+        CHECK_FALSE(s.other_start_inverted.has_value());
+      } else {
+        REQUIRE(s.other_start_inverted.has_value());
+        CHECK(s.start_inverted <= *s.other_start_inverted);
+        if (s.carried && s.start_inverted > 0) carried_with_folds = true;
+      }
+    }
+    CHECK(carried_with_folds);
+    // After the repair rounds (the last stage may end with a few).
+    CHECK(r.quality_optimized.inverted_cells == 0);
+  }
+}

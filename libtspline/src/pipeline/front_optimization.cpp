@@ -171,17 +171,48 @@ void FrontOptimizer::run_nested_stages() {
       r_.refinement = rep;
       report_final_tmesh(rep);
     }
-    // Carry the previous stage over only if it was untangled: a coarse stage
-    // can be impossible to untangle (its boundary too coarse for a thin part of
-    // the domain), and then the Coons start of the finer mesh is the better start.
-    const bool carry = k > 0 && r_.quality_optimized.inverted_cells == 0;
-    if (carry)
-      r_.optimized = transfer_positions(coarse, r_.optimized, r_.mesh, r_.boundary);
-    else
-      r_.optimized = last ? r_.coons : coons_positions(r_.mesh, r_.boundary);
+    // The start of this stage: the previous stage carried over, or the Coons
+    // positions of this mesh, whichever has fewer inverted cells (the carried
+    // ones on a tie). A coarse stage can be impossible to untangle (its
+    // boundary too coarse for a thin part of the domain): Coons is then the
+    // better start. But a stage that ends at its sweep cap with a few inverted
+    // cells is a far better start than Coons, whose folds the finer stages
+    // often cannot undo in their sweeps (hokkaido at level 7: 2,515 inverted
+    // cells left at the end when every such stage restarted from Coons, none
+    // with the better start).
+    FrontStage stage;
+    std::vector<Eigen::Vector2d> coons = last ? r_.coons : coons_positions(r_.mesh, r_.boundary);
+    if (k > 0) {
+      std::vector<Eigen::Vector2d> carried = transfer_positions(coarse, r_.optimized, r_.mesh, r_.boundary);
+      stage.start_inverted = mesh_quality(r_.mesh, carried).inverted_cells;
+      stage.carried = true;
+      if (r_.quality_optimized.inverted_cells > 0) {
+        const std::size_t coons_inverted = mesh_quality(r_.mesh, coons).inverted_cells;
+        stage.other_start_inverted = coons_inverted;
+        if (coons_inverted < stage.start_inverted) {
+          stage.other_start_inverted = stage.start_inverted;
+          stage.start_inverted = coons_inverted;
+          stage.carried = false;
+        }
+      }
+      r_.optimized = stage.carried ? std::move(carried) : std::move(coons);
+    } else {
+      stage.start_inverted = mesh_quality(r_.mesh, coons).inverted_cells;
+      r_.optimized = std::move(coons);
+    }
+    if (k > 0 && stage.other_start_inverted)
+      log("optimization", "stage " + std::to_string(k + 1) + " starts from " +
+                              (stage.carried ? "the previous stage carried over (" : "Coons (") +
+                              std::to_string(stage.start_inverted) + " inverted cells; " +
+                              (stage.carried ? "Coons " : "carried over ") +
+                              std::to_string(*stage.other_start_inverted) + ")");
     // Intermediate stages only provide a start: a bounded number of sweeps.
     sopt_.max_sweeps = last ? opt_.smoothing.max_sweeps : std::min(opt_.smoothing.max_sweeps, 100);
     optimize(last ? "final mesh" : "stage " + std::to_string(k + 1) + " of " + std::to_string(st.size()));
+    stage.cells = r_.mesh.num_cells();
+    stage.end_inverted = r_.quality_optimized.inverted_cells;
+    stage.sweeps = r_.smoothing.sweeps;
+    r_.stages.push_back(stage);
     clock_.stop("optimization");
   }
 }

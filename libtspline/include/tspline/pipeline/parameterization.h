@@ -73,6 +73,22 @@ struct CornerTrial {
 std::size_t best_corner_trial(const std::vector<CornerTrial>& trials);
 
 /// Everything the front half produces, for writers and reports.
+/// One stage of the front's nested optimization (FrontResult::stages): where
+/// it started and how many cells were inverted at its start and end.
+struct FrontStage {
+  std::size_t cells = 0;
+  /// The previous stage's positions carried over to this stage's finer mesh,
+  /// or the Coons positions of this mesh: whichever has fewer inverted cells
+  /// (the carried ones on a tie; the first stage starts from Coons).
+  bool carried = false;
+  std::size_t start_inverted = 0;  ///< inverted cells of the start taken
+  /// Inverted cells of the start not taken, where both were counted (not
+  /// where the previous stage ended with none: it is carried over then).
+  std::optional<std::size_t> other_start_inverted;
+  std::size_t end_inverted = 0;  ///< after the stage's optimization
+  int sweeps = 0;
+};
+
 struct FrontResult {
   explicit FrontResult(BoundaryMap b) : boundary(std::move(b)) {}
   BoundaryMap boundary;
@@ -92,6 +108,7 @@ struct FrontResult {
   /// Why the repair stopped with inverted cells left ("" if none are left or
   /// the repair rounds ran out).
   std::string repair_stop_reason;
+  std::vector<FrontStage> stages;  ///< the nested optimization's stages, coarse to fine (not the repairs)
   std::vector<CornerTrial> corner_trials;  ///< empty unless automatic corners were tried
   std::vector<StageTime> times;
   /// What clean_polygon removed from the input (file numbering), one note each.
