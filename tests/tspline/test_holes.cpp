@@ -416,6 +416,32 @@ TEST_SUITE("holes") {
     }
   }
 
+  TEST_CASE("stop_when: the run stops at the first patch it names, later patches are not run") {
+    const Domain d = read_text_domain(holes_file("plate_with_hole.txt"));
+    tspline::MultiPatchOptions multi;
+    multi.threads = 1;  // the patches in order
+    std::vector<std::size_t> seen;
+    multi.stop_when = [&seen](std::size_t p, const tspline::ParameterizationResult& r) {
+      seen.push_back(p);
+      CHECK(r.map);
+      return p == 2 ? std::string("is the one asked for") : std::string();
+    };
+    const std::string what = message_of<tspline::MultiPatchStopped>(
+        [&] { (void)tspline::run_multipatch_parameterization(d, std::nullopt, {}, {}, multi); });
+    CHECK(what == "patch 2 is the one asked for");
+    CHECK(seen == std::vector<std::size_t>{0, 1, 2});
+    // Never stopping: every patch once (the first round), the same map as without.
+    seen.clear();
+    multi.stop_when = [&seen](std::size_t p, const tspline::ParameterizationResult&) {
+      seen.push_back(p);
+      return std::string();
+    };
+    const tspline::MultiPatchResult R = tspline::run_multipatch_parameterization(d, std::nullopt, {}, {}, multi);
+    REQUIRE(seen.size() == R.patches.size());
+    for (std::size_t p = 0; p < seen.size(); ++p) CHECK(seen[p] == p);
+    CHECK(R.certified_valid());
+  }
+
   TEST_CASE("multi-patch map of the flange (bore and four bolt holes)") {
     const Domain d = read_text_domain(holes_file("flange.txt"));
     REQUIRE(d.holes.size() == 5);

@@ -258,6 +258,9 @@ MultiPatchResult run_multipatch_parameterization(const Domain& domain, PatchLayo
       po.progress = patch_progress(shared.progress, p);
       runs[i].emplace(run_parameterization(patch.polygon, po, adaptive));
       if (!runs[i]->map) throw NumericalError("patch " + std::to_string(p) + ": no map was produced");
+      if (round == 0 && multi.stop_when)
+        if (const std::string why = multi.stop_when(p, *runs[i]); !why.empty())
+          throw MultiPatchStopped("patch " + std::to_string(p) + " " + why);
     });
     for (std::size_t i = 0; i < todo.size(); ++i) {
       const std::size_t p = todo[i];

@@ -119,6 +119,7 @@ DomainParameterization parameterize_domain(const Domain& input, const Parameteri
     QuadLayout layout;
     std::string explanation;                 ///< the layout's, before its patches took it
     std::optional<MultiPatchResult> patches;  ///< run ahead of the decision, if the layout was first
+    std::string stopped;  ///< why its patches' run was stopped (first_layout_multi), if it was
   };
   // The layout's progress and the single patch's, from two threads, one at a time.
   std::mutex progress_mutex;
@@ -145,25 +146,53 @@ DomainParameterization parameterize_domain(const Domain& input, const Parameteri
     return (!adaptive.certify || R.certified_valid()) && reaches_good_quality(dense_figures(R), c);
   };
   auto patch_figures = [](const MultiPatchResult& R) { return figures(dense_figures(R)); };
+  // The first layout's patches stop at the first patch that is certified but
+  // below the thresholds where another layout will be tried: that layout's map
+  // cannot be good (its figures are the least over its patches), and the rest
+  // of its patches would only be needed if the other layout does no better
+  // (then they are run after all; retry_with_another_layout).
+  const bool retry_possible = c.retry_size_factor > 0.0 && c.retry_size_factor != 1.0;
+  MultiPatchOptions first_layout_multi = c.multi;
+  if (retry_possible)
+    first_layout_multi.stop_when = [&c, &adaptive](std::size_t, const ParameterizationResult& r) {
+      if ((adaptive.certify && !r.certified_valid()) || reaches_good_quality(r.dense_quality, c)) return std::string();
+      return "is certified but below the thresholds (" + figures(r.dense_quality) + ")";
+    };
   // A certified map of a quad layout below the thresholds: one more layout of
   // `valid`, kept where its map is certified and the worse of its two figures
   // is higher. Where the first gave flat ring corners sheets of quads, the
   // second pillows their rings instead (the same ring nodes); else its
   // patches are c.retry_size_factor times larger (another mesh of the domain,
-  // whose worst corners fall elsewhere).
-  auto retry_with_another_layout = [&](const Domain& valid, const QuadLayout& first_layout) {
-    const MultiPatchResult& first = *out.patches;
+  // whose worst corners fall elsewhere). `stopped`: why the first layout's
+  // patches were stopped (first_layout_multi), its map not made; it is made
+  // in full only if the second's map is not good, to compare the two.
+  auto retry_with_another_layout = [&](const Domain& valid, const QuadLayout& first_layout,
+                                       const std::string& first_explanation, const std::string& stopped) {
     const bool pillow = first_layout.stats.corner_sheets > 0;
-    if (!(c.retry_size_factor > 0.0) || c.retry_size_factor == 1.0) return;
-    if (good_patches(first) || (adaptive.certify && !first.certified_valid())) return;
+    if (!retry_possible) return;
+    if (stopped.empty() && (good_patches(*out.patches) || (adaptive.certify && !out.patches->certified_valid())))
+      return;
     std::ostringstream second;
     if (pillow)
       second << "a second quad layout with the rings of its flat corners pillowed instead of sheets through them";
     else
       second << "a second quad layout with patches " << c.retry_size_factor << " times larger";
     report_step(serial.progress, "layout",
-                "the layout's map is certified but below the thresholds (" + patch_figures(first) + "): " +
-                    second.str());
+                (stopped.empty() ? "the layout's map is certified but below the thresholds (" +
+                                       patch_figures(*out.patches) + ")"
+                                 : "the layout's " + stopped + ", so its map cannot be good; its other patches are not run") +
+                    ": " + second.str());
+    // The first layout's map in full, where it was stopped (to compare, or to
+    // keep where the second fails).
+    std::string first_note;  // where the first was stopped: what became of its other patches
+    if (!stopped.empty()) first_note = " (the layout's " + stopped + ": its other patches were not run)";
+    auto make_first = [&] {
+      if (out.patches) return;
+      first_note = " (the layout's " + stopped + ": its other patches were run only to compare)";
+      report_step(serial.progress, "layout", "the first quad layout's patches in full, to compare");
+      out.patches.emplace(run_multipatch_parameterization(valid, first_layout.layout, first_explanation,
+                                                          patch_options, adaptive, c.multi, on_patch));
+    };
     std::string outcome;
     try {
       QuadLayoutOptions q = c.quad;
@@ -178,8 +207,16 @@ DomainParameterization parameterize_domain(const Domain& input, const Parameteri
       report_step(serial.progress, "layout", explanation);
       MultiPatchResult R = run_multipatch_parameterization(valid, std::move(L.layout), explanation, patch_options,
                                                            adaptive, c.multi, on_patch);
-      if ((!adaptive.certify || R.certified_valid()) && worse_figure(dense_figures(R)) > worse_figure(dense_figures(first))) {
-        outcome = second.str() + " gave a better map (" + patch_figures(R) + "): kept";
+      // Where the first was stopped, a good second map is kept at once (the
+      // first's cannot be good); else the two are compared.
+      const bool second_good = good_patches(R);
+      if (!(stopped.size() && second_good)) make_first();
+      const bool second_certified = !adaptive.certify || R.certified_valid();
+      const bool first_certified = out.patches && (!adaptive.certify || out.patches->certified_valid());
+      if (second_certified &&
+          (!out.patches || !first_certified || worse_figure(dense_figures(R)) > worse_figure(dense_figures(*out.patches)))) {
+        outcome = second.str() + (second_good ? " gave a good map (" : " gave a better map (") + patch_figures(R) +
+                  "): kept";
         out.patches.emplace(std::move(R));
         out.quad_stats = L.stats;
       } else {
@@ -187,9 +224,10 @@ DomainParameterization parameterize_domain(const Domain& input, const Parameteri
       }
     } catch (const NumericalError& e) {
       outcome = second.str() + " failed (" + e.what() + "): the first kept";
+      make_first();
     }
     report_step(serial.progress, "layout", outcome);
-    out.reason += "; below the thresholds, " + outcome;
+    out.reason += "; below the thresholds" + first_note + ", " + outcome;
   };
   auto run_quad = [&](const std::string& reason) {
     LayoutAhead a;
@@ -203,16 +241,21 @@ DomainParameterization parameterize_domain(const Domain& input, const Parameteri
       a.layout = build_quad_layout(a.valid, q);
       a.explanation = a.layout.explanation();
     }
-    if (!a.patches) report_step(serial.progress, "layout", a.explanation);  // (the run ahead reported it)
+    if (!a.patches && a.stopped.empty()) report_step(serial.progress, "layout", a.explanation);  // (else the run ahead did)
     out.layout = "quad";
     out.reason = reason;
     out.quad_stats = a.layout.stats;
-    if (a.patches)
+    if (a.patches) {
       out.patches.emplace(std::move(*a.patches));
-    else
-      out.patches.emplace(run_multipatch_parameterization(a.valid, std::move(a.layout.layout), a.explanation,
-                                                          patch_options, adaptive, c.multi, on_patch));
-    retry_with_another_layout(a.valid, a.layout);
+    } else if (a.stopped.empty()) {
+      try {
+        out.patches.emplace(run_multipatch_parameterization(a.valid, a.layout.layout, a.explanation, patch_options,
+                                                            adaptive, first_layout_multi, on_patch));
+      } catch (const MultiPatchStopped& e) {
+        a.stopped = e.what();
+      }
+    }
+    retry_with_another_layout(a.valid, a.layout, a.explanation, a.stopped);
   };
   if (c.layout == LayoutMode::Quad) {
     run_quad("layout quad was asked for");
@@ -290,7 +333,7 @@ DomainParameterization parameterize_domain(const Domain& input, const Parameteri
     // before the single patch's try, 0.3 s more where one patch is kept and
     // its try shares the cores; neither a nice-19 run ahead, which would
     // starve on a loaded machine, nor one limited to one thread did better.)
-    MultiPatchOptions ahead_multi = c.multi;
+    MultiPatchOptions ahead_multi = first_layout_multi;
     ahead_multi.cancel = &cancel;
     ParameterizationOptions ahead_options = patch_options;
     if (serial.progress)
@@ -306,8 +349,12 @@ DomainParameterization parameterize_domain(const Domain& input, const Parameteri
       a.layout = build_quad_layout(a.valid, q);
       a.explanation = a.layout.explanation();
       report_step(ahead_options.progress, "layout", a.explanation);
-      a.patches.emplace(run_multipatch_parameterization(a.valid, std::move(a.layout.layout), a.explanation,
-                                                        ahead_options, adaptive, ahead_multi, ahead_on_patch));
+      try {
+        a.patches.emplace(run_multipatch_parameterization(a.valid, a.layout.layout, a.explanation, ahead_options,
+                                                          adaptive, ahead_multi, ahead_on_patch));
+      } catch (const MultiPatchStopped& e) {
+        a.stopped = e.what();
+      }
       return a;
     });
   }

@@ -15,6 +15,7 @@
 #include <functional>
 #include <mutex>
 #include <optional>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -35,11 +36,23 @@ struct MultiPatchOptions {
   /// Checked before each patch and each interface round: once set (by another
   /// thread), MultiPatchCancelled is thrown.
   const std::atomic<bool>* cancel = nullptr;
+  /// Called after each patch's map of the first round (from the thread that
+  /// ran it, so it must be thread-safe): a non-empty text stops the run. The
+  /// patches not yet started are not run, and run_multipatch_parameterization
+  /// throws MultiPatchStopped("patch P " + text). Lets a caller that only
+  /// wants the map if every patch is good stop at the first that is not.
+  std::function<std::string(std::size_t patch, const ParameterizationResult&)> stop_when;
 };
 
 /// Thrown where MultiPatchOptions::cancel was set.
 struct MultiPatchCancelled : std::exception {
   const char* what() const noexcept override { return "the patches' run was cancelled"; }
+};
+
+/// Thrown where MultiPatchOptions::stop_when stopped the run; what() names
+/// the patch and gives stop_when's text.
+struct MultiPatchStopped : std::runtime_error {
+  using std::runtime_error::runtime_error;
 };
 
 struct InterfaceReport {
