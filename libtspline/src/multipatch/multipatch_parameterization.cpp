@@ -256,7 +256,11 @@ MultiPatchResult run_multipatch_parameterization(const Domain& domain, PatchLayo
       po.corner_trials = 1;
       po.border_params = required[p];
       po.progress = patch_progress(shared.progress, p);
-      runs[i].emplace(run_parameterization(patch.polygon, po, adaptive));
+      try {
+        runs[i].emplace(run_parameterization(patch.polygon, po, adaptive));
+      } catch (const InputError& e) {  // (its corners and polygon come from the layout: say which patch)
+        throw InputError("patch " + std::to_string(p) + " of the layout: " + e.what());
+      }
       if (!runs[i]->map) throw NumericalError("patch " + std::to_string(p) + ": no map was produced");
       if (round == 0 && multi.stop_when)
         if (const std::string why = multi.stop_when(p, *runs[i]); !why.empty())

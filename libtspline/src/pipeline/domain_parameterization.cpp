@@ -267,8 +267,10 @@ DomainParameterization parameterize_domain(const Domain& input, const Parameteri
     std::string why = "the domain has holes";
     std::optional<MultiPatchResult> by_cuts;  // kept in case the quad layout does worse
     if (domain.holes.size() <= static_cast<std::size_t>(c.first_try_max_holes) && quad_mesher_available()) {
+      bool cuts_found = false;
       try {
         AutomaticCuts a = automatic_cuts(domain);
+        cuts_found = true;
         MultiPatchResult R = run_multipatch_parameterization(domain, build_patch_layout(domain, std::move(a.cuts)),
                                                              "automatic: " + a.explanation, options, adaptive,
                                                              c.multi, on_patch);
@@ -282,7 +284,9 @@ DomainParameterization parameterize_domain(const Domain& input, const Parameteri
         why = "the automatic cuts between the holes are certified but poor, or not certified (" + q + ")";
         if (!adaptive.certify || R.certified_valid()) by_cuts.emplace(std::move(R));
       } catch (const InputError& e) {
-        why = std::string("the domain has holes, and no automatic cuts were found (") + e.what() + ")";
+        why = std::string(cuts_found ? "the domain has holes, and the automatic cuts make a patch that cannot be mapped ("
+                                     : "the domain has holes, and no automatic cuts were found (") +
+              e.what() + ")";
       }
       report_step(serial.progress, "layout", why + ": building a quad layout");
     }
