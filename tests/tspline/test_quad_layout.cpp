@@ -455,6 +455,34 @@ TEST_SUITE("quad_layout") {
     CHECK(worse(*once.patches) == worse(*first.patches));
   }
 
+  TEST_CASE("auto: the layout's patches run ahead of the single try also stop at the first below the thresholds") {
+    // The flower under auto with a threshold no map of it reaches: the single
+    // try is not good, the layout's patches (run while it was tried) stop at
+    // the first patch, the second layout is not good either, so the first
+    // layout's patches run in full to compare; the map kept is certified and
+    // the same as under layout quad.
+    const tspline::Domain flower{tspline::io::read_polygon(test_support::polygon_file("flower.txt")), {}};
+    tspline::ParameterizationOptions po;
+    const tspline::AdaptiveOptions ad;
+    tspline::DomainParameterizationOptions c;
+    c.good.scaled_jacobian = 0.999;
+    const tspline::DomainParameterization A = tspline::parameterize_domain(flower, po, ad, c);
+    INFO(A.reason);
+    REQUIRE(A.patches);
+    CHECK(A.layout == "quad");
+    CHECK(A.patches->certified_valid());
+    CHECK(contains(A.reason, "one patch is certified but poor over the whole map"));
+    CHECK(contains(A.reason, "(the layout's patch "));  // (which patch: the first to finish on its thread)
+    CHECK(contains(A.reason, " is certified but below the thresholds (scaled Jacobian "));
+    CHECK(contains(A.reason, "its other patches were run only to compare)"));
+    c.layout = tspline::LayoutMode::Quad;
+    const tspline::DomainParameterization Q = tspline::parameterize_domain(flower, po, ad, c);
+    REQUIRE(Q.patches);
+    CHECK(Q.patches->patches.size() == A.patches->patches.size());
+    CHECK(Q.patches->min_mean_ratio_dense() == A.patches->min_mean_ratio_dense());
+    CHECK(Q.patches->min_scaled_jacobian_dense() == A.patches->min_scaled_jacobian_dense());
+  }
+
   TEST_CASE("auto's choice between a certified layout and one patch: the layout where it is good") {
     const tspline::DomainParameterizationOptions c;  // scaled Jacobian >= 0.3 and J_r >= 0.1
     auto figures = [](double sj, double jr) {
