@@ -436,7 +436,8 @@ TEST_SUITE("holes") {
       seen.push_back(p);
       return std::string();
     };
-    const tspline::MultiPatchResult R = tspline::run_multipatch_parameterization(d, std::nullopt, {}, {}, multi);
+    const tspline::MultiPatchResult R =
+        tspline::run_multipatch_parameterization(d, std::nullopt, {}, {}, multi);
     REQUIRE(seen.size() == R.patches.size());
     for (std::size_t p = 0; p < seen.size(); ++p) CHECK(seen[p] == p);
     CHECK(R.certified_valid());

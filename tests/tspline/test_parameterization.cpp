@@ -115,7 +115,9 @@ TEST_SUITE("parameterization") {
 }
 
 TEST_SUITE("parameterization") {
-  TEST_CASE("each nested stage starts from the carried-over positions or Coons, whichever has fewer inverted cells") {
+  TEST_CASE(
+      "each nested stage starts from the carried-over positions or Coons, whichever has fewer inverted "
+      "cells") {
     // Hokkaido at level 6 with a fine tolerance: stages end at their sweep
     // cap with a few inverted cells, and the Coons start of the next has
     // several times more. Restarting each such stage from Coons left 430
@@ -134,8 +136,9 @@ TEST_SUITE("parameterization") {
       const tspline::FrontStage& s = r.stages[k];
       const tspline::FrontStage& prev = r.stages[k - 1];
       CAPTURE(k);
-      MESSAGE("stage " << k + 1 << ": " << s.cells << " cells, from " << std::string(s.carried ? "carried" : "Coons") << " with "
-                       << s.start_inverted << " inverted (the other "
+      MESSAGE("stage " << k + 1 << ": " << s.cells << " cells, from "
+                       << std::string(s.carried ? "carried" : "Coons") << " with " << s.start_inverted
+                       << " inverted (the other "
                        << (s.other_start_inverted ? std::to_string(*s.other_start_inverted) : "-") << "), "
                        << s.end_inverted << " at the end, " << s.sweeps << " sweeps");
       CHECK(s.cells >= prev.cells);

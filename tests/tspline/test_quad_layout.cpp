@@ -436,8 +436,9 @@ TEST_SUITE("quad_layout") {
     // run in full only after the second layout's map is not good either.
     CHECK(contains(again.reason, "below the thresholds (the layout's patch "));
     CHECK(contains(again.reason, "is certified but below the thresholds (scaled Jacobian "));
-    CHECK(contains(again.reason, "its other patches were run only to compare), a second quad layout with patches 1.2 "
-                                 "times larger"));
+    CHECK(contains(again.reason,
+                   "its other patches were run only to compare), a second quad layout with patches 1.2 "
+                   "times larger"));
     auto worse = [](const tspline::MultiPatchResult& R) {
       return std::min(R.min_scaled_jacobian_dense(), R.min_mean_ratio_dense());
     };
@@ -455,7 +456,8 @@ TEST_SUITE("quad_layout") {
     CHECK(worse(*once.patches) == worse(*first.patches));
   }
 
-  TEST_CASE("auto: the layout's patches run ahead of the single try also stop at the first below the thresholds") {
+  TEST_CASE(
+      "auto: the layout's patches run ahead of the single try also stop at the first below the thresholds") {
     // The flower under auto with a threshold no map of it reaches: the single
     // try is not good, the layout's patches (run while it was tried) stop at
     // the first patch, the second layout is not good either, so the first

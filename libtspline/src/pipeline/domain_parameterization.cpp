@@ -155,7 +155,8 @@ DomainParameterization parameterize_domain(const Domain& input, const Parameteri
   MultiPatchOptions first_layout_multi = c.multi;
   if (retry_possible)
     first_layout_multi.stop_when = [&c, &adaptive](std::size_t, const ParameterizationResult& r) {
-      if ((adaptive.certify && !r.certified_valid()) || reaches_good_quality(r.dense_quality, c)) return std::string();
+      if ((adaptive.certify && !r.certified_valid()) || reaches_good_quality(r.dense_quality, c))
+        return std::string();
       return "is certified but below the thresholds (" + figures(r.dense_quality) + ")";
     };
   // A certified map of a quad layout below the thresholds: one more layout of
@@ -170,18 +171,20 @@ DomainParameterization parameterize_domain(const Domain& input, const Parameteri
                                        const std::string& first_explanation, const std::string& stopped) {
     const bool pillow = first_layout.stats.corner_sheets > 0;
     if (!retry_possible) return;
-    if (stopped.empty() && (good_patches(*out.patches) || (adaptive.certify && !out.patches->certified_valid())))
+    if (stopped.empty() &&
+        (good_patches(*out.patches) || (adaptive.certify && !out.patches->certified_valid())))
       return;
     std::ostringstream second;
     if (pillow)
       second << "a second quad layout with the rings of its flat corners pillowed instead of sheets through them";
     else
       second << "a second quad layout with patches " << c.retry_size_factor << " times larger";
-    report_step(serial.progress, "layout",
-                (stopped.empty() ? "the layout's map is certified but below the thresholds (" +
-                                       patch_figures(*out.patches) + ")"
-                                 : "the layout's " + stopped + ", so its map cannot be good; its other patches are not run") +
-                    ": " + second.str());
+    report_step(
+        serial.progress, "layout",
+        (stopped.empty()
+             ? "the layout's map is certified but below the thresholds (" + patch_figures(*out.patches) + ")"
+             : "the layout's " + stopped + ", so its map cannot be good; its other patches are not run") +
+            ": " + second.str());
     // The first layout's map in full, where it was stopped (to compare, or to
     // keep where the second fails).
     std::string first_note;  // where the first was stopped: what became of its other patches
@@ -213,10 +216,10 @@ DomainParameterization parameterize_domain(const Domain& input, const Parameteri
       if (!(stopped.size() && second_good)) make_first();
       const bool second_certified = !adaptive.certify || R.certified_valid();
       const bool first_certified = out.patches && (!adaptive.certify || out.patches->certified_valid());
-      if (second_certified &&
-          (!out.patches || !first_certified || worse_figure(dense_figures(R)) > worse_figure(dense_figures(*out.patches)))) {
-        outcome = second.str() + (second_good ? " gave a good map (" : " gave a better map (") + patch_figures(R) +
-                  "): kept";
+      if (second_certified && (!out.patches || !first_certified ||
+                               worse_figure(dense_figures(R)) > worse_figure(dense_figures(*out.patches)))) {
+        outcome = second.str() + (second_good ? " gave a good map (" : " gave a better map (") +
+                  patch_figures(R) + "): kept";
         out.patches.emplace(std::move(R));
         out.quad_stats = L.stats;
       } else {
@@ -241,7 +244,8 @@ DomainParameterization parameterize_domain(const Domain& input, const Parameteri
       a.layout = build_quad_layout(a.valid, q);
       a.explanation = a.layout.explanation();
     }
-    if (!a.patches && a.stopped.empty()) report_step(serial.progress, "layout", a.explanation);  // (else the run ahead did)
+    if (!a.patches && a.stopped.empty())
+      report_step(serial.progress, "layout", a.explanation);  // (else the run ahead did)
     out.layout = "quad";
     out.reason = reason;
     out.quad_stats = a.layout.stats;
@@ -249,8 +253,8 @@ DomainParameterization parameterize_domain(const Domain& input, const Parameteri
       out.patches.emplace(std::move(*a.patches));
     } else if (a.stopped.empty()) {
       try {
-        out.patches.emplace(run_multipatch_parameterization(a.valid, a.layout.layout, a.explanation, patch_options,
-                                                            adaptive, first_layout_multi, on_patch));
+        out.patches.emplace(run_multipatch_parameterization(
+            a.valid, a.layout.layout, a.explanation, patch_options, adaptive, first_layout_multi, on_patch));
       } catch (const MultiPatchStopped& e) {
         a.stopped = e.what();
       }
@@ -284,8 +288,10 @@ DomainParameterization parameterize_domain(const Domain& input, const Parameteri
         why = "the automatic cuts between the holes are certified but poor, or not certified (" + q + ")";
         if (!adaptive.certify || R.certified_valid()) by_cuts.emplace(std::move(R));
       } catch (const InputError& e) {
-        why = std::string(cuts_found ? "the domain has holes, and the automatic cuts make a patch that cannot be mapped ("
-                                     : "the domain has holes, and no automatic cuts were found (") +
+        why = std::string(
+                  cuts_found
+                      ? "the domain has holes, and the automatic cuts make a patch that cannot be mapped ("
+                      : "the domain has holes, and no automatic cuts were found (") +
               e.what() + ")";
       }
       report_step(serial.progress, "layout", why + ": building a quad layout");
@@ -354,8 +360,8 @@ DomainParameterization parameterize_domain(const Domain& input, const Parameteri
       a.explanation = a.layout.explanation();
       report_step(ahead_options.progress, "layout", a.explanation);
       try {
-        a.patches.emplace(run_multipatch_parameterization(a.valid, a.layout.layout, a.explanation, ahead_options,
-                                                          adaptive, ahead_multi, ahead_on_patch));
+        a.patches.emplace(run_multipatch_parameterization(
+            a.valid, a.layout.layout, a.explanation, ahead_options, adaptive, ahead_multi, ahead_on_patch));
       } catch (const MultiPatchStopped& e) {
         a.stopped = e.what();
       }

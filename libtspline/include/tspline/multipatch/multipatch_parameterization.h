@@ -19,9 +19,9 @@
 #include <string>
 #include <vector>
 
-#include "tspline/pipeline/adaptive_parameterization.h"
 #include "tspline/boundary/domain.h"
 #include "tspline/multipatch/patch_layout.h"
+#include "tspline/pipeline/adaptive_parameterization.h"
 
 namespace tspline {
 
