@@ -181,12 +181,15 @@ void FrontOptimizer::run_nested_stages() {
     // cells left at the end when every such stage restarted from Coons, none
     // with the better start).
     FrontStage stage;
-    std::vector<Eigen::Vector2d> coons = last ? r_.coons : coons_positions(r_.mesh, r_.boundary);
+    // (The Coons positions only where they are compared or taken.)
+    auto coons_start = [&]() { return last ? r_.coons : coons_positions(r_.mesh, r_.boundary); };
     if (k > 0) {
       std::vector<Eigen::Vector2d> carried = transfer_positions(coarse, r_.optimized, r_.mesh, r_.boundary);
       stage.start_inverted = mesh_quality(r_.mesh, carried).inverted_cells;
       stage.carried = true;
+      std::vector<Eigen::Vector2d> coons;
       if (r_.quality_optimized.inverted_cells > 0) {
+        coons = coons_start();
         const std::size_t coons_inverted = mesh_quality(r_.mesh, coons).inverted_cells;
         stage.other_start_inverted = coons_inverted;
         if (coons_inverted < stage.start_inverted) {
@@ -197,8 +200,8 @@ void FrontOptimizer::run_nested_stages() {
       }
       r_.optimized = stage.carried ? std::move(carried) : std::move(coons);
     } else {
-      stage.start_inverted = mesh_quality(r_.mesh, coons).inverted_cells;
-      r_.optimized = std::move(coons);
+      r_.optimized = coons_start();
+      stage.start_inverted = mesh_quality(r_.mesh, r_.optimized).inverted_cells;
     }
     if (k > 0 && stage.other_start_inverted)
       log("optimization", "stage " + std::to_string(k + 1) + " starts from " +

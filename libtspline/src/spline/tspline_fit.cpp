@@ -157,10 +157,12 @@ void solve_interpolation(TSplineMap& map, const InterpolationData& data, FitRepo
   std::vector<Eigen::Vector2d> cp(n);
   for (int a = 0; a < n; ++a) cp[a] = P.row(a).transpose() + centre;
   map.set_control_points(std::move(cp));
-  const TSplineMap& fitted = map;
-  // Residual of the interpolation conditions, evaluated through the map itself.
+  // Residual of the interpolation conditions: row b of A holds the functions'
+  // values at the interpolation point b, so A P is the map there (relative to
+  // the centre; evaluating the map again costs as much as assembling A did).
+  const Eigen::MatrixX2d residual = A * P - rhs;
   double res = 0.0;
-  for (int b = 0; b < n; ++b) res = std::max(res, (fitted.point(data.params[b]) - data.targets[b]).norm());
+  for (int b = 0; b < n; ++b) res = std::max(res, residual.row(b).norm());
   const double diag = (hi - lo).norm();
   const double rel = diag > 0 ? res / diag : res;
   if (!(rel <= 1e-8)) {
