@@ -12,6 +12,8 @@
 #include "separable_maps.h"
 #include "test_support.h"
 #include "tspline/validity/corner_quality.h"
+#include "tspline/io/polygon_reader.h"
+#include "tspline/pipeline/adaptive_parameterization.h"
 #include "tspline/validity/map_energy.h"
 
 namespace {
@@ -74,6 +76,60 @@ TEST_SUITE("corner_quality") {
     }
     CHECK(tspline::worst_boundary_corner(map)->scaled_jacobian == doctest::Approx(std::sqrt(0.5)).epsilon(1e-12));
     CHECK_FALSE(tspline::worst_boundary_corner(map, {false, false, false, false}).has_value());
+  }
+
+  TEST_CASE("the least scaled Jacobian and the least J_r over the corners, each at its own corner") {
+    // Angles 135, 90, 85.9 and 49.1 degrees: the scaled Jacobian (the sine)
+    // is least at q0 (sin 135 = 0.707, against sin 49.1 = 0.756 at q3), J_r
+    // (2 det / (a^2 + b^2)) at q3, between sides 1.41 and 7.02: 15 / 51.25 =
+    // 0.293, against 12 / 38 = 0.316 at q0.
+    const std::array<Vector2d, 4> q = {Vector2d(0, 0), Vector2d(6, 0), Vector2d(6, 1.5), Vector2d(-1, 1)};
+    const tspline::TSplineMap map = bilinear_map(q, test_support::uniform_mesh(2));
+    const tspline::BoundaryCornerMinima m = tspline::boundary_corner_minima(map);
+    CHECK(m.scaled.corner == 0);
+    CHECK(m.scaled.scaled_jacobian == doctest::Approx(std::sqrt(0.5)).epsilon(1e-12));
+    CHECK(m.scaled.angle_degrees == doctest::Approx(135.0).epsilon(1e-12));
+    CHECK(m.mean_ratio.corner == 3);
+    CHECK(m.mean_ratio.mean_ratio == doctest::Approx(15.0 / 51.25).epsilon(1e-12));
+    for (int k = 0; k < 4; ++k) {
+      CAPTURE(k);
+      CHECK(m.scaled.scaled_jacobian <= corner_figures(q, k).scaled + 1e-12);
+      CHECK(m.mean_ratio.mean_ratio <= corner_figures(q, k).mean_ratio + 1e-12);
+    }
+  }
+
+  TEST_CASE("the boundary frozen in the first round fixes J at the corners of the map kept") {
+    // What auto's first try relies on to stop early: J at the four corners of
+    // the map passed to stop_when_boundary_frozen is J there in the map the
+    // whole run keeps, after untangling, adaptive refinement and polish.
+    // (Bali and the C-shape take an adaptive round after the first; Bali's
+    // kept map is polished.)
+    for (const std::string name : {"../coastlines/bali.txt", "cshape.txt"}) {
+      CAPTURE(name);
+      const auto poly = tspline::io::read_polygon(test_support::polygon_file(name));
+      tspline::AdaptiveOptions ad;
+      std::array<Eigen::Matrix2d, 4> frozen;
+      int calls = 0;
+      const std::array<Vector2d, 4> corners = {Vector2d(0, 0), Vector2d(1, 0), Vector2d(1, 1), Vector2d(0, 1)};
+      ad.stop_when_boundary_frozen = [&](const tspline::TSplineMap& map) {
+        ++calls;
+        for (int k = 0; k < 4; ++k) frozen[k] = map.jacobian(corners[k]);
+        return std::string();
+      };
+      const tspline::ParameterizationResult r = tspline::run_parameterization(poly, {}, ad);
+      CHECK(calls == 1);
+      REQUIRE(r.map);
+      CHECK(r.iterations.size() > 1);
+      CHECK(r.control_points_optimized);
+      for (int k = 0; k < 4; ++k) {
+        CAPTURE(k);
+        // Round-off of the transfers to the refined meshes (interpolation solves).
+        CHECK((r.map->jacobian(corners[k]) - frozen[k]).norm() <= 1e-9 * frozen[k].norm());
+      }
+      // A text stops the run there.
+      ad.stop_when_boundary_frozen = [](const tspline::TSplineMap&) { return std::string("enough"); };
+      CHECK_THROWS_WITH_AS((void)tspline::run_parameterization(poly, {}, ad), "enough", tspline::ParameterizationStopped);
+    }
   }
 
   TEST_CASE("no control point the untangling moves changes J at a corner") {

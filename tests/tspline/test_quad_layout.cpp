@@ -366,7 +366,10 @@ TEST_SUITE("quad_layout") {
     auto first = [&](const std::function<bool(const std::string&)>& is) {
       return std::find_if(events.begin(), events.end(), is) - events.begin();
     };
-    const auto verdict = first([](const std::string& e) { return contains(e, "poor over the whole map"); });
+    // (Here the verdict comes at the single patch's corners, before its untangling.)
+    const auto verdict = first([](const std::string& e) {
+      return contains(e, "one patch cannot be good: ") || contains(e, "poor over the whole map");
+    });
     const auto layout = first([](const std::string& e) { return e.rfind("layout: quad layout: ", 0) == 0; });
     const auto patches = first([](const std::string& e) {
       return e == "on_patch" || e.rfind("patches: ", 0) == 0 || contains(e, ": patch ");
@@ -473,7 +476,8 @@ TEST_SUITE("quad_layout") {
     REQUIRE(A.patches);
     CHECK(A.layout == "quad");
     CHECK(A.patches->certified_valid());
-    CHECK(contains(A.reason, "one patch is certified but poor over the whole map"));
+    // (The flower's single patch has corners on its smooth petals: its try stops there.)
+    CHECK(contains(A.reason, "one patch cannot be good: its corner at ("));
     CHECK(contains(A.reason, "(the layout's patch "));  // (which patch: the first to finish on its thread)
     CHECK(contains(A.reason, " is certified but below the thresholds (scaled Jacobian "));
     CHECK(contains(A.reason, "its other patches were run only to compare)"));
@@ -483,6 +487,89 @@ TEST_SUITE("quad_layout") {
     CHECK(Q.patches->patches.size() == A.patches->patches.size());
     CHECK(Q.patches->min_mean_ratio_dense() == A.patches->min_mean_ratio_dense());
     CHECK(Q.patches->min_scaled_jacobian_dense() == A.patches->min_scaled_jacobian_dense());
+  }
+
+  TEST_CASE("auto: a single try whose corners rule out the thresholds stops at its frozen boundary") {
+    // The disk: one patch has its four corners on the smooth circle, where the
+    // boundary curves meet at about 180 degrees; J there caps both whole-map
+    // figures far below the thresholds (corner_quality.h). The try stops
+    // before its untangling, and the map kept is the layout's, the same as
+    // under layout quad.
+    const tspline::Domain disk{tspline::io::read_polygon(test_support::polygon_file("disk.txt")), {}};
+    tspline::ParameterizationOptions po;
+    const tspline::AdaptiveOptions ad;
+    tspline::DomainParameterizationOptions c;
+    std::vector<std::string> steps;
+    po.progress = [&steps](const tspline::ProgressEvent& e) { steps.push_back(e.text); };
+    const tspline::DomainParameterization A = tspline::parameterize_domain(disk, po, ad, c);
+    INFO(A.reason);
+    REQUIRE(A.patches);
+    CHECK(A.layout == "quad");
+    CHECK(contains(A.reason, "one patch cannot be good: its corner at ("));
+    CHECK(contains(A.reason, "fixes the scaled Jacobian at "));
+    CHECK_FALSE(A.rejected_single);
+    REQUIRE(A.single_corners);
+    const tspline::BoundaryCornerQuality& sj = A.single_corners->scaled;
+    CHECK(sj.scaled_jacobian < 0.01);
+    CHECK(sj.angle_degrees > 179.0);
+    // The scaled Jacobian at a corner is the sine of the angle between the boundary curves.
+    CHECK(sj.scaled_jacobian == doctest::Approx(std::sin(sj.angle_degrees * std::numbers::pi / 180.0)).epsilon(1e-6));
+    CHECK(A.single_corners->mean_ratio.mean_ratio <= sj.mean_ratio);
+    // The try stopped before its untangling and its map's check: no such step
+    // before the stop (the layout's patches' steps, run ahead, are held until
+    // the layout is kept, after it).
+    const auto stop = std::find_if(steps.begin(), steps.end(),
+                                   [](const std::string& m) { return contains(m, "stopped: its corner at ("); });
+    REQUIRE(stop != steps.end());
+    CHECK(std::none_of(steps.begin(), stop, [](const std::string& m) {
+      return contains(m, "untangling:") || contains(m, "map (iteration");
+    }));
+    CHECK(std::any_of(stop, steps.end(), [](const std::string& m) { return contains(m, "patch 0: map (iteration 0)"); }));
+    c.layout = tspline::LayoutMode::Quad;
+    po.progress = nullptr;
+    const tspline::DomainParameterization Q = tspline::parameterize_domain(disk, po, ad, c);
+    REQUIRE(Q.patches);
+    CHECK(Q.patches->patches.size() == A.patches->patches.size());
+    CHECK(Q.patches->min_mean_ratio_dense() == A.patches->min_mean_ratio_dense());
+    CHECK(Q.patches->min_scaled_jacobian_dense() == A.patches->min_scaled_jacobian_dense());
+  }
+
+  TEST_CASE("auto: a stopped single try is run to the end where the layout is below its corners") {
+    // The unit square's single patch has J = I at its corners (scaled
+    // Jacobian and J_r 1). A threshold above 1 rules it out at the corners,
+    // so its try stops; the layout is not good either, and where its map is
+    // below the single patch's corners the try runs again to the end and the
+    // usual comparison decides (one patch, better than the layout).
+    const tspline::Domain square{rectangle(0, 0, 1, 1), {}};
+    tspline::ParameterizationOptions po;
+    po.initial_level = 2;
+    const tspline::AdaptiveOptions ad;
+    tspline::DomainParameterizationOptions c;
+    c.good.scaled_jacobian = 1.5;
+    std::vector<std::string> steps;
+    po.progress = [&steps](const tspline::ProgressEvent& e) { steps.push_back(e.text); };
+    const tspline::DomainParameterization A = tspline::parameterize_domain(square, po, ad, c);
+    po.progress = nullptr;
+    INFO(A.reason);
+    auto step = [&steps](const std::string& text) {
+      return std::any_of(steps.begin(), steps.end(), [&](const std::string& m) { return contains(m, text); });
+    };
+    CHECK(step("one patch cannot be good: its corner at ("));
+    // The layout's map (J_r about 0.7 on the square's patches) is below the
+    // single patch's corners (1): the try runs to the end.
+    REQUIRE_FALSE(A.patches);
+    REQUIRE(A.single);
+    CHECK(A.layout == "single");
+    CHECK(contains(A.reason, "poorer than one patch"));
+    CHECK(step("one patch tried again to the end, to compare"));
+    CHECK_FALSE(A.single_corners);
+    // The same map as the whole try would give (layout single).
+    c.layout = tspline::LayoutMode::Single;
+    const tspline::DomainParameterization S = tspline::parameterize_domain(square, po, ad, c);
+    REQUIRE(S.single);
+    CHECK(S.single->map->mesh().num_cells() == A.single->map->mesh().num_cells());
+    CHECK(S.single->dense_quality.min_mean_ratio == A.single->dense_quality.min_mean_ratio);
+    CHECK(S.single->dense_quality.min_scaled == A.single->dense_quality.min_scaled);
   }
 
   TEST_CASE("auto's choice between a certified layout and one patch: the layout where it is good") {

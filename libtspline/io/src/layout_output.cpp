@@ -1,5 +1,7 @@
 #include "tspline/io/layout_output.h"
 
+#include "tspline/io/param_output.h"
+
 namespace tspline {
 
 // The report's keys are the field names (one list, here; from_json comes with
@@ -20,6 +22,11 @@ nlohmann::json layout_report(const DomainParameterization& result) {
   if (result.rejected_single)
     out["single_patch_first_try"] = {{"min_scaled_jacobian_dense", result.rejected_single->min_scaled},
                                      {"min_mean_ratio_dense", result.rejected_single->min_mean_ratio}};
+  if (result.single_corners)
+    out["single_patch_first_try"] = {
+        {"stopped", "at its frozen boundary: its corners rule out the thresholds (upper bounds of its whole-map minima)"},
+        {"corner_min_scaled_jacobian", boundary_corner_json(result.single_corners->scaled)},
+        {"corner_min_mean_ratio", boundary_corner_json(result.single_corners->mean_ratio)}};
   return out;
 }
 

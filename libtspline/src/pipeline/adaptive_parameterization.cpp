@@ -124,7 +124,14 @@ class AdaptiveRun {
                        : warm_ ? std::move(warm_->map)
                                : fit_tspline(f_.mesh, f_.optimized, f_.boundary, &rec.fit);
       t_fit_ += seconds_since(t0);
-      if (it == 0) freeze_boundary(map, rec);
+      if (it == 0) {
+        freeze_boundary(map, rec);
+        if (ad_.stop_when_boundary_frozen)
+          if (std::string why = ad_.stop_when_boundary_frozen(map); !why.empty()) {
+            log("stop", "stopped: " + why);
+            throw ParameterizationStopped(why);
+          }
+      }
       MapCertification cert;
       std::vector<CellMapQuality> cells;
       const MapQualityStats quality = untangle_and_assess(map, rec, cert, cells);

@@ -15,6 +15,7 @@
 #include "tspline/errors.h"
 #include "tspline/layout/quad_mesher.h"
 #include "tspline/multipatch/automatic_cuts.h"
+#include "tspline/validity/corner_quality.h"
 
 namespace tspline {
 
@@ -69,6 +70,27 @@ DenseMapQuality dense_figures(const MultiPatchResult& R) {
   q.min_scaled = R.min_scaled_jacobian_dense();
   q.min_mean_ratio = R.min_mean_ratio_dense();
   return q;
+}
+
+// Why one patch with these corner figures (corner_quality.h) cannot reach
+// `good`, or "" where its corners allow it. The margin: J at a corner is the
+// boundary's, which the later rounds' transfers reproduce up to round-off.
+std::string corners_rule_out(const BoundaryCornerMinima& m, const QualityFloor& good) {
+  constexpr double margin = 1e-9;
+  auto at = [](std::ostringstream& s, const BoundaryCornerQuality& q) {
+    s << "its corner at (" << q.at.x() << ", " << q.at.y() << "), where the boundary curves meet at ";
+    s.precision(3);
+    s << q.angle_degrees << " degrees, fixes ";
+  };
+  std::ostringstream s;
+  if (m.scaled.scaled_jacobian < good.scaled_jacobian - margin) {
+    at(s, m.scaled);
+    s << "the scaled Jacobian at " << m.scaled.scaled_jacobian << ", below " << good.scaled_jacobian;
+  } else if (m.mean_ratio.mean_ratio < good.mean_ratio - margin) {
+    at(s, m.mean_ratio);
+    s << "J_r at " << m.mean_ratio.mean_ratio << ", below " << good.mean_ratio;
+  }
+  return s.str();
 }
 
 // The worse of the two figures: how maps that are not both good are ranked.
@@ -383,32 +405,76 @@ DomainParameterization parameterize_domain(const Domain& input, const Parameteri
   QualityFloor& skip = first.polish_skip;
   skip.scaled_jacobian = std::max(skip.scaled_jacobian, 0.5 * c.good.scaled_jacobian);
   skip.mean_ratio = std::max(skip.mean_ratio, 0.25 * c.good.mean_ratio);
-  ParameterizationResult single = run_parameterization(domain.outer, serial, first, on_iteration);
-  const DenseMapQuality& q = single.dense_quality;
-  const bool certified = !adaptive.certify || single.certified_valid();
-  const bool good = certified && single.map && reaches_good_quality(q, c);
-  // A first try cut short by its round limit is run again in full, so that
-  // auto gives what layout single gives wherever it keeps one patch.
-  const bool cut_short = first.max_adapt < adaptive.max_adapt &&
-                         single.stop_reason.rfind("reached `max_adapt`", 0) == 0;
-  if (good) drop_layout();
-  if ((good || !quad_mesher_available()) && cut_short)
-    single = run_parameterization(domain.outer, options, adaptive, on_iteration);
-  if (good || !quad_mesher_available()) {
-    out.layout = "single";
-    out.reason = good ? "one patch is certified and good over the whole map (" + figures(q) + ")"
-                      : "this build has no quad mesher";
-    out.single.emplace(std::move(single));
-    return out;
+  // A try whose corners already rule out the thresholds stops once its
+  // boundary is frozen, before its untangling: J at the corners of the square
+  // is the boundary's, and the whole-map minima cannot exceed it
+  // (corner_quality.h; a corner on a nearly straight coast caps the scaled
+  // Jacobian at the sine of its angle). Its figures are needed only where the
+  // layout is neither good nor at least as good as those corners: the try is
+  // then run again without the stop, so that every choice is the one the
+  // whole try would give.
+  std::optional<BoundaryCornerMinima> corners;
+  if (quad_mesher_available())  // (else one patch is all there is)
+    first.stop_when_boundary_frozen = [&c, &corners](const TSplineMap& map) {
+      corners = boundary_corner_minima(map);
+      return corners_rule_out(*corners, c.good);
+    };
+  std::optional<ParameterizationResult> single;
+  std::string stopped;
+  try {
+    single.emplace(run_parameterization(domain.outer, serial, first, on_iteration));
+  } catch (const ParameterizationStopped& e) {
+    stopped = e.what();
   }
-  std::string why = !certified ? std::string("one patch is not certified after ") +
-                                     std::to_string(first.max_adapt) + " adaptive rounds"
-                               : "one patch is certified but poor over the whole map (" + figures(q) + ")";
+  DenseMapQuality q;
+  bool certified = false, cut_short = false;
+  auto assess = [&] {
+    q = single->dense_quality;
+    certified = !adaptive.certify || single->certified_valid();
+    // A first try cut short by its round limit is run again in full, so that
+    // auto gives what layout single gives wherever it keeps one patch.
+    cut_short = first.max_adapt < adaptive.max_adapt && single->stop_reason.rfind("reached `max_adapt`", 0) == 0;
+  };
+  auto try_in_full = [&] {
+    if (single) return;
+    AdaptiveOptions again = first;
+    again.stop_when_boundary_frozen = nullptr;
+    report_step(serial.progress, "layout", "one patch tried again to the end, to compare");
+    single.emplace(run_parameterization(domain.outer, serial, again, on_iteration));
+    assess();
+  };
+  if (single) {
+    assess();
+    const bool good = certified && single->map && reaches_good_quality(q, c);
+    if (good) drop_layout();
+    if ((good || !quad_mesher_available()) && cut_short)
+      single = run_parameterization(domain.outer, options, adaptive, on_iteration);
+    if (good || !quad_mesher_available()) {
+      out.layout = "single";
+      out.reason = good ? "one patch is certified and good over the whole map (" + figures(q) + ")"
+                        : "this build has no quad mesher";
+      out.single.emplace(std::move(*single));
+      return out;
+    }
+  }
+  std::string why = !single      ? "one patch cannot be good: " + stopped
+                    : !certified ? std::string("one patch is not certified after ") +
+                                       std::to_string(first.max_adapt) + " adaptive rounds"
+                                 : "one patch is certified but poor over the whole map (" + figures(q) + ")";
   report_step(serial.progress, "layout", why + ": building a quad layout");
   try {
     run_quad(why);
     if (!adaptive.certify || out.patches->certified_valid()) {
       const DenseMapQuality lq = dense_figures(*out.patches);
+      // The stopped try's figures are at most its corners': a layout kept over
+      // those is kept over the try.
+      DenseMapQuality at_corners;
+      if (corners) at_corners.min_scaled = corners->scaled.scaled_jacobian, at_corners.min_mean_ratio = corners->mean_ratio.mean_ratio;
+      if (!single && keep_layout_over_single(lq, at_corners, true, c)) {
+        out.single_corners = corners;
+        return out;
+      }
+      try_in_full();
       if (keep_layout_over_single(lq, q, certified, c)) {
         out.rejected_single = q;
         return out;
@@ -423,12 +489,13 @@ DomainParameterization parameterize_domain(const Domain& input, const Parameteri
   // The quad layout failed or did worse: the single patch, with every adaptive
   // round it may take (what layout single gives).
   report_step(serial.progress, "layout", why);
+  try_in_full();
   out.patches.reset();
   out.quad_stats.reset();
   out.layout = "single";
   out.reason = why;
   if (cut_short) single = run_parameterization(domain.outer, options, adaptive, on_iteration);
-  out.single.emplace(std::move(single));
+  out.single.emplace(std::move(*single));
   return out;
 }
 

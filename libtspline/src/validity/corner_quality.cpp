@@ -32,4 +32,16 @@ std::optional<BoundaryCornerQuality> worst_boundary_corner(const TSplineMap& map
   return worst;
 }
 
+BoundaryCornerMinima boundary_corner_minima(const TSplineMap& map) {
+  BoundaryCornerMinima m;
+  for (int k = 0; k < 4; ++k) {
+    std::array<bool, 4> one{};
+    one[k] = true;
+    const BoundaryCornerQuality q = *worst_boundary_corner(map, one);
+    if (k == 0 || q.scaled_jacobian < m.scaled.scaled_jacobian) m.scaled = q;
+    if (k == 0 || q.mean_ratio < m.mean_ratio.mean_ratio) m.mean_ratio = q;
+  }
+  return m;
+}
+
 }  // namespace tspline

@@ -91,6 +91,19 @@ struct AdaptiveOptions {
   bool certify = true;
   /// How det J > 0 is certified, by this loop and by the untangling it runs (one owner).
   CertificationOptions certification;
+  /// Called once the first round's boundary curve is frozen (after its checks
+  /// and refits, before any untangling): a non-empty text stops the run, which
+  /// throws ParameterizationStopped(text). From there on the boundary, and with
+  /// it J at the corners of the square (corner_quality.h), stay as in the map
+  /// passed. Lets a caller that needs a given quality give up on a map whose
+  /// corners already rule it out.
+  std::function<std::string(const TSplineMap&)> stop_when_boundary_frozen;
+};
+
+/// Thrown where AdaptiveOptions::stop_when_boundary_frozen stopped the run;
+/// what() is its text.
+struct ParameterizationStopped : std::runtime_error {
+  using std::runtime_error::runtime_error;
 };
 
 struct AdaptIteration {

@@ -24,6 +24,7 @@
 #include "tspline/layout/quad_layout.h"
 #include "tspline/multipatch/multipatch_parameterization.h"
 #include "tspline/pipeline/adaptive_parameterization.h"
+#include "tspline/validity/corner_quality.h"
 
 namespace tspline {
 
@@ -70,6 +71,11 @@ struct DomainParameterization {
   std::optional<QuadLayoutStats> quad_stats;
   /// The single-patch first try of `auto` that was not kept (whole-map figures), if any.
   std::optional<DenseMapQuality> rejected_single;
+  /// Where auto's single-patch first try was stopped at its frozen boundary
+  /// because its corners rule out the thresholds (and the layout kept is at
+  /// least as good as those corners): the corners with the least scaled
+  /// Jacobian and the least J_r, upper bounds of what the whole try would reach.
+  std::optional<BoundaryCornerMinima> single_corners;
 };
 
 /// Whether whole-map figures (dense samples) reach auto's thresholds: scaled

@@ -37,4 +37,15 @@ std::optional<BoundaryCornerQuality> worst_boundary_corner(const TSplineMap& map
                                                            const std::array<bool, 4>& counted = {true, true, true,
                                                                                                  true});
 
+/// The corners of [0,1]^2 where map's scaled Jacobian is least (`scaled`)
+/// and where its J_r is least (`mean_ratio`): upper bounds of the whole-map
+/// minima of the two figures, fixed once the boundary is (the two may be at
+/// different corners). Lets a caller drop a map whose corners already rule
+/// out the quality it needs before its interior is optimized.
+struct BoundaryCornerMinima {
+  BoundaryCornerQuality scaled;
+  BoundaryCornerQuality mean_ratio;
+};
+BoundaryCornerMinima boundary_corner_minima(const TSplineMap& map);
+
 }  // namespace tspline
