@@ -107,8 +107,13 @@ Pool& pool() {
 
 }  // namespace
 
+unsigned hardware_threads() {
+  static const unsigned n = std::max(1u, std::thread::hardware_concurrency());
+  return n;
+}
+
 int pool_threads() {
-  static const int n = std::clamp(static_cast<int>(std::thread::hardware_concurrency()), 1, 16);
+  static const int n = std::min(static_cast<int>(hardware_threads()), 16);
   return n;
 }
 

@@ -9,6 +9,8 @@
 #include <optional>
 #include <sstream>
 #include <thread>
+
+#include "tspline/detail/thread_pool.h"
 #include <utility>
 
 #include "tspline/boundary/corners.h"
@@ -27,7 +29,7 @@ namespace {
 // have finished (no body starts after one has thrown).
 template <class Body>
 void for_each_concurrently(std::size_t n, Body&& body) {
-  const std::size_t threads = std::min<std::size_t>(n, std::max(1u, std::thread::hardware_concurrency()));
+  const std::size_t threads = std::min<std::size_t>(n, detail::hardware_threads());
   std::atomic<std::size_t> next{0};
   std::atomic<bool> failed{false};
   std::vector<std::exception_ptr> errors(n);

@@ -264,7 +264,7 @@ MapEnergy::MapEnergy(const TSplineMap& map, const MapEnergyOptions& opt)
   if (!(opt.theta >= 0.0 && opt.theta < 1.0)) throw toolkit::InputError("MapEnergy: theta must be in [0, 1)");
   if (opt.max_sample_level < 0 || opt.max_sample_level > 4)
     throw toolkit::InputError("MapEnergy: max_sample_level must be in [0, 4]");
-  if (options_.threads <= 0) options_.threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  if (options_.threads <= 0) options_.threads = static_cast<int>(detail::hardware_threads());
   options_.threads = std::min(options_.threads, 16);
 
   // Samples per level: the n points of the rule on each of the 2^l equal

@@ -11,6 +11,8 @@
 #include <stdexcept>
 #include <thread>
 
+#include "tspline/detail/thread_pool.h"
+
 #include "tspline/detail/bernstein.h"
 #include "tspline/detail/element_jacobian.h"
 #include "toolkit/errors.h"
@@ -493,7 +495,7 @@ MapQualityBounds certified_map_quality(const BezierExtraction& extraction, const
   // the figures do not depend on the number of threads.
   constexpr std::size_t kChunk = 64;
   const std::size_t chunks = (es.size() + kChunk - 1) / kChunk;
-  const unsigned hw = std::max(1u, std::thread::hardware_concurrency());
+  const unsigned hw = detail::hardware_threads();
   const std::size_t threads =
       std::max<std::size_t>(1, std::min<std::size_t>(chunks, opt.threads > 0 ? opt.threads : hw));
   std::atomic<std::size_t> next{0};
