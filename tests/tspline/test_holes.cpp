@@ -419,18 +419,21 @@ TEST_SUITE("holes") {
   TEST_CASE("stop_when: the run stops at the first patch it names, later patches are not run") {
     const Domain d = read_text_domain(holes_file("plate_with_hole.txt"));
     tspline::MultiPatchOptions multi;
-    multi.threads = 1;  // the patches in order
+    multi.threads = 1;  // the patches one after the other
     std::vector<std::size_t> seen;
     multi.stop_when = [&seen](std::size_t p, const tspline::ParameterizationResult& r) {
       seen.push_back(p);
       CHECK(r.map);
-      return p == 2 ? std::string("is the one asked for") : std::string();
+      return seen.size() == 3 ? std::string("is the one asked for") : std::string();
     };
     const std::string what = message_of<tspline::MultiPatchStopped>(
         [&] { (void)tspline::run_multipatch_parameterization(d, std::nullopt, {}, {}, multi); });
-    CHECK(what == "patch 2 is the one asked for");
-    CHECK(seen == std::vector<std::size_t>{0, 1, 2});
-    // Never stopping: every patch once (the first round), the same map as without.
+    REQUIRE(seen.size() == 3);
+    CHECK(what == "patch " + std::to_string(seen[2]) + " is the one asked for");
+    const std::vector<std::size_t> stopped = seen;
+    // Never stopping: every patch once (the first round), the same map as
+    // without; with a stop_when the patches run sharpest corner first (the
+    // least sine of a patch polygon's corner angles), the run above in the same order.
     seen.clear();
     multi.stop_when = [&seen](std::size_t p, const tspline::ParameterizationResult&) {
       seen.push_back(p);
@@ -439,8 +442,29 @@ TEST_SUITE("holes") {
     const tspline::MultiPatchResult R =
         tspline::run_multipatch_parameterization(d, std::nullopt, {}, {}, multi);
     REQUIRE(seen.size() == R.patches.size());
-    for (std::size_t p = 0; p < seen.size(); ++p) CHECK(seen[p] == p);
+    std::vector<std::size_t> sorted = seen;
+    std::sort(sorted.begin(), sorted.end());
+    for (std::size_t p = 0; p < sorted.size(); ++p) CHECK(sorted[p] == p);
+    CHECK(std::equal(stopped.begin(), stopped.end(), seen.begin()));
+    auto worst_sine = [&R](std::size_t p) {
+      const tspline::Patch& patch = R.layout.patches[p];
+      const auto& v = patch.polygon.vertices;
+      double w = 1.0;
+      for (const std::size_t c : patch.corners) {
+        const Eigen::Vector2d a = v[(c + 1) % v.size()] - v[c], b = v[(c + v.size() - 1) % v.size()] - v[c];
+        w = std::min(w, (a.x() * b.y() - a.y() * b.x()) / (a.norm() * b.norm()));
+      }
+      return w;
+    };
+    for (std::size_t k = 0; k + 1 < seen.size(); ++k) CHECK(worst_sine(seen[k]) <= worst_sine(seen[k + 1]));
+    CHECK(worst_sine(seen.front()) < worst_sine(seen.back()));  // (the plate's patches differ)
     CHECK(R.certified_valid());
+    // Without a stop_when the same map.
+    multi.stop_when = nullptr;
+    const tspline::MultiPatchResult plain = tspline::run_multipatch_parameterization(d, std::nullopt, {}, {}, multi);
+    REQUIRE(plain.patches.size() == R.patches.size());
+    for (std::size_t p = 0; p < R.patches.size(); ++p)
+      CHECK(plain.patches[p].map->control_points() == R.patches[p].map->control_points());
   }
 
   TEST_CASE("multi-patch map of the flange (bore and four bolt holes)") {
