@@ -11,9 +11,9 @@
 
 #include "separable_maps.h"
 #include "test_support.h"
-#include "tspline/validity/corner_quality.h"
 #include "tspline/io/polygon_reader.h"
 #include "tspline/pipeline/adaptive_parameterization.h"
+#include "tspline/validity/corner_quality.h"
 #include "tspline/validity/map_energy.h"
 
 namespace {
@@ -110,7 +110,8 @@ TEST_SUITE("corner_quality") {
       tspline::AdaptiveOptions ad;
       std::array<Eigen::Matrix2d, 4> frozen;
       int calls = 0;
-      const std::array<Vector2d, 4> corners = {Vector2d(0, 0), Vector2d(1, 0), Vector2d(1, 1), Vector2d(0, 1)};
+      const std::array<Vector2d, 4> corners = {Vector2d(0, 0), Vector2d(1, 0), Vector2d(1, 1),
+                                               Vector2d(0, 1)};
       ad.stop_when_boundary_frozen = [&](const tspline::TSplineMap& map) {
         ++calls;
         for (int k = 0; k < 4; ++k) frozen[k] = map.jacobian(corners[k]);
@@ -128,7 +129,8 @@ TEST_SUITE("corner_quality") {
       }
       // A text stops the run there.
       ad.stop_when_boundary_frozen = [](const tspline::TSplineMap&) { return std::string("enough"); };
-      CHECK_THROWS_WITH_AS((void)tspline::run_parameterization(poly, {}, ad), "enough", tspline::ParameterizationStopped);
+      CHECK_THROWS_WITH_AS((void)tspline::run_parameterization(poly, {}, ad), "enough",
+                           tspline::ParameterizationStopped);
     }
   }
 

@@ -461,7 +461,8 @@ TEST_SUITE("holes") {
     CHECK(R.certified_valid());
     // Without a stop_when the same map.
     multi.stop_when = nullptr;
-    const tspline::MultiPatchResult plain = tspline::run_multipatch_parameterization(d, std::nullopt, {}, {}, multi);
+    const tspline::MultiPatchResult plain =
+        tspline::run_multipatch_parameterization(d, std::nullopt, {}, {}, multi);
     REQUIRE(plain.patches.size() == R.patches.size());
     for (std::size_t p = 0; p < R.patches.size(); ++p)
       CHECK(plain.patches[p].map->control_points() == R.patches[p].map->control_points());

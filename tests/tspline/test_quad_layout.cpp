@@ -513,18 +513,21 @@ TEST_SUITE("quad_layout") {
     CHECK(sj.scaled_jacobian < 0.01);
     CHECK(sj.angle_degrees > 179.0);
     // The scaled Jacobian at a corner is the sine of the angle between the boundary curves.
-    CHECK(sj.scaled_jacobian == doctest::Approx(std::sin(sj.angle_degrees * std::numbers::pi / 180.0)).epsilon(1e-6));
+    CHECK(sj.scaled_jacobian ==
+          doctest::Approx(std::sin(sj.angle_degrees * std::numbers::pi / 180.0)).epsilon(1e-6));
     CHECK(A.single_corners->mean_ratio.mean_ratio <= sj.mean_ratio);
     // The try stopped before its untangling and its map's check: no such step
     // before the stop (the layout's patches' steps, run ahead, are held until
     // the layout is kept, after it).
-    const auto stop = std::find_if(steps.begin(), steps.end(),
-                                   [](const std::string& m) { return contains(m, "stopped: its corner at ("); });
+    const auto stop = std::find_if(steps.begin(), steps.end(), [](const std::string& m) {
+      return contains(m, "stopped: its corner at (");
+    });
     REQUIRE(stop != steps.end());
     CHECK(std::none_of(steps.begin(), stop, [](const std::string& m) {
       return contains(m, "untangling:") || contains(m, "map (iteration");
     }));
-    CHECK(std::any_of(stop, steps.end(), [](const std::string& m) { return contains(m, "patch 0: map (iteration 0)"); }));
+    CHECK(std::any_of(stop, steps.end(),
+                      [](const std::string& m) { return contains(m, "patch 0: map (iteration 0)"); }));
     c.layout = tspline::LayoutMode::Quad;
     po.progress = nullptr;
     const tspline::DomainParameterization Q = tspline::parameterize_domain(disk, po, ad, c);

@@ -98,7 +98,6 @@ double worst_corner_sine(const Patch& patch) {
   return worst;
 }
 
-
 /// The least of value(r) over the patches' results (+infinity for none).
 template <class Value>
 double min_over_patches(const std::vector<ParameterizationResult>& patches, Value value) {
@@ -268,7 +267,8 @@ MultiPatchResult run_multipatch_parameterization(const Domain& domain, PatchLayo
     if (round == 0 && multi.stop_when) {
       std::vector<double> sine(todo.size());
       for (std::size_t i = 0; i < todo.size(); ++i) sine[i] = worst_corner_sine(R.layout.patches[todo[i]]);
-      std::stable_sort(order.begin(), order.end(), [&sine](std::size_t a, std::size_t b) { return sine[a] < sine[b]; });
+      std::stable_sort(order.begin(), order.end(),
+                       [&sine](std::size_t a, std::size_t b) { return sine[a] < sine[b]; });
     }
     for_each_patch(todo.size(), threads, [&](std::size_t k) {
       check_cancel();

@@ -433,7 +433,8 @@ DomainParameterization parameterize_domain(const Domain& input, const Parameteri
     certified = !adaptive.certify || single->certified_valid();
     // A first try cut short by its round limit is run again in full, so that
     // auto gives what layout single gives wherever it keeps one patch.
-    cut_short = first.max_adapt < adaptive.max_adapt && single->stop_reason.rfind("reached `max_adapt`", 0) == 0;
+    cut_short =
+        first.max_adapt < adaptive.max_adapt && single->stop_reason.rfind("reached `max_adapt`", 0) == 0;
   };
   auto try_in_full = [&] {
     if (single) return;
@@ -469,7 +470,10 @@ DomainParameterization parameterize_domain(const Domain& input, const Parameteri
       // The stopped try's figures are at most its corners': a layout kept over
       // those is kept over the try.
       DenseMapQuality at_corners;
-      if (corners) at_corners.min_scaled = corners->scaled.scaled_jacobian, at_corners.min_mean_ratio = corners->mean_ratio.mean_ratio;
+      if (corners) {
+        at_corners.min_scaled = corners->scaled.scaled_jacobian;
+        at_corners.min_mean_ratio = corners->mean_ratio.mean_ratio;
+      }
       if (!single && keep_layout_over_single(lq, at_corners, true, c)) {
         out.single_corners = corners;
         return out;

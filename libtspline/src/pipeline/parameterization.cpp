@@ -2,22 +2,21 @@
 
 #include <algorithm>
 #include <atomic>
-#include <exception>
-#include <mutex>
 #include <cmath>
+#include <exception>
 #include <limits>
+#include <mutex>
 #include <optional>
 #include <sstream>
 #include <thread>
-
-#include "tspline/detail/thread_pool.h"
 #include <utility>
 
 #include "tspline/boundary/corners.h"
-#include "tspline/errors.h"
 #include "tspline/boundary/plane.h"
 #include "tspline/boundary/polygon_validation.h"
 #include "tspline/detail/stage_clock.h"
+#include "tspline/detail/thread_pool.h"
+#include "tspline/errors.h"
 #include "tspline/pipeline/front_optimization.h"
 
 namespace tspline {

@@ -11,12 +11,11 @@
 #include <stdexcept>
 #include <thread>
 
-#include "tspline/detail/thread_pool.h"
-
-#include "tspline/detail/bernstein.h"
-#include "tspline/detail/element_jacobian.h"
 #include "toolkit/errors.h"
 #include "toolkit/timing.h"
+#include "tspline/detail/bernstein.h"
+#include "tspline/detail/element_jacobian.h"
+#include "tspline/detail/thread_pool.h"
 
 namespace tspline {
 
