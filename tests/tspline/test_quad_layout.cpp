@@ -20,6 +20,7 @@
 #include "tspline/io/gis_reader.h"
 #include "tspline/io/polygon_reader.h"
 #include "tspline/layout/quad_layout.h"
+#include "tspline/layout/quad_layout_memo.h"
 #include "tspline/layout/quad_mesher.h"
 #include "tspline/layout/ring_nodes.h"
 #include "tspline/layout/size_field.h"
@@ -73,6 +74,22 @@ void check_layout_tiles(const tspline::Domain& d, const tspline::PatchLayout& L)
   CHECK(area == doctest::Approx(tspline::domain_area(d)).epsilon(1e-12));
   // Every cut is the side of exactly two patches.
   CHECK(L.interfaces.size() == L.cuts.size());
+}
+
+// Two layouts the same to the last bit: patch polygons, corners and the
+// optimization's counts and figures.
+void check_same_layout(const tspline::QuadLayout& a, const tspline::QuadLayout& b) {
+  REQUIRE(a.layout.patches.size() == b.layout.patches.size());
+  for (std::size_t p = 0; p < a.layout.patches.size(); ++p) {
+    CHECK(a.layout.patches[p].polygon.vertices == b.layout.patches[p].polygon.vertices);
+    CHECK(a.layout.patches[p].corners == b.layout.patches[p].corners);
+  }
+  CHECK(a.ring_nodes == b.ring_nodes);
+  CHECK(a.stats.rotations == b.stats.rotations);
+  CHECK(a.stats.optimization_sweeps == b.stats.optimization_sweeps);
+  CHECK(a.stats.repair_rounds == b.stats.repair_rounds);
+  CHECK(a.stats.corner_mean_ratio == b.stats.corner_mean_ratio);
+  CHECK(a.stats.corner_scaled_jacobian == b.stats.corner_scaled_jacobian);
 }
 
 }  // namespace
@@ -258,6 +275,40 @@ TEST_SUITE("quad_layout") {
     o.start_ring_nodes = {{1.0, 0.5}};
     CHECK(contains(message_of<tspline::InputError>([&] { (void)tspline::build_quad_layout(d, o); }),
                    "not ascending arc lengths"));
+  }
+
+  TEST_CASE("a memo shared by two layouts of one domain: the second takes the first's mesh and first pass, same result") {
+    if (!tspline::quad_mesher_available()) return;
+    tspline::DomainCleaningOptions how;
+    how.blunt_tips_below_degrees = 17.5;
+    const tspline::Domain d = tspline::validate_domain(
+        {tspline::io::read_polygon(std::string(TSPLINE_TEST_DATA_DIR) + "/coastlines/bali.txt"), {}}, how);
+    // The pillowed layout from the first layout's ring nodes, as parameterize_domain makes it, without a memo.
+    const tspline::QuadLayout sheets = tspline::build_quad_layout(d);
+    REQUIRE(sheets.stats.corner_sheets >= 1);
+    tspline::QuadLayoutOptions pillow;
+    pillow.corner_sheets = false;
+    pillow.start_ring_nodes = sheets.ring_nodes;
+    const tspline::QuadLayout pillowed = tspline::build_quad_layout(d, pillow);
+    // The same two with one memo.
+    tspline::QuadLayoutOptions first;
+    first.memo = tspline::make_quad_layout_memo();
+    const tspline::QuadLayout sheets_memo = tspline::build_quad_layout(d, first);
+    check_same_layout(sheets_memo, sheets);
+    const std::size_t hits_first = first.memo->hits();
+    pillow.memo = first.memo;
+    const tspline::QuadLayout pillowed_memo = tspline::build_quad_layout(d, pillow);
+    check_same_layout(pillowed_memo, pillowed);
+    CHECK(pillowed_memo.stats.pillowed_rings == 1);
+    // Its first mesh and that mesh's first pass came from the memo.
+    CHECK(first.memo->hits() >= hits_first + 2);
+    // Another domain is not served by this memo: the same layout as without it, no hit.
+    const tspline::Domain neck = tspline::validate_domain({dumbbell(1.0), {}});
+    tspline::QuadLayoutOptions other;
+    other.memo = first.memo;
+    const std::size_t hits_before = first.memo->hits();
+    check_same_layout(tspline::build_quad_layout(neck, other), tspline::build_quad_layout(neck));
+    CHECK(first.memo->hits() == hits_before);
   }
 
   TEST_CASE("quad layout of a domain whose holes have needles at vertex 0: cleaned, then laid out and mapped") {

@@ -16,6 +16,7 @@
 #include "tspline/layout/layout_optimizer.h"
 #include "tspline/layout/layout_quality.h"
 #include "tspline/layout/layout_topology.h"
+#include "tspline/layout/quad_layout_memo.h"
 #include "tspline/layout/quad_mesher.h"
 #include "tspline/layout/ring_geometry.h"
 #include "toolkit/timing.h"
@@ -93,10 +94,14 @@ void report_optimization(const LayoutOptimizationReport& rep, QuadLayoutStats& s
 //     again while rotations are kept.
 // `start` becomes the mesh the checks fall back to (the mesher's nodes, after
 // any pillowing).
+// `first_done`: the first pass (step 1 and, at level 2, the first rotations)
+// as an earlier layout of the same domain made it from the same mesh
+// (quad_layout_memo.h), instead of making it again; `first_made`: where the
+// first pass made here is left.
 void optimize_layout(LayoutMesh& m, LayoutMesh& start, const LayoutRings& R, const LayoutQuality& Q,
                      const LayoutAdmissible& admissible, int level, bool corner_sheets, bool guard_corners,
-                     QuadLayoutStats& st,
-                     const std::atomic<bool>* cancel) {
+                     QuadLayoutStats& st, const std::atomic<bool>* cancel, const LayoutFirstPass* first_done,
+                     LayoutFirstPass* first_made) {
   st.rotations = 0;
   st.openings = 0;
   st.optimization_sweeps = 0;
@@ -115,13 +120,19 @@ void optimize_layout(LayoutMesh& m, LayoutMesh& start, const LayoutRings& R, con
     return rr;
   };
   if (debugging()) lap();
-  if (level >= 1) {
+  if (level >= 1 && first_done) {
+    m = first_done->mesh;
+    st.rotations = first_done->rotations;
+    st.optimization_sweeps = first_done->optimization_sweeps;
+    if (debugging()) std::fprintf(stderr, "layout first pass: an earlier layout's of the same mesh\n");
+  } else if (level >= 1) {
     smooth_layout_kstar(m, R);
     if (debugging()) std::fprintf(stderr, "layout K*: %.2f s\n", lap());
     LayoutOptimizationOptions quick = full;
     quick.max_sweeps = 8;
     report_optimization(optimize_layout_nodes(m, Q, admissible, {}, quick), st);
     if (level >= 2) rotate();
+    if (first_made) *first_made = {m, st.rotations, st.optimization_sweeps};
   }
   const std::vector<int> flat_corners = flat_ring_corners(m, Q);
   if (!flat_corners.empty()) {
@@ -235,6 +246,8 @@ class QuadLayoutBuilder {
   void make_patch_layout(const LayoutMesh& m, const LayoutTopology& t);
   void recover_from_rejected_layout(const std::string& what);
   void fill_stats(const LayoutMesh& m, const LayoutTopology& t);
+
+  QuadLayoutMemo::Rings memo_domain() const;
 
   const Domain& d_;
   const QuadLayoutOptions& o_;
@@ -359,8 +372,14 @@ QuadLayout QuadLayoutBuilder::build() {
     note(mesh_name() + ": " + std::to_string(m.quads.size()) + " quads from the mesher; optimizing them" +
          (level_ == 2 ? "" : " without edge rotations"));
     const auto t_opt = std::chrono::steady_clock::now();
+    std::optional<LayoutFirstPass> first_done;
+    LayoutFirstPass first_made;
+    if (o_.memo && level_ >= 1)
+      first_done = o_.memo->first_pass(memo_domain(), size_options_, nodes_, level_, guard_corners_);
     optimize_layout(m, start, R_, quality_, admissible_, level_, o_.corner_sheets, guard_corners_, out_.stats,
-                    o_.cancel);
+                    o_.cancel, first_done ? &*first_done : nullptr, &first_made);
+    if (o_.memo && level_ >= 1 && !first_done)
+      o_.memo->store_first_pass(memo_domain(), size_options_, nodes_, level_, guard_corners_, first_made);
     if (debugging())
       std::fprintf(stderr, "layout round %d: mesh %zu quads at %.2f s, optimized in %.2f s\n", round, m.quads.size(),
                    std::chrono::duration<double>(t_opt - t0_).count(), toolkit::seconds_since(t_opt));
@@ -380,6 +399,12 @@ QuadLayout QuadLayoutBuilder::build() {
     out_.ring_nodes = nodes_;
     return std::move(out_);
   }
+}
+
+QuadLayoutMemo::Rings QuadLayoutBuilder::memo_domain() const {
+  QuadLayoutMemo::Rings rings{d_.outer.vertices};
+  for (const Polygon& h : d_.holes) rings.push_back(h.vertices);
+  return rings;
 }
 
 std::size_t QuadLayoutBuilder::marked() const {
@@ -485,7 +510,11 @@ void QuadLayoutBuilder::mark_blunted_tips(const std::vector<std::vector<Eigen::V
 // marked for a node more.
 std::optional<PlanarQuadMesh> QuadLayoutBuilder::mesh(const std::vector<std::vector<Eigen::Vector2d>>& straight) {
   try {
-    return quad_mesh(straight, h_);
+    if (o_.memo)
+      if (std::optional<PlanarQuadMesh> known = o_.memo->mesh(memo_domain(), size_options_, nodes_)) return known;
+    PlanarQuadMesh made = quad_mesh(straight, h_);
+    if (o_.memo) o_.memo->store_mesh(memo_domain(), size_options_, nodes_, made);
+    return made;
   } catch (const NumericalError& e) {
     const std::string what = e.what();
     const std::size_t at = what.find("on curve ");

@@ -117,6 +117,10 @@ DomainParameterization parameterize_domain(const Domain& input, const Parameteri
   const bool holes = !input.holes.empty();
   const Domain domain = holes || c.cuts || c.layout == LayoutMode::Quad ? validate_domain(input) : input;
   DomainParameterization out;
+  // The layouts of this domain share a memo (a second layout from the same
+  // ring nodes takes the first's mesh and first optimization pass).
+  QuadLayoutOptions layout_options = c.quad;
+  if (!layout_options.memo) layout_options.memo = make_quad_layout_memo();
   if (c.cuts) {
     if (c.layout == LayoutMode::Single) throw InputError("cuts make a layout of several patches: not with layout single");
     out.layout = "cuts";
@@ -220,7 +224,7 @@ DomainParameterization parameterize_domain(const Domain& input, const Parameteri
     };
     std::string outcome;
     try {
-      QuadLayoutOptions q = c.quad;
+      QuadLayoutOptions q = layout_options;
       if (pillow) {
         q.corner_sheets = false;
         q.start_ring_nodes = first_layout.ring_nodes;  // its repairs done already
@@ -261,7 +265,7 @@ DomainParameterization parameterize_domain(const Domain& input, const Parameteri
       a = ahead.get();
     } else {
       a.valid = holes || c.layout == LayoutMode::Quad ? domain : validate_domain(input);
-      QuadLayoutOptions q = c.quad;
+      QuadLayoutOptions q = layout_options;
       q.progress = layout_progress("quad layout: ");
       a.layout = build_quad_layout(a.valid, q);
       a.explanation = a.layout.explanation();
@@ -355,7 +359,7 @@ DomainParameterization parameterize_domain(const Domain& input, const Parameteri
     ~CancelOnExit() { flag = true; }
   } cancel_on_exit{cancel};
   if (quad_mesher_available()) {
-    QuadLayoutOptions q = c.quad;
+    QuadLayoutOptions q = layout_options;
     q.cancel = &cancel;
     q.progress = layout_progress("quad layout (built while one patch is tried): ");
     // Once the layout is built, its patches are run at once, while the single

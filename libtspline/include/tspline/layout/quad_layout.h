@@ -25,6 +25,7 @@
 #include <atomic>
 #include <cstddef>
 #include <functional>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -35,6 +36,11 @@
 #include "tspline/multipatch/patch_layout.h"
 
 namespace tspline {
+
+class QuadLayoutMemo;  // quad_layout_memo.h (internal)
+
+/// A memo for the layouts of one domain (QuadLayoutOptions::memo).
+std::shared_ptr<QuadLayoutMemo> make_quad_layout_memo();
 
 struct QuadLayoutOptions {
   RingNodeOptions nodes;
@@ -61,6 +67,14 @@ struct QuadLayoutOptions {
   /// Told what each mesh round does (a large coast takes several rounds of
   /// tens of seconds each); never called from two threads at once.
   std::function<void(const std::string&)> progress;
+  /// Shared by the layouts of one domain (make_quad_layout_memo): a layout
+  /// takes from an earlier one the quad mesher's quads for the same ring nodes
+  /// and the first pass of their optimization (K* untangling, a short node
+  /// optimization, edge rotations), which are what the work itself would give
+  /// (the pillowed second layout of parameterize_domain starts from the first
+  /// layout's ring nodes, and so from its first mesh). A memo serves only the
+  /// domain and size options it was first used with. Null: nothing shared.
+  std::shared_ptr<QuadLayoutMemo> memo;
 };
 
 

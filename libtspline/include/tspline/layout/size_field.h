@@ -32,6 +32,7 @@ struct SizeFieldOptions {
   double max_size = 0.0;      ///< absolute; 0: an eighth of the bounding-box diagonal
   double across_ratio = 2.5;  ///< arc length / distance above which two samples of a ring face each other
   int grid_cells = 768;       ///< grid cells along the longer side of the bounding box
+  bool operator==(const SizeFieldOptions&) const = default;
 };
 
 class SizeField {
