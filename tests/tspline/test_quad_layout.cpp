@@ -9,9 +9,9 @@
 #include <cmath>
 #include <functional>
 #include <mutex>
+#include <numbers>
 #include <string>
 #include <thread>
-#include <numbers>
 
 #include "test_support.h"
 #include "tspline/boundary/domain.h"
@@ -277,13 +277,16 @@ TEST_SUITE("quad_layout") {
                    "not ascending arc lengths"));
   }
 
-  TEST_CASE("a memo shared by two layouts of one domain: the second takes the first's mesh and first pass, same result") {
+  TEST_CASE(
+      "a memo shared by two layouts of one domain: the second takes the first's mesh and first pass, same "
+      "result") {
     if (!tspline::quad_mesher_available()) return;
     tspline::DomainCleaningOptions how;
     how.blunt_tips_below_degrees = 17.5;
     const tspline::Domain d = tspline::validate_domain(
         {tspline::io::read_polygon(std::string(TSPLINE_TEST_DATA_DIR) + "/coastlines/bali.txt"), {}}, how);
-    // The pillowed layout from the first layout's ring nodes, as parameterize_domain makes it, without a memo.
+    // The pillowed layout from the first layout's ring nodes, as parameterize_domain makes it, without a
+    // memo.
     const tspline::QuadLayout sheets = tspline::build_quad_layout(d);
     REQUIRE(sheets.stats.corner_sheets >= 1);
     tspline::QuadLayoutOptions pillow;

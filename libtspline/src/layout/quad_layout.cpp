@@ -8,9 +8,11 @@
 #include <numbers>
 #include <optional>
 #include <set>
-#include <unordered_map>
 #include <sstream>
+#include <unordered_map>
 
+#include "toolkit/timing.h"
+#include "tspline/boundary/plane.h"
 #include "tspline/errors.h"
 #include "tspline/layout/layout_kstar.h"
 #include "tspline/layout/layout_optimizer.h"
@@ -19,8 +21,6 @@
 #include "tspline/layout/quad_layout_memo.h"
 #include "tspline/layout/quad_mesher.h"
 #include "tspline/layout/ring_geometry.h"
-#include "toolkit/timing.h"
-#include "tspline/boundary/plane.h"
 
 namespace tspline {
 namespace {
@@ -511,7 +511,8 @@ void QuadLayoutBuilder::mark_blunted_tips(const std::vector<std::vector<Eigen::V
 std::optional<PlanarQuadMesh> QuadLayoutBuilder::mesh(const std::vector<std::vector<Eigen::Vector2d>>& straight) {
   try {
     if (o_.memo)
-      if (std::optional<PlanarQuadMesh> known = o_.memo->mesh(memo_domain(), size_options_, nodes_)) return known;
+      if (std::optional<PlanarQuadMesh> known = o_.memo->mesh(memo_domain(), size_options_, nodes_))
+        return known;
     PlanarQuadMesh made = quad_mesh(straight, h_);
     if (o_.memo) o_.memo->store_mesh(memo_domain(), size_options_, nodes_, made);
     return made;

@@ -37,7 +37,8 @@ void QuadLayoutMemo::store_mesh(const Rings& domain, const SizeFieldOptions& siz
 }
 
 std::optional<LayoutFirstPass> QuadLayoutMemo::first_pass(const Rings& domain, const SizeFieldOptions& size,
-                                                          const RingNodes& nodes, int level, bool guard_corners) {
+                                                          const RingNodes& nodes, int level,
+                                                          bool guard_corners) {
   std::lock_guard<std::mutex> lock(mutex_);
   if (!serves(domain, size)) return std::nullopt;
   for (const PassEntry& e : passes_)
@@ -48,8 +49,9 @@ std::optional<LayoutFirstPass> QuadLayoutMemo::first_pass(const Rings& domain, c
   return std::nullopt;
 }
 
-void QuadLayoutMemo::store_first_pass(const Rings& domain, const SizeFieldOptions& size, const RingNodes& nodes,
-                                      int level, bool guard_corners, const LayoutFirstPass& pass) {
+void QuadLayoutMemo::store_first_pass(const Rings& domain, const SizeFieldOptions& size,
+                                      const RingNodes& nodes, int level, bool guard_corners,
+                                      const LayoutFirstPass& pass) {
   std::lock_guard<std::mutex> lock(mutex_);
   if (!serves(domain, size)) return;
   for (const PassEntry& e : passes_)

@@ -36,7 +36,8 @@ class QuadLayoutMemo {
   using Rings = std::vector<std::vector<Eigen::Vector2d>>;
   using RingNodes = std::vector<std::vector<double>>;
 
-  std::optional<PlanarQuadMesh> mesh(const Rings& domain, const SizeFieldOptions& size, const RingNodes& nodes);
+  std::optional<PlanarQuadMesh> mesh(const Rings& domain, const SizeFieldOptions& size,
+                                     const RingNodes& nodes);
   void store_mesh(const Rings& domain, const SizeFieldOptions& size, const RingNodes& nodes,
                   const PlanarQuadMesh& mesh);
 
