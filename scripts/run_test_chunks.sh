@@ -5,8 +5,9 @@
 # order depends on it, every suite of the executable runs); a suite that is
 # not listed starts after them, in doctest's listing order.
 # Each suite's output is printed whole, in listing order, with its own doctest
-# summary; then one line with the totals. Exits non-zero if a suite fails or if
-# the suites did not run every test case of the executable exactly once.
+# summary and its wall seconds in its header; then one line with the totals.
+# Exits non-zero if a suite fails or if the suites did not run every test case
+# of the executable exactly once.
 #   bash scripts/run_test_chunks.sh BUILD/tests/unit_tests [doctest options]
 set -euo pipefail
 bin=$1
@@ -30,14 +31,14 @@ done
 logs=$(mktemp -d)
 trap 'rm -rf "$logs"' EXIT
 printf '%s\n' "${order[@]}" |
-  xargs -P "$jobs" -I{} bash -c '"$0" --test-suite="{}" "${@:2}" > "$1/{}.log" 2>&1; echo $? > "$1/{}.rc"' \
+  xargs -P "$jobs" -I{} bash -c 's=$SECONDS; "$0" --test-suite="{}" "${@:2}" > "$1/{}.log" 2>&1; echo $? > "$1/{}.rc"; echo $((SECONDS - s)) > "$1/{}.sec"' \
     "$bin" "$logs" "$@"
 status=0
 cases=0
 passed=0
 failed=0
 for s in "${suites[@]}"; do
-  echo "== test suite $s"
+  echo "== test suite $s ($(cat "$logs/$s.sec" 2>/dev/null || echo '?') s)"
   cat "$logs/$s.log"
   [ "$(cat "$logs/$s.rc" 2>/dev/null)" = 0 ] || status=1
   line=$(grep '^\[doctest\] test cases:' "$logs/$s.log" || true)

@@ -76,6 +76,14 @@ void check_layout_tiles(const tspline::Domain& d, const tspline::PatchLayout& L)
   CHECK(L.interfaces.size() == L.cuts.size());
 }
 
+// The unit square, one patch at initial level 2, default adaptive options.
+struct UnitSquareAtLevel2 {
+  UnitSquareAtLevel2() { po.initial_level = 2; }
+  const tspline::Domain square{rectangle(0, 0, 1, 1), {}};
+  tspline::ParameterizationOptions po;
+  const tspline::AdaptiveOptions ad;
+};
+
 // Two layouts the same to the last bit: patch polygons, corners and the
 // optimization's counts and figures.
 void check_same_layout(const tspline::QuadLayout& a, const tspline::QuadLayout& b) {
@@ -447,11 +455,8 @@ TEST_SUITE("quad_layout") {
     }
   }
 
-  TEST_CASE("layout choice: single keeps the one-patch run, auto keeps one patch where it is good") {
-    const tspline::Domain square{rectangle(0, 0, 1, 1), {}};
-    tspline::ParameterizationOptions po;
-    po.initial_level = 2;
-    const tspline::AdaptiveOptions ad;
+  TEST_CASE_FIXTURE(UnitSquareAtLevel2,
+                    "layout choice: single keeps the one-patch run, auto keeps one patch where it is good") {
     tspline::DomainParameterizationOptions single;
     single.layout = tspline::LayoutMode::Single;
     const tspline::DomainParameterization S = tspline::parameterize_domain(square, po, ad, single);
@@ -591,16 +596,13 @@ TEST_SUITE("quad_layout") {
     CHECK(Q.patches->min_scaled_jacobian_dense() == A.patches->min_scaled_jacobian_dense());
   }
 
-  TEST_CASE("auto: a stopped single try is run to the end where the layout is below its corners") {
+  TEST_CASE_FIXTURE(UnitSquareAtLevel2,
+                    "auto: a stopped single try is run to the end where the layout is below its corners") {
     // The unit square's single patch has J = I at its corners (scaled
     // Jacobian and J_r 1). A threshold above 1 rules it out at the corners,
     // so its try stops; the layout is not good either, and where its map is
     // below the single patch's corners the try runs again to the end and the
     // usual comparison decides (one patch, better than the layout).
-    const tspline::Domain square{rectangle(0, 0, 1, 1), {}};
-    tspline::ParameterizationOptions po;
-    po.initial_level = 2;
-    const tspline::AdaptiveOptions ad;
     tspline::DomainParameterizationOptions c;
     c.good.scaled_jacobian = 1.5;
     std::vector<std::string> steps;
