@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "commands.h"
+#include "kept_until_exit.h"
 #include "param_multipatch.h"
 #include "param_options_cli.h"
 #include "param_session.h"
@@ -39,8 +40,9 @@ int param_command(const std::string& input, const std::string& out_dir, const Pa
   hooks.on_patch = [&](std::size_t p, int round) {
     progress.event({{"event", "patch"}, {"patch", p}, {"round", round}});
   };
-  const ParamRun run =
-      tspline_app::run_param(tspline::io::read_domain(input, settings.domain), input, settings, hooks, t0);
+  const KeptUntilExit<ParamRun> kept(
+      tspline_app::run_param(tspline::io::read_domain(input, settings.domain), input, settings, hooks, t0));
+  const ParamRun& run = *kept;
   const tspline::AdaptiveOptions& adaptive = settings.adaptive;
   if (run.multipatch()) return tspline_app::write_multipatch_param(run, out_dir, progress);
   const tspline::ParameterizationResult& result = *run.result.single;
