@@ -1,11 +1,14 @@
 // parallel_ranges (detail/thread_pool.h): the ranges a body sees depend only on
 // n and the thread count, never on whether the pool was free at the time.
+// parallel_items: every item once, whatever thread takes it; after a throw no
+// item starts and the exception reaches the caller.
 #include <doctest/doctest.h>
 
 #include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <mutex>
+#include <stdexcept>
 #include <thread>
 #include <tuple>
 #include <vector>
@@ -67,5 +70,49 @@ TEST_SUITE("thread_pool") {
     other.join();
     CHECK(busy_pool == free_pool);  // in slot order, run one after the other
     for (const auto& id : ran_on) CHECK(id == me);
+  }
+
+  TEST_CASE("parallel_items: every item exactly once, one at a time; a throw stops the hand-out and is rethrown") {
+    // Items of very uneven cost (the first ones slow), as a layout's patches:
+    // each is made once, its result at its index.
+    const std::size_t n = 200;
+    std::vector<std::atomic<int>> made(n);
+    std::vector<std::size_t> result(n, 0);
+    tspline::detail::parallel_items(n, tspline::detail::pool_threads(), [&](std::size_t k) {
+      if (k < 4) std::this_thread::sleep_for(std::chrono::milliseconds(5));
+      ++made[k];
+      result[k] = k * k;
+    });
+    for (std::size_t k = 0; k < n; ++k) {
+      CHECK(made[k] == 1);
+      CHECK(result[k] == k * k);
+    }
+    // One thread, or fewer items than min_parallel: in order, in the caller.
+    std::vector<std::size_t> order;
+    const std::thread::id me = std::this_thread::get_id();
+    tspline::detail::parallel_items(5, 1, [&](std::size_t k) {
+      CHECK(std::this_thread::get_id() == me);
+      order.push_back(k);
+    });
+    CHECK(order == std::vector<std::size_t>{0, 1, 2, 3, 4});
+    order.clear();
+    tspline::detail::parallel_items(3, tspline::detail::pool_threads(), [&](std::size_t k) { order.push_back(k); }, 4);
+    CHECK(order == std::vector<std::size_t>{0, 1, 2});
+    // Item 10 throws: the caller gets its exception, and at most the items
+    // already handed out (one per thread) start after it.
+    std::atomic<std::size_t> started{0};
+    std::atomic<bool> thrown{false};
+    std::atomic<std::size_t> started_after{0};
+    CHECK_THROWS_WITH_AS(tspline::detail::parallel_items(1000, tspline::detail::pool_threads(), [&](std::size_t k) {
+                           ++started;
+                           if (thrown) ++started_after;
+                           if (k == 10) {
+                             thrown = true;
+                             throw std::runtime_error("item 10");
+                           }
+                         }),
+                         "item 10", std::runtime_error);
+    CHECK(started < 1000);
+    CHECK(started_after <= static_cast<std::size_t>(tspline::detail::pool_threads()));
   }
 }

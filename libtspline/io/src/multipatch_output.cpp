@@ -76,11 +76,10 @@ json multipatch_report(const MultiPatchResult& R, const std::string& input_path,
     certified += r.certification.certified;
   }
   // Each patch's report bounds its map's quality (certified_map_quality):
-  // the patches on the pool's threads.
+  // the patches on the pool's threads, handed out one at a time.
   std::vector<json> per_patch(R.patches.size());
-  detail::parallel_ranges(R.patches.size(), detail::pool_threads(), [&](std::size_t begin, std::size_t end, int) {
-    for (std::size_t p = begin; p < end; ++p) per_patch[p] = param_report(R.patches[p], input_path);
-  }, 2);
+  detail::parallel_items(R.patches.size(), detail::pool_threads(),
+                         [&](std::size_t p) { per_patch[p] = param_report(R.patches[p], input_path); });
   json patches = json::array();
   for (json& p : per_patch) patches.push_back(std::move(p));
   json faces = json::array();
@@ -176,9 +175,8 @@ void write_multipatch_outputs(const MultiPatchResult& R, const std::string& out_
   auto make_piece = [&](std::size_t f, int i) {
     const std::size_t first = piece_begin[static_cast<std::size_t>(i)];
     std::vector<toolkit::io::VtuMesh> parts(piece_begin[static_cast<std::size_t>(i) + 1] - first);
-    detail::parallel_ranges(parts.size(), detail::pool_threads(), [&](std::size_t begin, std::size_t end, int) {
-      for (std::size_t k = begin; k < end; ++k) parts[k] = files[f].second(first + k);
-    }, 2);
+    detail::parallel_items(parts.size(), detail::pool_threads(),
+                           [&](std::size_t k) { parts[k] = files[f].second(first + k); });
     toolkit::io::VtuMesh piece = merge_patches(std::move(parts));
     for (int& patch : piece.cell_ints.at("patch")) patch += static_cast<int>(first);
     return piece;

@@ -2,6 +2,7 @@
 #include "tspline/detail/thread_pool.h"
 
 #include <algorithm>
+#include <atomic>
 #include <condition_variable>
 #include <exception>
 #include <mutex>
@@ -137,6 +138,31 @@ void parallel_ranges(std::size_t n, int threads, const std::function<void(std::s
     return;
   }
   body(0, n, 0);
+}
+
+void parallel_items(std::size_t n, int threads, const std::function<void(std::size_t)>& item,
+                    std::size_t min_parallel) {
+  const std::size_t slots =
+      std::min(n, static_cast<std::size_t>(std::max(1, std::min(threads, pool_threads()))));
+  if (slots <= 1 || n < min_parallel) {
+    for (std::size_t k = 0; k < n; ++k) item(k);
+    return;
+  }
+  std::atomic<std::size_t> next{0};
+  std::atomic<bool> failed{false};
+  parallel_ranges(
+      slots, static_cast<int>(slots),
+      [&](std::size_t, std::size_t, int) {
+        for (std::size_t k; !failed && (k = next.fetch_add(1)) < n;) {
+          try {
+            item(k);
+          } catch (...) {
+            failed = true;
+            throw;
+          }
+        }
+      },
+      1);
 }
 
 }  // namespace tspline::detail

@@ -45,11 +45,8 @@ MapCheck check_map(const std::vector<const TSplineMap*>& patches, const std::vec
   QualityBoundOptions qo = o.quality;
   if (patches.size() > 1) qo.threads = 1;
   // (Patches handed out one at a time: their sizes vary along the layout.)
-  const std::size_t threads = std::min<std::size_t>(patches.size(), static_cast<std::size_t>(detail::pool_threads()));
-  std::atomic<std::size_t> next{0};
-  detail::parallel_ranges(threads, static_cast<int>(threads), [&](std::size_t, std::size_t, int) {
-    for (std::size_t p; (p = next.fetch_add(1)) < patches.size();) m.patches[p] = check_patch(*patches[p], o, qo);
-  }, 1);
+  detail::parallel_items(patches.size(), detail::pool_threads(),
+                         [&](std::size_t p) { m.patches[p] = check_patch(*patches[p], o, qo); });
   std::vector<MapQualityBounds> parts;
   parts.reserve(patches.size());
   m.min_relative_det_lower_bound = m.min_det_lower_bound = std::numeric_limits<double>::infinity();

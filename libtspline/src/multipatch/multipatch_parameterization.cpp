@@ -159,9 +159,9 @@ InterfaceReport measure_interface(const MultiPatchResult& R, const Interface& f)
 // Every interface of R measured (R.interfaces), on the pool's threads.
 void measure_interfaces(MultiPatchResult& R) {
   R.interfaces.assign(R.layout.interfaces.size(), {});
-  detail::parallel_ranges(R.layout.interfaces.size(), detail::pool_threads(), [&](std::size_t begin, std::size_t end, int) {
-    for (std::size_t i = begin; i < end; ++i) R.interfaces[i] = measure_interface(R, R.layout.interfaces[i]);
-  }, 16);
+  detail::parallel_items(
+      R.layout.interfaces.size(), detail::pool_threads(),
+      [&](std::size_t i) { R.interfaces[i] = measure_interface(R, R.layout.interfaces[i]); }, 16);
 }
 
 // Once the boundary curves agree, the later adaptive rounds may still have
@@ -182,27 +182,25 @@ std::size_t equalize_interface_knots(MultiPatchResult& R, const AdaptiveOptions&
   }
   // Each patch on its own (want is read only): on the pool's threads.
   std::atomic<std::size_t> count{0};
-  detail::parallel_ranges(R.patches.size(), detail::pool_threads(), [&](std::size_t begin, std::size_t end, int) {
-    for (std::size_t p = begin; p < end; ++p) {
-      ParameterizationResult& r = R.patches[p];
-      TMesh mesh = r.map->mesh();
-      if (refine_to_border_params(mesh, want[p], max_level) == 0) continue;
-      TSplineMap map = transfer_map(*r.map, std::move(mesh));
-      MapCertification cert = ad.certify ? certify_map(map, ad.certification) : MapCertification{};
-      if (ad.certify && r.certified_valid() && !cert.certified_valid()) continue;
-      ++count;
-      std::vector<CellMapQuality> cells;
-      r.quality = map_quality(map, ad.gauss, &cells);
-      r.cell_quality = std::move(cells);
-      r.dense_quality = dense_map_quality(map, ad.dense_samples);
-      r.certification = std::move(cert);
-      r.front.mesh = map.mesh();
-      r.front.optimized.assign(r.front.mesh.num_vertices(), Eigen::Vector2d::Zero());
-      for (int v = 0; v < static_cast<int>(r.front.mesh.num_vertices()); ++v)
-        r.front.optimized[v] = map.point(r.front.mesh.vertex_param(v));
-      r.map.emplace(std::move(map));
-    }
-  }, 2);
+  detail::parallel_items(R.patches.size(), detail::pool_threads(), [&](std::size_t p) {
+    ParameterizationResult& r = R.patches[p];
+    TMesh mesh = r.map->mesh();
+    if (refine_to_border_params(mesh, want[p], max_level) == 0) return;
+    TSplineMap map = transfer_map(*r.map, std::move(mesh));
+    MapCertification cert = ad.certify ? certify_map(map, ad.certification) : MapCertification{};
+    if (ad.certify && r.certified_valid() && !cert.certified_valid()) return;
+    ++count;
+    std::vector<CellMapQuality> cells;
+    r.quality = map_quality(map, ad.gauss, &cells);
+    r.cell_quality = std::move(cells);
+    r.dense_quality = dense_map_quality(map, ad.dense_samples);
+    r.certification = std::move(cert);
+    r.front.mesh = map.mesh();
+    r.front.optimized.assign(r.front.mesh.num_vertices(), Eigen::Vector2d::Zero());
+    for (int v = 0; v < static_cast<int>(r.front.mesh.num_vertices()); ++v)
+      r.front.optimized[v] = map.point(r.front.mesh.vertex_param(v));
+    r.map.emplace(std::move(map));
+  });
   return count;
 }
 
@@ -398,9 +396,8 @@ void finish_multipatch_result(MultiPatchResult& R, const AdaptiveOptions& adapti
   // The patches' areas on the pool's threads, summed in patch order.
   const std::size_t P = R.patches.size();
   std::vector<double> areas(P);
-  detail::parallel_ranges(P, detail::pool_threads(), [&](std::size_t begin, std::size_t end, int) {
-    for (std::size_t p = begin; p < end; ++p) areas[p] = map_area(*R.patches[p].map);
-  }, 2);
+  detail::parallel_items(P, detail::pool_threads(),
+                         [&](std::size_t p) { areas[p] = map_area(*R.patches[p].map); });
   R.map_area = std::accumulate(areas.begin(), areas.end(), 0.0);
 }
 
