@@ -581,9 +581,10 @@ LayoutRotationReport rotate_layout_edges(LayoutMesh& m, const LayoutQuality& Q, 
       for (const int n : marked) reached[n] = 0;
       while (i < bad.size() && done[i]) ++i;
       std::vector<RotationTry> tries(batch.size());
-      detail::parallel_ranges(batch.size(), detail::pool_threads(), [&](std::size_t begin, std::size_t end, int) {
-        for (std::size_t k = begin; k < end; ++k) tries[k] = try_rotations(m, t, Q, admissible, touched, batch[k], reaches[k], lo);
-      }, 2);
+      // (Handed out one at a time: a try's cost varies with its neighbourhood.)
+      detail::parallel_items(batch.size(), detail::pool_threads(), [&](std::size_t k) {
+        tries[k] = try_rotations(m, t, Q, admissible, touched, batch[k], reaches[k], lo);
+      });
       bool changed = false;
       for (std::size_t k = 0; k < batch.size(); ++k) {
         const RotationTry& r = tries[k];
