@@ -98,21 +98,22 @@ TEST_SUITE("thread_pool") {
     order.clear();
     tspline::detail::parallel_items(3, tspline::detail::pool_threads(), [&](std::size_t k) { order.push_back(k); }, 4);
     CHECK(order == std::vector<std::size_t>{0, 1, 2});
-    // Item 10 throws: the caller gets its exception, and at most the items
-    // already handed out (one per thread) start after it.
+    // Item 10 throws: the caller gets its exception and the hand-out stops.
+    // One thread: items 0 to 10 started, in order. On the pool: items of 1 ms
+    // each, so that the few an other thread starts while the exception
+    // unwinds (microseconds) leave most of the 200 never started.
     std::atomic<std::size_t> started{0};
-    std::atomic<bool> thrown{false};
-    std::atomic<std::size_t> started_after{0};
-    CHECK_THROWS_WITH_AS(tspline::detail::parallel_items(1000, tspline::detail::pool_threads(), [&](std::size_t k) {
-                           ++started;
-                           if (thrown) ++started_after;
-                           if (k == 10) {
-                             thrown = true;
-                             throw std::runtime_error("item 10");
-                           }
-                         }),
-                         "item 10", std::runtime_error);
-    CHECK(started < 1000);
-    CHECK(started_after <= static_cast<std::size_t>(tspline::detail::pool_threads()));
+    auto throwing = [&](std::size_t k) {
+      ++started;
+      if (k == 10) throw std::runtime_error("item 10");
+      std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    };
+    CHECK_THROWS_WITH_AS(tspline::detail::parallel_items(200, 1, throwing), "item 10", std::runtime_error);
+    CHECK(started == 11);
+    started = 0;
+    CHECK_THROWS_WITH_AS(tspline::detail::parallel_items(200, tspline::detail::pool_threads(), throwing), "item 10",
+                         std::runtime_error);
+    CHECK(started >= 11);
+    CHECK(started < 100);
   }
 }
