@@ -305,4 +305,48 @@ TEST_SUITE("map_quality_bounds") {
     CHECK(two.mean_ratio.lower_bound_element == q.mean_ratio.lower_bound_element);
     CHECK(two.scaled.sampled == q.scaled.sampled);
   }
+
+  TEST_CASE("dense sample where the minimum can be: the figures of a sample of every element") {
+    // Without per_element only the elements whose bounds do not exceed the
+    // least sampled value are sampled; the sampled minima, their elements and
+    // their points must be those of sampling every element, bit for bit.
+    auto same_sample = [](const TSplineMap& map, const char* what) {
+      QualityBoundOptions every;
+      every.per_element = true;
+      const MapQualityBounds all = tspline::certified_map_quality(map, every);
+      const MapQualityBounds some = tspline::certified_map_quality(map);
+      INFO(std::string(what) << ": " << some.sampled_elements << " of " << some.elements
+                             << " elements sampled");
+      CHECK(all.sampled_elements == all.elements);
+      for (const auto& [a, b] :
+           {std::pair{all.mean_ratio, some.mean_ratio}, std::pair{all.scaled, some.scaled}}) {
+        CHECK(a.sampled == b.sampled);
+        CHECK(a.sampled_element == b.sampled_element);
+        CHECK(a.sampled_at == b.sampled_at);
+        CHECK(a.lower_bound == b.lower_bound);
+        CHECK(a.attained == b.attained);
+      }
+      return some;
+    };
+    const auto poly = tspline::io::read_polygon(test_support::polygon_file("flower.txt"));
+    const tspline::ParameterizationResult r = tspline::run_parameterization(poly, {}, {});
+    REQUIRE(r.map);
+    const MapQualityBounds flower = same_sample(*r.map, "flower");
+    // The pruning works: a small fraction of the elements is sampled.
+    CHECK(flower.sampled_elements >= 1);
+    CHECK(flower.sampled_elements * 4 < flower.elements);
+    // A fold: the folded elements have the lowest bounds and hold the minimum.
+    const MapQualityBounds folded = same_sample(test_support::fold_between_gauss_points(), "folded");
+    CHECK(folded.mean_ratio.sampled < 0.0);
+    // An affine map: every element ties (bounds and samples equal up to
+    // round-off), so the first element of the least value must be found.
+    Eigen::Matrix2d A;
+    A << 2.0, 0.7, -0.3, 1.1;
+    same_sample(greville_map(2, [&](const Eigen::Vector2d& p) -> Eigen::Vector2d { return A * p; }),
+                "affine");
+    // The identity: every value is 1, the merge's start: element 0 at (0, 0), as before.
+    const MapQualityBounds id = same_sample(
+        greville_map(2, [](const Eigen::Vector2d& p) -> Eigen::Vector2d { return p; }), "identity");
+    CHECK(id.mean_ratio.sampled == doctest::Approx(1.0).epsilon(1e-12));
+  }
 }

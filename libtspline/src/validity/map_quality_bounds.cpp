@@ -327,29 +327,50 @@ void check_options(const QualityBoundOptions& o) {
   if (o.samples_per_edge < 0) throw toolkit::InputError("quality bounds: samples_per_edge must be >= 0");
 }
 
+// The Bernstein forms of one element: D, w and the round-off scale of D as
+// the certification computes them, and X, Y, w (bidegree (3,3)).
+struct ElementForms {
+  detail::ElementJacobian J;
+  std::array<BernsteinPoly, 3> xyw;
+};
+
+ElementForms element_forms(const BezierElement& e, const std::vector<Eigen::Vector2d>& P) {
+  ElementForms f{detail::element_jacobian(e, P),
+                 {BernsteinPoly(3, 3), BernsteinPoly(3, 3), BernsteinPoly(3, 3)}};
+  f.xyw[2] = f.J.weight;
+  // X, Y relative to the element's mean control point (as element_jacobian:
+  // N_s, N_t are translation invariant, X -> X + c w adds c (w_s w - w w_s) = 0).
+  const Eigen::Index nf = e.C.rows();
+  Eigen::Vector2d centre = Eigen::Vector2d::Zero();
+  for (Eigen::Index a = 0; a < nf; ++a) centre += P[e.functions[a]];
+  if (nf > 0) centre /= static_cast<double>(nf);
+  for (Eigen::Index a = 0; a < nf; ++a) {
+    const Eigen::Vector2d p = P[e.functions[a]] - centre;
+    for (int k = 0; k < 16; ++k) {
+      f.xyw[0].c[k] += p.x() * e.C(a, k);
+      f.xyw[1].c[k] += p.y() * e.C(a, k);
+    }
+  }
+  return f;
+}
+
+double aspect(const BezierElement& e) { return (e.hi.y() - e.lo.y()) / (e.hi.x() - e.lo.x()); }
+
+// The dense sample of one element (its forms made again, the same as
+// bound_element's): into out's `sampled` fields.
+void sample_element(const BezierElement& e, const std::vector<Eigen::Vector2d>& P, const SampleTable& tab,
+                    ElementQualityBound& out) {
+  dense_sample(element_forms(e, P).xyw, tab, aspect(e), e, out);
+}
+
 ElementQualityBound bound_element(const BezierElement& e, const std::vector<Eigen::Vector2d>& P,
                                   const QualityBoundOptions& opt, const SampleTable& tab) {
   ElementQualityBound res;
   const double hx = e.hi.x() - e.lo.x(), hy = e.hi.y() - e.lo.y();
-  const double r = hy / hx;
-  // D, w and the round-off scale of D as the certification computes them.
-  const detail::ElementJacobian J = detail::element_jacobian(e, P);
-  // X, Y relative to the element's mean control point (as element_jacobian:
-  // N_s, N_t are translation invariant, X -> X + c w adds c (w_s w - w w_s) = 0).
-  std::array<BernsteinPoly, 3> xyw = {BernsteinPoly(3, 3), BernsteinPoly(3, 3), J.weight};
-  {
-    const Eigen::Index nf = e.C.rows();
-    Eigen::Vector2d centre = Eigen::Vector2d::Zero();
-    for (Eigen::Index a = 0; a < nf; ++a) centre += P[e.functions[a]];
-    if (nf > 0) centre /= static_cast<double>(nf);
-    for (Eigen::Index a = 0; a < nf; ++a) {
-      const Eigen::Vector2d p = P[e.functions[a]] - centre;
-      for (int k = 0; k < 16; ++k) {
-        xyw[0].c[k] += p.x() * e.C(a, k);
-        xyw[1].c[k] += p.y() * e.C(a, k);
-      }
-    }
-  }
+  const double r = aspect(e);
+  const ElementForms forms = element_forms(e, P);
+  const detail::ElementJacobian& J = forms.J;
+  const std::array<BernsteinPoly, 3>& xyw = forms.xyw;
   const BernsteinPoly& W = xyw[2];
   const BernsteinPoly Ws = bernstein_ds(W), Wt = bernstein_dt(W);
   // (1): N_s = X_s w - X w_s, N_t = X_t w - X w_t per component.
@@ -458,6 +479,54 @@ ElementQualityBound bound_element(const BezierElement& e, const std::vector<Eige
   return res;
 }
 
+// The dense sample of the elements that can hold the map's sampled minimum of
+// J_r or SJ, into `per` (the others keep `sampled` = 1, as if sampled above the
+// minimum). An element's sampled values are at least its certified lower
+// bounds, so an element whose bound exceeds the smallest value sampled so far
+// cannot hold the minimum: the elements are sampled in ascending order of
+// their bounds until the next bound exceeds it. Every element whose sampled
+// value equals the minimum is sampled too (its bound is at most that value),
+// so the merge in element order finds the same value, element and point as a
+// sample of every element. The first value to beat is the merge's start, 1.
+// (A NaN bound is sampled.)
+// Returns the number of elements sampled.
+std::size_t sample_where_minimum_can_be(const std::vector<BezierElement>& es,
+                                        const std::vector<Eigen::Vector2d>& P, const SampleTable& tab,
+                                        std::vector<ElementQualityBound>& per) {
+  const std::size_t n = per.size();
+  auto ascending = [&](auto field) {
+    std::vector<std::size_t> order(n);
+    for (std::size_t k = 0; k < n; ++k) order[k] = k;
+    auto bound = [&](std::size_t k) {
+      const double b = (per[k].*field).lower_bound;
+      return std::isnan(b) ? -HUGE_VAL : b;
+    };
+    std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+      return bound(a) < bound(b) || (bound(a) == bound(b) && a < b);
+    });
+    return order;
+  };
+  const std::vector<std::size_t> by_jr = ascending(&ElementQualityBound::mean_ratio);
+  const std::vector<std::size_t> by_sj = ascending(&ElementQualityBound::scaled);
+  std::vector<char> sampled(n, 0);
+  double least_jr = 1.0, least_sj = 1.0;
+  std::size_t i = 0, j = 0, count = 0;
+  auto can_hold = [](double bound, double least) { return !(bound > least); };
+  for (;;) {
+    while (i < n && sampled[by_jr[i]]) ++i;
+    while (j < n && sampled[by_sj[j]]) ++j;
+    const bool jr = i < n && can_hold(per[by_jr[i]].mean_ratio.lower_bound, least_jr);
+    const bool sj = j < n && can_hold(per[by_sj[j]].scaled.lower_bound, least_sj);
+    if (!jr && !sj) return count;
+    const std::size_t k = jr ? by_jr[i] : by_sj[j];
+    sample_element(es[k], P, tab, per[k]);
+    sampled[k] = 1;
+    ++count;
+    least_jr = std::min(least_jr, per[k].mean_ratio.sampled);
+    least_sj = std::min(least_sj, per[k].scaled.sampled);
+  }
+}
+
 // The minimum of each field of b into a (locations and elements follow their
 // values). b is one element's (index `first`) or a map's whose element
 // indices start at `first` in a's numbering (offset = true).
@@ -497,19 +566,26 @@ MapQualityBounds certified_map_quality(const BezierExtraction& extraction, const
   const unsigned hw = detail::hardware_threads();
   const std::size_t threads =
       std::max<std::size_t>(1, std::min<std::size_t>(chunks, opt.threads > 0 ? opt.threads : hw));
+  // Without per-element results, the dense sample is taken afterwards, only
+  // where it can hold the map's sampled minimum (sample_where_minimum_can_be).
+  const bool sample_all = opt.per_element;
+  const SampleTable none(0);
   std::atomic<std::size_t> next{0};
   auto work = [&] {
     for (std::size_t c; (c = next.fetch_add(1)) < chunks;)
       for (std::size_t k = c * kChunk; k < std::min(es.size(), (c + 1) * kChunk); ++k)
-        per[k] = bound_element(es[k], P, opt, tab);
+        per[k] = bound_element(es[k], P, opt, sample_all ? tab : none);
   };
   std::vector<std::thread> pool;
   for (std::size_t t = 1; t < threads; ++t) pool.emplace_back(work);
   work();
   for (std::thread& t : pool) t.join();
+  std::size_t sampled_elements = tab.k > 0 ? es.size() : 0;
+  if (!sample_all && tab.k > 0) sampled_elements = sample_where_minimum_can_be(es, P, tab, per);
 
   MapQualityBounds m;
   m.elements = es.size();
+  m.sampled_elements = sampled_elements;
   m.samples_per_edge = opt.samples_per_edge;
   m.samples_per_element =
       opt.samples_per_edge > 0 ? static_cast<std::size_t>((opt.samples_per_edge + 1) * (opt.samples_per_edge + 1)) : 0;
@@ -543,6 +619,7 @@ MapQualityBounds merge_map_quality(std::vector<MapQualityBounds>&& parts) {
     merge_into(m.mean_ratio, b.mean_ratio, m.elements, true);
     merge_into(m.scaled, b.scaled, m.elements, true);
     m.elements += b.elements;
+    m.sampled_elements += b.sampled_elements;
     m.samples_per_element = b.samples_per_element;
     m.max_depth_used = std::max(m.max_depth_used, b.max_depth_used);
     m.patches += b.patches;

@@ -88,6 +88,14 @@
 // of a uniform grid including the element's corners and edges, evaluated from
 // the same Bernstein forms of X and w (not from the bounds). It is reported
 // next to the bound as a check: bound <= true minimum <= sampled minimum.
+// Over a map (without per_element) the sample is taken only where it can hold
+// the map's sampled minimum: an element's sampled values are at least its
+// bounds, so the elements are sampled in ascending order of their bounds until
+// the next bound exceeds the least value sampled. The map's sampled minimum,
+// its element and its point are those of a sample of every element (every
+// element that could equal the minimum is sampled); the other elements keep
+// `sampled` = 1. On a coastline's 8,776-patch map 7 % of the elements
+// (bench_quality_bounds: 4.4 -> 2.6 s on one thread).
 #include <Eigen/Core>
 #include <cstddef>
 #include <vector>
@@ -108,7 +116,8 @@ struct QualityBoundOptions {
   int samples_per_edge = 25;
   /// Threads over elements (0: std::thread::hardware_concurrency()).
   int threads = 0;
-  /// Keep the per-element results (MapQualityBounds::per_element).
+  /// Keep the per-element results (MapQualityBounds::per_element); every
+  /// element then has its own dense sample.
   bool per_element = false;
 };
 
@@ -137,6 +146,9 @@ struct ElementQualityBound {
 
 struct MapQualityBounds {
   std::size_t elements = 0;
+  /// Elements whose dense sample was taken: all with per_element, else those
+  /// that could hold the sampled minimum (header, "The dense sample").
+  std::size_t sampled_elements = 0;
   /// Whole map: the minimum over the elements of each field (lower_bound,
   /// attained, sampled, each with its own element and location).
   QualityBound mean_ratio, scaled;
