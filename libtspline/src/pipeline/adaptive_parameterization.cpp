@@ -173,7 +173,8 @@ class AdaptiveRun {
       const auto tb = std::chrono::steady_clock::now();
       std::vector<Eigen::Vector2d> at;
       r_.boundary_problem = corner_problem(map, f_.boundary, &at);
-      const BoundaryCurveCheck simple = check_boundary_curve(map);
+      frozen_extraction_.emplace(map.basis());
+      const BoundaryCurveCheck simple = check_boundary_curve(map, *frozen_extraction_);
       r_.boundary_simple = simple.simple;
       if (!simple.simple) {
         at.insert(at.end(), simple.conflicts.begin(), simple.conflicts.end());
@@ -210,8 +211,11 @@ class AdaptiveRun {
                                       std::vector<CellMapQuality>& cells) {
     // One Bezier extraction for every check below: the untangling moves the
     // control points only, so the map, its interpolant and the map kept share
-    // the T-mesh and the basis.
-    const BezierExtraction extraction(map.basis());
+    // the T-mesh and the basis. In the first round, the one the boundary
+    // check made of this map (freeze_boundary).
+    const BezierExtraction extraction = frozen_extraction_
+                                            ? std::move(*std::exchange(frozen_extraction_, std::nullopt))
+                                            : BezierExtraction(map.basis());
     MapQualityStats quality;
     if (!keep_warm_start(map, extraction, rec, cert, cells, quality))
       quality = untangle_and_compare(map, extraction, rec, cert, cells);
@@ -310,7 +314,7 @@ class AdaptiveRun {
     }
     if (ad_.optimize_control_points) {
       const auto t1 = std::chrono::steady_clock::now();
-      const MapUntanglingReport u = untangle_map(map, untangling_options(), ad_.certification);
+      const MapUntanglingReport u = untangle_map(map, untangling_options(), ad_.certification, &extraction);
       cert = u.certification;
       rec.untangling = u;
       rec.untangling.certification.failures.clear();
@@ -388,13 +392,14 @@ class AdaptiveRun {
     uo.max_quality_stages = ad_.polish_stages;
     uo.quality_power = ad_.polish_power;
     TSplineMap map = b.map;
-    const MapUntanglingReport u = untangle_map(map, uo, ad_.certification);
+    const BezierExtraction extraction(map.basis());  // for the untangling and the checks
+    const MapUntanglingReport u = untangle_map(map, uo, ad_.certification, &extraction);
     t_untangle_ += seconds_since(t1);
     if (ad_.certify && !u.certified) return;
     const auto t2 = std::chrono::steady_clock::now();
     std::vector<CellMapQuality> cells;
-    const MapQualityStats quality = map_quality(map, ad_.gauss, &cells);
-    const DenseMapQuality dense = whole_map_quality(map, cells);
+    const MapQualityStats quality = map_quality(map, extraction, ad_.gauss, &cells);
+    const DenseMapQuality dense = whole_map_quality(map, cells, &extraction);
     t_check_ += seconds_since(t2);
     std::ostringstream s;
     s << "polish: " << u.stages << " more quality stages, whole-map J_r " << b.dense.min_mean_ratio << " -> "
@@ -548,6 +553,9 @@ class AdaptiveRun {
   int last_gain_it_ = 0;
   std::optional<TSplineMap> previous_;
   std::optional<WarmStart> warm_;
+  // The Bezier extraction of the map freeze_boundary checked last, until
+  // untangle_and_assess takes it (the first round's map, unchanged in between).
+  std::optional<BezierExtraction> frozen_extraction_;
   bool warm_kept_ = false;  // the warm start was kept as moved (no optimization)
   double t_boundary_ = 0.0, t_fit_ = 0.0, t_untangle_ = 0.0, t_check_ = 0.0, t_certify_ = 0.0, t_refine_ = 0.0;
 };

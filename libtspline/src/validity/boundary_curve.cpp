@@ -86,8 +86,7 @@ bool monotone(const Piece* a, const Piece* b, double tiny) {
 
 // The border segments of the map's Bezier elements as one closed curve, side
 // by side in the CCW order of the border.
-std::vector<Piece> boundary_pieces(const TSplineMap& map) {
-  const BezierExtraction ex(map.basis());
+std::vector<Piece> boundary_pieces(const TSplineMap& map, const BezierExtraction& ex) {
   std::array<std::vector<Piece>, 4> sides;
   std::array<std::vector<double>, 4> keys;
   for (const BezierElement& e : ex.elements()) element_border_segments(e, map.control_points(), sides, keys);
@@ -188,7 +187,14 @@ void report_not_simple(const std::vector<Piece>& pieces, const Conflicts& c, Bou
 
 BoundaryCurveCheck check_boundary_curve(const TSplineMap& map, int max_depth) {
   if (max_depth < 0 || max_depth > 20) throw toolkit::InputError("check_boundary_curve: max_depth out of range");
-  std::vector<Piece> pieces = boundary_pieces(map);
+  return check_boundary_curve(map, BezierExtraction(map.basis()), max_depth);
+}
+
+BoundaryCurveCheck check_boundary_curve(const TSplineMap& map, const BezierExtraction& extraction,
+                                        int max_depth) {
+  if (max_depth < 0 || max_depth > 20)
+    throw toolkit::InputError("check_boundary_curve: max_depth out of range");
+  std::vector<Piece> pieces = boundary_pieces(map, extraction);
   BoundaryCurveCheck out;
   out.segments = pieces.size();
   const double diag = control_box_diagonal(pieces);

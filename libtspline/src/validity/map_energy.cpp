@@ -256,8 +256,11 @@ MapEnergy::Samples::Samples(const MapEnergy& energy) {
   scratch.resize(8 * static_cast<std::size_t>(energy.levels_.back().grid.m));
 }
 
-MapEnergy::MapEnergy(const TSplineMap& map, const MapEnergyOptions& opt)
-    : options_(opt), extraction_(map.basis()) {
+MapEnergy::MapEnergy(const TSplineMap& map, const MapEnergyOptions& opt, const BezierExtraction* extraction)
+    : options_(opt),
+      own_extraction_(extraction ? std::nullopt
+                                 : std::optional<BezierExtraction>(std::in_place, map.basis())),
+      extraction_(extraction ? extraction : &*own_extraction_) {
   if (!opt.lobatto && (opt.gauss < 1 || opt.gauss > 6)) throw toolkit::InputError("MapEnergy: gauss must be in [1, 6]");
   if (opt.lobatto && (opt.gauss < 3 || opt.gauss > 5))
     throw toolkit::InputError("MapEnergy: Gauss-Lobatto points per direction must be in [3, 5]");
@@ -309,7 +312,7 @@ MapEnergy::MapEnergy(const TSplineMap& map, const MapEnergyOptions& opt)
   centre_ = 0.5 * (lo + hi);
   original_ = P;
 
-  const auto& es = extraction_.elements();
+  const auto& es = extraction_->elements();
   elements_.resize(es.size());
   for (std::size_t k = 0; k < es.size(); ++k) {
     const BezierElement& e = es[k];
@@ -356,7 +359,7 @@ MapEnergy::MapEnergy(const TSplineMap& map, const MapEnergyOptions& opt)
 
 void MapEnergy::element_coefficients(std::size_t k, const double* x, std::array<double, 16>& X,
                                      std::array<double, 16>& Y) const {
-  const BezierElement& e = extraction_.elements()[k];
+  const BezierElement& e = extraction_->elements()[k];
   double sx[16] = {}, sy[16] = {};  // locals: no aliasing with C
   for (Eigen::Index r = 0; r < e.C.rows(); ++r) {
     const int a = e.functions[r];
@@ -414,7 +417,7 @@ std::size_t MapEnergy::num_samples() const {
 
 double MapEnergy::evaluate(const double* xv, double eps, double* gradient, std::size_t* nonpositive,
                            double power) const {
-  const auto& es = extraction_.elements();
+  const auto& es = extraction_->elements();
   const int threads = options_.threads;
   std::vector<double> energy(threads, 0.0);
   std::vector<std::size_t> folded(threads, 0);

@@ -132,7 +132,7 @@ SampleTerm sample_term(const Eigen::Matrix2d& J, double eps, double theta, doubl
 
 void MapEnergy::build_hessian_pattern() const {
   HessianPattern& hp = hpattern_;
-  const auto& es = extraction_.elements();
+  const auto& es = extraction_->elements();
   const std::size_t nodes = free_functions_.size();
   // Node adjacency, lower part (rows i >= column j).
   std::vector<std::vector<int>> col(nodes);
@@ -301,7 +301,7 @@ void MapEnergy::hessian(const double* xv, double eps, Eigen::SparseMatrix<double
     H = hp.H;
   else
     std::fill(H.valuePtr(), H.valuePtr() + H.nonZeros(), 0.0);
-  const auto& es = extraction_.elements();
+  const auto& es = extraction_->elements();
   const double theta = options_.theta;
   const int* outer = H.outerIndexPtr();
   double* val = H.valuePtr();

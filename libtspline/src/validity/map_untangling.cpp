@@ -206,7 +206,8 @@ double starting_eps(double min_det) { return std::clamp(0.2 * std::abs(min_det),
 }  // namespace
 
 MapUntanglingReport untangle_map(TSplineMap& map, const MapUntanglingOptions& opt,
-                                 const CertificationOptions& certification) {
+                                 const CertificationOptions& certification,
+                                 const BezierExtraction* extraction) {
   if (opt.max_stages < 1 || opt.max_iterations_per_stage < 1 || opt.max_iterations < 1)
     throw toolkit::InputError("untangle_map: stage and iteration limits must be >= 1");
   if (!(opt.eps_floor > 0.0) || !(opt.energy_tolerance > 0.0))
@@ -224,7 +225,7 @@ MapUntanglingReport untangle_map(TSplineMap& map, const MapUntanglingOptions& op
   if (opt.max_cg_iterations < 1 || opt.newton_cholesky_below < 0)
     throw toolkit::InputError("untangle_map: max_cg_iterations must be >= 1 and newton_cholesky_below >= 0");
   const auto t0 = std::chrono::steady_clock::now();
-  MapEnergy energy(map, opt.energy);
+  MapEnergy energy(map, opt.energy, extraction);
   MapUntanglingReport rep;
   rep.free_points = energy.free_functions().size();
   rep.fixed_points = map.basis().size() - rep.free_points;

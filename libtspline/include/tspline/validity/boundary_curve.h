@@ -23,6 +23,7 @@
 #include <string>
 #include <vector>
 
+#include "tspline/spline/bezier_extraction.h"
 #include "tspline/spline/tspline_map.h"
 
 namespace tspline {
@@ -41,5 +42,9 @@ struct BoundaryCurveCheck {
 /// T-spline basis: the border functions are the univariate B-splines of the
 /// border vertices). max_depth in [0, 20].
 BoundaryCurveCheck check_boundary_curve(const TSplineMap& map, int max_depth = 8);
+/// The same with the Bezier extraction of the map's basis made by the caller
+/// (shared with the checks that follow).
+BoundaryCurveCheck check_boundary_curve(const TSplineMap& map, const BezierExtraction& extraction,
+                                        int max_depth = 8);
 
 }  // namespace tspline

@@ -162,8 +162,11 @@ struct MapUntanglingReport {
 
 /// Moves the interior control points of `map` in place; `certification` says
 /// how det J > 0 is certified on the elements (the stopping test).
+/// `extraction`: the Bezier extraction of the map's basis, if the caller has
+/// it (nullptr: made here); the basis does not change.
 /// \throw InputError for options out of range.
 MapUntanglingReport untangle_map(TSplineMap& map, const MapUntanglingOptions& options = {},
-                                 const CertificationOptions& certification = {});
+                                 const CertificationOptions& certification = {},
+                                 const BezierExtraction* extraction = nullptr);
 
 }  // namespace tspline

@@ -60,6 +60,7 @@
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
 #include <cstddef>
+#include <optional>
 #include <vector>
 
 #include "tspline/detail/tensor_grid.h"
@@ -73,7 +74,12 @@ class MapEnergy {
  public:
   /// \throw InputError for options out of range or a map whose
   /// domain has no positive area.
-  MapEnergy(const TSplineMap& map, const MapEnergyOptions& options = {});
+  /// `extraction`: the Bezier extraction of the map's basis, made by the
+  /// caller and outliving this (shared with its other checks); nullptr: made here.
+  MapEnergy(const TSplineMap& map, const MapEnergyOptions& options = {},
+            const BezierExtraction* extraction = nullptr);
+  MapEnergy(const MapEnergy&) = delete;  // (extraction_ may point into this)
+  MapEnergy& operator=(const MapEnergy&) = delete;
 
   std::size_t num_variables() const { return 2 * free_functions_.size(); }
   /// Indices (into the basis) of the functions whose control points are free.
@@ -81,7 +87,7 @@ class MapEnergy {
   std::size_t num_elements() const { return elements_.size(); }
   /// Does element k touch a free control point (else the energy leaves it out)?
   bool element_active(std::size_t k) const { return elements_[k].active; }
-  const BezierExtraction& extraction() const { return extraction_; }
+  const BezierExtraction& extraction() const { return *extraction_; }
   double length_scale() const { return L_; }
 
   /// The free coordinates of `map` (same basis as at construction), normalized.
@@ -164,7 +170,8 @@ class MapEnergy {
   void element_samples(std::size_t k, const double* X, const double* Y, Samples& s) const;
 
   MapEnergyOptions options_;
-  BezierExtraction extraction_;
+  std::optional<BezierExtraction> own_extraction_;  // where the caller gave none
+  const BezierExtraction* extraction_;
   std::vector<Element> elements_;
   std::vector<int> active_;  // the elements that touch a variable, in order
   std::vector<Level> levels_;
