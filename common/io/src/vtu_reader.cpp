@@ -13,6 +13,7 @@
 
 #include "toolkit/errors.h"
 #include "vtk_errors.h"
+#include "vtk_threads.h"
 
 namespace toolkit::io {
 
@@ -31,6 +32,7 @@ void copy_arrays(vtkFieldData* data, vtkIdType n, std::map<std::string, std::vec
 }  // namespace
 
 VtuMesh read_vtu(const std::string& path) {
+  detail::prepare_vtk_for_threads();
   std::error_code ec;
   if (!std::filesystem::is_regular_file(path, ec)) throw IoError("cannot read '" + path + "': no such file");
   vtkNew<vtkXMLUnstructuredGridReader> reader;

@@ -40,6 +40,7 @@
 #include "toolkit/errors.h"
 #include "toolkit/io/atomic_file.h"
 #include "vtk_errors.h"
+#include "vtk_threads.h"
 
 namespace toolkit::io {
 namespace {
@@ -504,12 +505,14 @@ void write_grid(const std::string& path, vtkUnstructuredGrid* grid, PieceSource*
 }  // namespace
 
 void write_vtu(const std::string& path, const VtuMesh& mesh) {
+  detail::prepare_vtk_for_threads();
   validate(mesh);  // before anything touches the file system
   vtkNew<vtkUnstructuredGrid> grid = build_grid(std::span<const VtuMesh>(&mesh, 1), "");
   write_grid(path, grid);
 }
 
 void write_vtu(const std::string& path, VtuMesh&& mesh) {
+  detail::prepare_vtk_for_threads();
   validate(mesh);
   vtkNew<vtkUnstructuredGrid> grid = build_grid(std::span<VtuMesh>(&mesh, 1), "");
   mesh = VtuMesh();
@@ -527,6 +530,7 @@ VtuMesh merge_vtu(std::vector<VtuMesh>&& parts, const std::string& part_array) {
 }
 
 void write_vtu_parts(const std::string& path, std::vector<VtuMesh>&& parts, const std::string& part_array) {
+  detail::prepare_vtk_for_threads();
   for (const VtuMesh& p : parts) validate(p);
   vtkNew<vtkUnstructuredGrid> grid = build_grid(std::span<VtuMesh>(parts), part_array);
   parts.clear();
@@ -534,6 +538,7 @@ void write_vtu_parts(const std::string& path, std::vector<VtuMesh>&& parts, cons
 }
 
 void write_vtu_pieces(const std::string& path, int pieces, const std::function<VtuMesh(int)>& piece) {
+  detail::prepare_vtk_for_threads();
   if (pieces < 1) throw toolkit::InputError("write_vtu_pieces: the number of pieces must be >= 1");
   vtkNew<PieceSource> source;
   source->make = piece;
