@@ -6,6 +6,7 @@
 #include <limits>
 #include <numbers>
 #include "tspline/boundary/plane.h"
+#include "tspline/detail/thread_pool.h"
 #include "tspline/layout/layout_energy.h"
 #include "layout_local.h"
 
@@ -91,6 +92,51 @@ const std::array<Eigen::Vector2d, 8> kDirections = [] {
   }
   return d;
 }();
+
+// What one node's move in a sweep did.
+struct NodeMove {
+  bool moved = false;
+  double gain = 0.0;  ///< its energy's relative fall
+};
+
+// update(k) for every node order[k], with the result of running them one by
+// one in that order, but in batches on the pool's threads. A node's move
+// reads only the nodes of the quads around it and writes only its own place
+// (and its own pattern-search step), so two nodes that share no quad give
+// the same result in either order. A batch takes the nodes in order that
+// share no quad with an earlier node not yet run (in the batch, or waiting
+// for a later one); nodes past one that waits may join it.
+template <class Update>
+void sweep_in_batches(const LayoutMesh& m, const LayoutTopology& t, const std::vector<int>& order,
+                      std::vector<char>& reached, const Update& update) {
+  constexpr std::size_t min_parallel = 64;
+  if (order.size() < min_parallel || detail::pool_threads() < 2) {
+    for (std::size_t k = 0; k < order.size(); ++k) update(k);
+    return;
+  }
+  std::vector<char> done(order.size(), 0);
+  std::vector<std::size_t> batch;
+  std::vector<int> marked;
+  for (std::size_t i = 0; i < order.size();) {
+    batch.clear();
+    for (std::size_t k = i; k < order.size(); ++k) {
+      if (done[k]) continue;
+      const int n = order[k];
+      // reached: the nodes that share a quad with an earlier node not yet run.
+      const bool clear = !reached[n];
+      for (const auto& [q, j] : t.corners_of(n))
+        for (const int v : m.quads[q])
+          if (!reached[v]) reached[v] = 1, marked.push_back(v);
+      if (!clear) continue;
+      done[k] = 1;
+      batch.push_back(k);
+    }
+    for (const int v : marked) reached[v] = 0;
+    marked.clear();
+    while (i < order.size() && done[i]) ++i;
+    detail::parallel_items(batch.size(), detail::pool_threads(), [&](std::size_t b) { update(batch[b]); }, 16);
+  }
+}
 
 }  // namespace
 
@@ -186,6 +232,9 @@ LayoutOptimizationReport optimize_layout_nodes(LayoutMesh& m, const LayoutQualit
     for (const int n : active)
       if (on[n]) moving.push_back(n);
   };
+  std::vector<int> order;      // the nodes moved in a sweep, in order
+  std::vector<NodeMove> moves;  // and what their moves did
+  std::vector<char> reached(n_nodes, 0);
   bool untangling = false;
   int quality_sweeps = 0;
   double best_worst = -2.0;  // the worst J_r of the quality sweeps, and when it last rose
@@ -210,20 +259,16 @@ LayoutOptimizationReport optimize_layout_nodes(LayoutMesh& m, const LayoutQualit
     untangling = tangled;
     if (!tangled && ++quality_sweeps == 3) refresh_moving();
     if (!tangled && quality_sweeps > 3 && quality_sweeps % 5 == 0) refresh_moving();
-    double gain = 0.0;
-    for (const int n : (tangled || quality_sweeps < 3 ? active : moving)) {
+    // One node's move: whether it moved and its relative gain.
+    auto update = [&](int n) -> NodeMove {
       const std::size_t nn = static_cast<std::size_t>(n);
-      if (t.valence(n) == 0) continue;
-      // While the layout is tangled the rings stay where they are: sliding a
-      // ring node across a fold only drags the fold along the coast.
-      if (tangled && m.ring[n] >= 0) continue;
       const double f0 = local(n);
       // Only the terms that move with n are evaluated (layout_moving_energy):
       // the energy differs from local(n) by a constant. Where that part is
       // not finite, the whole energy is.
       const LayoutMovingEnergy moving_part(m, t, Q, n, p, eps_rel, barrier);
       const double v0 = moving_part();
-      if (!std::isfinite(f0) && std::isfinite(v0)) continue;  // infinite wherever n goes
+      if (!std::isfinite(f0) && std::isfinite(v0)) return {};  // infinite wherever n goes
       const bool incremental = std::isfinite(f0) && std::isfinite(v0);
       // (A place's energy only counts if it beats the best so far: its sum may stop there.)
       auto energy = [&](int v, double best_so_far) {
@@ -249,11 +294,20 @@ LayoutOptimizationReport optimize_layout_nodes(LayoutMesh& m, const LayoutQualit
         slide_ring_node(m, t, Q, n, energy, allowed, o, best_v);
       }
       const double best = incremental ? f0 - (v0 - best_v) : best_v;
-      if (best < f0) {
-        ++report.moves;
-        gain = std::max(gain, (f0 - best) / f0);
-      }
-    }
+      if (!(best < f0)) return {};
+      return {true, (f0 - best) / f0};
+    };
+    // The nodes that may move this sweep, in order. While the layout is
+    // tangled the rings stay where they are: sliding a ring node across a fold
+    // only drags the fold along the coast.
+    order.clear();
+    for (const int n : (tangled || quality_sweeps < 3 ? active : moving))
+      if (t.valence(n) != 0 && !(tangled && m.ring[n] >= 0)) order.push_back(n);
+    moves.assign(order.size(), NodeMove{});
+    sweep_in_batches(m, t, order, reached, [&](std::size_t k) { moves[k] = update(order[k]); });
+    double gain = 0.0;
+    for (const NodeMove& mv : moves)
+      if (mv.moved) ++report.moves, gain = std::max(gain, mv.gain);
     report.sweeps = sweep + 1;
     if (gain < o.tolerance && !tangled) break;
     if (!tangled) {
