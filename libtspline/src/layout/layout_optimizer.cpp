@@ -108,9 +108,9 @@ struct NodeMove {
 // for a later one); nodes past one that waits may join it.
 template <class Update>
 void sweep_in_batches(const LayoutMesh& m, const LayoutTopology& t, const std::vector<int>& order,
-                      std::vector<char>& reached, const Update& update) {
+                      std::vector<char>& reached, bool in_batches, const Update& update) {
   constexpr std::size_t min_parallel = 64;
-  if (order.size() < min_parallel || detail::pool_threads() < 2) {
+  if (!in_batches || order.size() < min_parallel || detail::pool_threads() < 2) {
     for (std::size_t k = 0; k < order.size(); ++k) update(k);
     return;
   }
@@ -304,7 +304,7 @@ LayoutOptimizationReport optimize_layout_nodes(LayoutMesh& m, const LayoutQualit
     for (const int n : (tangled || quality_sweeps < 3 ? active : moving))
       if (t.valence(n) != 0 && !(tangled && m.ring[n] >= 0)) order.push_back(n);
     moves.assign(order.size(), NodeMove{});
-    sweep_in_batches(m, t, order, reached, [&](std::size_t k) { moves[k] = update(order[k]); });
+    sweep_in_batches(m, t, order, reached, o.in_batches, [&](std::size_t k) { moves[k] = update(order[k]); });
     double gain = 0.0;
     for (const NodeMove& mv : moves)
       if (mv.moved) ++report.moves, gain = std::max(gain, mv.gain);

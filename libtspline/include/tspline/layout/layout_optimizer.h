@@ -44,6 +44,10 @@ struct LayoutOptimizationOptions {
   bool keep_patch_corners_in_range = false;
   /// Checked before every sweep: once set (by another thread), LayoutCancelled is thrown.
   const std::atomic<bool>* cancel = nullptr;
+  /// A sweep's moves in batches on the pool's threads (nodes that share no
+  /// quad, taken in sweep order): the same result as moving the nodes one by
+  /// one (false), in less time.
+  bool in_batches = true;
 };
 
 /// Thrown where a layout's cancel flag was set (QuadLayoutOptions::cancel).
