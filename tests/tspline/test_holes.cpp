@@ -414,6 +414,24 @@ TEST_SUITE("holes") {
         CHECK(piece_tags == R.patches.size());
       }
     }
+
+    SUBCASE(
+        "report.json comes last: where a file of either lane cannot be written, there is none, nor a "
+        "temporary") {
+      const nlohmann::json report = tspline::io::multipatch_report(R, "plate_with_hole.txt", 0.0);
+      // A directory where the file should go: its rename fails. surface.vtu
+      // is in the lane that does not write report.json, physical_tmesh.vtu in
+      // the one that does.
+      for (const char* blocked : {"surface.vtu", "physical_tmesh.vtu"}) {
+        CAPTURE(blocked);
+        const auto dir = test_support::scratch_dir("holes", std::string("blocked_") + blocked);
+        std::filesystem::create_directory(dir / blocked);
+        CHECK_THROWS(tspline::io::write_multipatch_outputs(R, dir.string(), report, 2));
+        CHECK(!std::filesystem::exists(dir / "report.json"));
+        for (const auto& e : std::filesystem::directory_iterator(dir))
+          CHECK(e.path().filename().string().find(".tmp.") == std::string::npos);
+      }
+    }
   }
 
   TEST_CASE("stop_when: the run stops at the first patch it names, later patches are not run") {
