@@ -5,10 +5,11 @@
 #include <cmath>
 #include <limits>
 #include <numbers>
+
+#include "layout_local.h"
 #include "tspline/boundary/plane.h"
 #include "tspline/detail/thread_pool.h"
 #include "tspline/layout/layout_energy.h"
-#include "layout_local.h"
 
 namespace tspline {
 namespace {
@@ -134,7 +135,8 @@ void sweep_in_batches(const LayoutMesh& m, const LayoutTopology& t, const std::v
     for (const int v : marked) reached[v] = 0;
     marked.clear();
     while (i < order.size() && done[i]) ++i;
-    detail::parallel_items(batch.size(), detail::pool_threads(), [&](std::size_t b) { update(batch[b]); }, 16);
+    detail::parallel_items(
+        batch.size(), detail::pool_threads(), [&](std::size_t b) { update(batch[b]); }, 16);
   }
 }
 
@@ -232,7 +234,7 @@ LayoutOptimizationReport optimize_layout_nodes(LayoutMesh& m, const LayoutQualit
     for (const int n : active)
       if (on[n]) moving.push_back(n);
   };
-  std::vector<int> order;      // the nodes moved in a sweep, in order
+  std::vector<int> order;       // the nodes moved in a sweep, in order
   std::vector<NodeMove> moves;  // and what their moves did
   std::vector<char> reached(n_nodes, 0);
   bool untangling = false;
@@ -287,8 +289,10 @@ LayoutOptimizationReport optimize_layout_nodes(LayoutMesh& m, const LayoutQualit
             if (f < best_v && allowed()) best_v = f, best_x = m.x[nn];
           }
           m.x[nn] = best_x;
-          if (best_x == start) step[nn] *= 0.5;
-          else step[nn] *= 1.5;
+          if (best_x == start)
+            step[nn] *= 0.5;
+          else
+            step[nn] *= 1.5;
         }
       } else {
         slide_ring_node(m, t, Q, n, energy, allowed, o, best_v);

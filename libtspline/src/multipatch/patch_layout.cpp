@@ -129,7 +129,8 @@ class ClosestRingPoint {
 
   // The edges of cell c not measured yet; the first in ring and edge order of equals wins.
   void measure(int c, const Eigen::Vector2d& p, RingHit& best) {
-    for (std::size_t k = first_[static_cast<std::size_t>(c)]; k < first_[static_cast<std::size_t>(c) + 1]; ++k) {
+    for (std::size_t k = first_[static_cast<std::size_t>(c)]; k < first_[static_cast<std::size_t>(c) + 1];
+         ++k) {
       const int e = edges_[k];
       if (seen_[e] == stamp_) continue;
       seen_[e] = stamp_;
@@ -138,7 +139,8 @@ class ClosestRingPoint {
       const Eigen::Vector2d &a = v[i], &b = v[(i + 1) % v.size()];
       const double s = project(p, a, b);
       const double dist = (a + s * (b - a) - p).norm();
-      if (dist < best.distance || (dist == best.distance && std::pair(r, i) < std::pair(best.ring, best.edge)))
+      if (dist < best.distance ||
+          (dist == best.distance && std::pair(r, i) < std::pair(best.ring, best.edge)))
         best = {r, i, s, dist};
     }
   }
