@@ -523,6 +523,72 @@ TEST_SUITE("layout_quality") {
     CHECK(tspline::open_wide_ring_corners(m, Q, anywhere).kept == 0);
   }
 
+  TEST_CASE("openings tried in batches on threads give the layout that one-by-one tries give") {
+    // A comb: blocks [4k - 2, 4k + 2] x [-2, 2] side by side; blocks 0, 4 and
+    // 8 each hold the crack tip of the test above (a notch from the top down
+    // to (4k, 0)), the others are two quads. The tips are far enough apart
+    // for their tries to share a batch.
+    const int K = 9;
+    auto notch = [](int k) { return k % 4 == 0; };
+    std::vector<V> ring_points;
+    std::vector<int> A(K + 1), B(K), H(K + 1), F(K), N(K), G(K), Z(K);
+    for (int k = 0; k < K; ++k) {
+      A[k] = static_cast<int>(ring_points.size()), ring_points.push_back(V(4 * k - 2, -2));
+      B[k] = static_cast<int>(ring_points.size()), ring_points.push_back(V(4 * k, -2));
+    }
+    A[K] = static_cast<int>(ring_points.size()), ring_points.push_back(V(4 * K - 2, -2));
+    H[K] = static_cast<int>(ring_points.size()),
+    ring_points.push_back(V(4 * K - 2, 2));  // the top right corner
+    for (int k = K - 1; k >= 0; --k) {
+      if (notch(k)) {
+        F[k] = static_cast<int>(ring_points.size()), ring_points.push_back(V(4 * k + 0.4, 2));
+        N[k] = static_cast<int>(ring_points.size()), ring_points.push_back(V(4 * k, 0));
+        G[k] = static_cast<int>(ring_points.size()), ring_points.push_back(V(4 * k - 0.4, 2));
+      } else {
+        Z[k] = static_cast<int>(ring_points.size()), ring_points.push_back(V(4 * k, 2));
+      }
+      H[k] = static_cast<int>(ring_points.size()), ring_points.push_back(V(4 * k - 2, 2));
+    }
+    const int R = static_cast<int>(ring_points.size());
+    std::vector<V> inner;
+    std::vector<std::array<int, 4>> quads;
+    for (int k = 0; k < K; ++k) {
+      // Block k: bottom A[k], B[k], A[k + 1]; top H[k + 1] (right), H[k] (left).
+      const int a = A[k], b = B[k], c_ = A[k + 1], e = H[k + 1], h = H[k];
+      if (!notch(k)) {
+        quads.push_back({a, b, Z[k], h});
+        quads.push_back({b, c_, e, Z[k]});
+        continue;
+      }
+      const int c = R + static_cast<int>(inner.size()), x = c + 1, y = c + 2;
+      inner.push_back(V(4 * k, -1)), inner.push_back(V(4 * k + 1.0, 0.2)),
+          inner.push_back(V(4 * k - 1.0, 0.2));
+      for (const std::array<int, 4>& q : std::vector<std::array<int, 4>>{{N[k], c, x, F[k]},
+                                                                         {N[k], G[k], y, c},
+                                                                         {c, b, c_, x},
+                                                                         {x, c_, e, F[k]},
+                                                                         {y, a, b, c},
+                                                                         {G[k], h, a, y}})
+        quads.push_back(q);
+    }
+    const tspline::LayoutRings ring = one_ring(ring_points);
+    const tspline::LayoutQuality Q(ring);
+    const tspline::LayoutMesh start = ring_mesh(ring.curves[0], ring_points, inner, quads);
+    for (const auto& q : start.quads) REQUIRE(quad_area(start, q) > 0.0);
+    tspline::LayoutOpeningOptions one_by_one, batched;
+    one_by_one.max_batch = 1;
+    tspline::LayoutMesh a = start, b = start;
+    const tspline::LayoutOpeningReport ra = tspline::open_wide_ring_corners(a, Q, anywhere, one_by_one);
+    const tspline::LayoutOpeningReport rb = tspline::open_wide_ring_corners(b, Q, anywhere, batched);
+    CHECK(ra.kept == 3);
+    CHECK(rb.kept == ra.kept);
+    CHECK(rb.tried == ra.tried);
+    CHECK(rb.moved == ra.moved);
+    CHECK(a.quads == b.quads);
+    CHECK(a.x == b.x);
+    CHECK(a.arc == b.arc);
+  }
+
   TEST_CASE("a flat single-quad corner marks its ring, and the pillow layer gives it two quads") {
     // A right triangle as one quad whose fourth corner is the hypotenuse's midpoint (180 degrees).
     const tspline::LayoutRings ring = one_ring({V(0, 0), V(2, 0), V(0, 2)});

@@ -94,7 +94,12 @@ struct LayoutOpeningOptions {
   /// itself) are where openings are tried.
   double wide_corner_degrees = 150.0;
   int local_sweeps = 12;  ///< optimizer sweeps over the nodes around a tried opening
-  const std::atomic<bool>* cancel = nullptr;  ///< as LayoutOptimizationOptions::cancel, checked per node
+  /// The corners are tried in batches on the pool's threads, each batch the
+  /// longest run of corners in order whose tries read disjoint local layouts,
+  /// at most this many (1: one by one, the same result).
+  std::size_t max_batch = 64;
+  const std::atomic<bool>* cancel =
+      nullptr;  ///< as LayoutOptimizationOptions::cancel, checked per batch of corners
 };
 
 struct LayoutOpeningReport {
