@@ -50,14 +50,14 @@ struct RingHit {
   double s = 0.0, distance = std::numeric_limits<double>::infinity();
 };
 
-// The closest point of the rings to a point: the first edge (ring by ring,
-// edge by edge) at the least distance, as a scan of every edge finds it, by a
-// search of a uniform grid of the edges outwards from the point's cell (a
-// scan per cut end was quadratic: 0.7 s of a Newfoundland layout's 16,000
-// cuts and 3,000 ring edges).
-class ClosestRingPoint {
+// The ring edges of a domain on a uniform grid, for the queries that a scan
+// of every edge per cut made quadratic (Newfoundland: 16,000 cuts and 3,100
+// ring edges per patch layout): the closest ring point, and the edges near a
+// cut segment. Edge ids run ring by ring, edge by edge, and both queries give
+// what a scan in that order gives.
+class RingEdgeGrid {
  public:
-  explicit ClosestRingPoint(const Domain& d) : d_(d) {
+  explicit RingEdgeGrid(const Domain& d) : d_(d) {
     std::size_t edges = 0;
     lo_ = hi_ = d.outer.vertices.front();
     for (std::size_t r = 0; r < ring_count(d); ++r)
@@ -92,8 +92,30 @@ class ClosestRingPoint {
     seen_.assign(edge_ring_.size(), 0);
   }
 
-  // (Not thread-safe: the search marks the edges it has measured.)
-  RingHit operator()(const Eigen::Vector2d& p) {
+  std::size_t ring_of(int e) const { return edge_ring_[e]; }
+  std::size_t index_of(int e) const { return edge_index_[e]; }
+
+  // The edges whose bounding boxes may meet the box [lo, hi] (every one that
+  // does, and others near), in id order, each once.
+  void edges_near(const Eigen::Vector2d& lo, const Eigen::Vector2d& hi, std::vector<int>& out) const {
+    out.clear();
+    const double pad = 1e-9 * cell_;
+    const auto [i0, j0] = cell_of(lo - Eigen::Vector2d::Constant(pad));
+    const auto [i1, j1] = cell_of(hi + Eigen::Vector2d::Constant(pad));
+    for (int j = j0; j <= j1; ++j)
+      for (int i = i0; i <= i1; ++i) {
+        const std::size_t c = static_cast<std::size_t>(i + nx_ * j);
+        out.insert(out.end(), edges_.begin() + static_cast<std::ptrdiff_t>(first_[c]),
+                   edges_.begin() + static_cast<std::ptrdiff_t>(first_[c + 1]));
+      }
+    std::sort(out.begin(), out.end());
+    out.erase(std::unique(out.begin(), out.end()), out.end());
+  }
+
+  // The closest point of the rings to p: the first edge at the least
+  // distance, searched outwards from p's cell. (Not thread-safe: the search
+  // marks the edges it has measured.)
+  RingHit closest(const Eigen::Vector2d& p) {
     RingHit best;
     if (!p.allFinite()) return best;  // (no distance is less than infinity: as a scan finds)
     ++stamp_;
@@ -225,7 +247,7 @@ class GraphBuilder {
         for (int e : it->second)
           if ((g_.points[e] - p).norm() <= tol_) return e;
       }
-    const RingHit h = closest_(p);
+    const RingHit h = closest_.closest(p);
     const auto& v = ring(d_, h.ring).vertices;
     const Eigen::Vector2d a = v[h.edge], b = v[(h.edge + 1) % v.size()];
     int id;
@@ -271,7 +293,7 @@ class GraphBuilder {
 
   const Domain& d_;
   const double tol_;
-  ClosestRingPoint closest_;
+  RingEdgeGrid closest_;
   Graph g_;
   std::vector<std::size_t> ring_first_;
   // Vertices inserted on ring edges: (ring, edge) -> (edge parameter, id).
@@ -363,7 +385,7 @@ namespace {
 // Each cut: two or more finite points, none repeated, each end on a ring or at
 // an end of another cut, and its first segment inside the domain.
 void check_cut_points(const Domain& d, const std::vector<Cut>& cuts, double tol) {
-  ClosestRingPoint closest(d);
+  RingEdgeGrid closest(d);
   // The cuts' ends by cells of size tol (a match lies in one of the 3 x 3 cells around a point).
   auto end_cell = [&](const Eigen::Vector2d& p) {
     return std::pair<long long, long long>(static_cast<long long>(std::floor(p.x() / tol)),
@@ -393,7 +415,7 @@ void check_cut_points(const Domain& d, const std::vector<Cut>& cuts, double tol)
           for (const auto& [o, p] : it->second)
             if (o != c && (p - end).norm() <= tol) at_cut_end = true;
         }
-      if (!at_cut_end && closest(end).distance > tol)
+      if (!at_cut_end && closest.closest(end).distance > tol)
         throw InputError(name + ": its end " + fmt(end) + " lies neither on a ring nor at an end of another cut");
     }
     if (!domain_contains(d, 0.5 * (cuts[c][0] + cuts[c][1])))
@@ -408,13 +430,19 @@ void check_cuts_against_rings(const Domain& d, const std::vector<Cut>& cuts, dou
       if ((a + project(e, a, b) * (b - a) - e).norm() <= tol) return true;
     return false;
   };
+  // (The ring edges near each segment, in ring and edge order: the first
+  // crossing found is the one a scan of every edge finds.)
+  const RingEdgeGrid grid(d);
+  std::vector<int> near;
   for (std::size_t c = 0; c < cuts.size(); ++c) {
     for (std::size_t k = 0; k + 1 < cuts[c].size(); ++k) {
       const CSegment s(cpoint(cuts[c][k]), cpoint(cuts[c][k + 1]));
       const auto box = s.bbox();
-      for (std::size_t r = 0; r < ring_count(d); ++r) {
-        const auto& v = ring(d, r).vertices;
-        for (std::size_t i = 0; i < v.size(); ++i) {
+      grid.edges_near(cuts[c][k].cwiseMin(cuts[c][k + 1]), cuts[c][k].cwiseMax(cuts[c][k + 1]), near);
+      for (const int e : near) {
+        const std::size_t r = grid.ring_of(e), i = grid.index_of(e);
+        {
+          const auto& v = ring(d, r).vertices;
           const Eigen::Vector2d a = v[i], b = v[(i + 1) % v.size()];
           const CSegment t(cpoint(a), cpoint(b));
           if (!CGAL::do_overlap(box, t.bbox()) || !CGAL::do_intersect(s, t)) continue;
@@ -563,9 +591,9 @@ std::vector<Interface> interfaces_of(const std::vector<Patch>& patches, std::siz
 
 PatchLayout build_patch_layout(const Domain& d, std::vector<Cut> cuts, const std::vector<Eigen::Vector2d>& ring_corners) {
   validate_cuts(d, cuts);
-  ClosestRingPoint closest(d);
+  RingEdgeGrid closest(d);
   for (const Eigen::Vector2d& p : ring_corners)
-    if (!p.allFinite() || closest(p).distance > snap_tolerance(d))
+    if (!p.allFinite() || closest.closest(p).distance > snap_tolerance(d))
       throw InputError("the patch corner " + fmt(p) + " does not lie on a ring");
   PatchLayout L;
   L.cuts = std::move(cuts);
