@@ -9,14 +9,16 @@
 // chi(D, eps) = (D + sqrt(eps^2 + D^2)) / 2 the regularization of Garanzha et
 // al. (2021) (so that a folded start can be unfolded; eps = 1e-4 |e|^2), and
 // a ring vertex inside a side with figure k = sin(phi / 2) adds 2 / k. Nodes
-// move one at a time (nonlinear Gauss-Seidel) to lower the sum of E^p over the
-// corners they touch (p = 4: close to the worst corner, yet smooth): inner
-// nodes by a pattern search in eight directions with a step kept per node,
-// ring nodes by sampling their arc (every ring vertex in reach, where the
-// corner angles jump, and a uniform grid, then a local refinement). A move is
-// kept only if `admissible` accepts it (the caller's check of the true
-// geometry: inner nodes inside the domain, no cut crossing a ring), unless the
-// node was not admissible where it stood (then any move that lowers the energy).
+// move one at a time (nonlinear Gauss-Seidel; nodes that share no quad in
+// batches on the pool's threads, with the same result) to lower the sum of
+// E^p over the corners they touch (p = 4: close to the worst corner, yet
+// smooth): inner nodes by a pattern search in eight directions with a step
+// kept per node, ring nodes by sampling their arc (every ring vertex in
+// reach, where the corner angles jump, and a uniform grid, then a local
+// refinement). A move is kept only if `admissible` accepts it (the caller's
+// check of the true geometry: inner nodes inside the domain, no cut crossing
+// a ring), unless the node was not admissible where it stood (then any move
+// that lowers the energy).
 #include <atomic>
 #include <exception>
 #include <functional>
