@@ -80,7 +80,9 @@ using LayoutAdmissible = std::function<bool(const LayoutMesh&, const LayoutTopol
 LayoutAdmissible admissible_in(const RingGeometry& geometry, double tol);
 
 /// \param admissible whether node n may stay where it now is (called after a
-/// tentative move that lowers the energy).
+/// tentative move that lowers the energy; from the pool's threads at once,
+/// for nodes that share no quad: it must be safe to call so, as a function
+/// of the mesh that reads only node n's quads is).
 /// \param active the nodes that may move (empty: all); the report's figures
 /// are then over the quads around them.
 LayoutOptimizationReport optimize_layout_nodes(LayoutMesh& m, const LayoutQuality& quality,
