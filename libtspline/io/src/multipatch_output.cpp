@@ -239,9 +239,8 @@ void write_multipatch_outputs(const MultiPatchResult& R, const std::string& out_
       toolkit::io::write_atomic(report_path, [&](const std::string& tmp) {
         std::ofstream out(tmp, std::ios::binary);
         out << std::setw(2) << report << '\n';
-        out.flush();
-        if (!out) throw toolkit::IoError("cannot write " + report_path);
         out.close();
+        if (!out) throw toolkit::IoError("cannot write " + report_path);
         surface_lane_done.get();  // (rethrows that lane's error: the temporary file goes)
       });
     });

@@ -6,6 +6,7 @@
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <map>
@@ -13,9 +14,9 @@
 #include <set>
 #include <sstream>
 
-#include "tspline/errors.h"
-#include "tspline/boundary/polygon_validation.h"
 #include "tspline/boundary/plane.h"
+#include "tspline/boundary/polygon_validation.h"
+#include "tspline/errors.h"
 
 namespace tspline {
 namespace {
@@ -59,11 +60,12 @@ class RingEdgeGrid {
  public:
   explicit RingEdgeGrid(const Domain& d) : d_(d) {
     std::size_t edges = 0;
-    lo_ = hi_ = d.outer.vertices.front();
+    Eigen::Vector2d hi = d.outer.vertices.front();
+    lo_ = hi;
     for (std::size_t r = 0; r < ring_count(d); ++r)
-      for (const auto& v : ring(d, r).vertices) lo_ = lo_.cwiseMin(v), hi_ = hi_.cwiseMax(v), ++edges;
+      for (const auto& v : ring(d, r).vertices) lo_ = lo_.cwiseMin(v), hi = hi.cwiseMax(v), ++edges;
     // About one edge per cell.
-    const Eigen::Vector2d extent = hi_ - lo_;
+    const Eigen::Vector2d extent = hi - lo_;
     const double side = std::max(extent.x(), extent.y());
     const double per_side = std::clamp(std::ceil(std::sqrt(static_cast<double>(edges))), 1.0, 2048.0);
     cell_ = side > 0.0 ? side / per_side : 1.0;
@@ -71,7 +73,6 @@ class RingEdgeGrid {
     ny_ = std::max(1, static_cast<int>(std::ceil(extent.y() / cell_)));
     // Each edge in every cell its bounding box (a little widened) meets, so
     // that the closest point of an edge lies in a cell that holds the edge.
-    const double pad = 1e-9 * cell_;
     std::vector<std::pair<int, int>> in_cell;  // (cell, edge)
     for (std::size_t r = 0; r < ring_count(d); ++r) {
       const auto& v = ring(d, r).vertices;
@@ -79,8 +80,7 @@ class RingEdgeGrid {
         const Eigen::Vector2d a = v[i], b = v[(i + 1) % v.size()];
         const int e = static_cast<int>(edge_ring_.size());
         edge_ring_.push_back(r), edge_index_.push_back(i);
-        const auto [i0, j0] = cell_of(a.cwiseMin(b) - Eigen::Vector2d::Constant(pad));
-        const auto [i1, j1] = cell_of(a.cwiseMax(b) + Eigen::Vector2d::Constant(pad));
+        const auto [i0, j0, i1, j1] = cells_meeting(a.cwiseMin(b), a.cwiseMax(b));
         for (int j = j0; j <= j1; ++j)
           for (int k = i0; k <= i1; ++k) in_cell.push_back({k + nx_ * j, e});
       }
@@ -99,9 +99,7 @@ class RingEdgeGrid {
   // does, and others near), in id order, each once.
   void edges_near(const Eigen::Vector2d& lo, const Eigen::Vector2d& hi, std::vector<int>& out) const {
     out.clear();
-    const double pad = 1e-9 * cell_;
-    const auto [i0, j0] = cell_of(lo - Eigen::Vector2d::Constant(pad));
-    const auto [i1, j1] = cell_of(hi + Eigen::Vector2d::Constant(pad));
+    const auto [i0, j0, i1, j1] = cells_meeting(lo, hi);
     for (int j = j0; j <= j1; ++j)
       for (int i = i0; i <= i1; ++i) {
         const std::size_t c = static_cast<std::size_t>(i + nx_ * j);
@@ -149,6 +147,15 @@ class RingEdgeGrid {
     return {index(p.x(), lo_.x(), nx_), index(p.y(), lo_.y(), ny_)};
   }
 
+  // The cells (i0, j0, i1, j1) that the box [lo, hi] meets, widened a little
+  // against the rounding of cell_of.
+  std::array<int, 4> cells_meeting(const Eigen::Vector2d& lo, const Eigen::Vector2d& hi) const {
+    const Eigen::Vector2d pad = Eigen::Vector2d::Constant(1e-9 * cell_);
+    const auto [i0, j0] = cell_of(lo - pad);
+    const auto [i1, j1] = cell_of(hi + pad);
+    return {i0, j0, i1, j1};
+  }
+
   // The edges of cell c not measured yet; the first in ring and edge order of equals wins.
   void measure(int c, const Eigen::Vector2d& p, RingHit& best) {
     for (std::size_t k = first_[static_cast<std::size_t>(c)]; k < first_[static_cast<std::size_t>(c) + 1];
@@ -168,7 +175,7 @@ class RingEdgeGrid {
   }
 
   const Domain& d_;
-  Eigen::Vector2d lo_, hi_;
+  Eigen::Vector2d lo_;
   double cell_ = 1.0;
   int nx_ = 1, ny_ = 1;
   std::vector<std::size_t> first_;  // cell c's edges: edges_[first_[c] .. first_[c + 1])
@@ -195,7 +202,7 @@ struct Graph {
 // ring_first_[r] + i), then the cuts' ends and inner points, then the half-edges.
 class GraphBuilder {
  public:
-  explicit GraphBuilder(const Domain& d) : d_(d), tol_(snap_tolerance(d)), closest_(d) {
+  explicit GraphBuilder(const Domain& d) : d_(d), tol_(snap_tolerance(d)), ring_edges_(d) {
     for (std::size_t r = 0; r < ring_count(d); ++r) {
       ring_first_.push_back(g_.points.size());
       for (const auto& v : ring(d, r).vertices) g_.points.push_back(v);
@@ -247,7 +254,7 @@ class GraphBuilder {
         for (int e : it->second)
           if ((g_.points[e] - p).norm() <= tol_) return e;
       }
-    const RingHit h = closest_.closest(p);
+    const RingHit h = ring_edges_.closest(p);
     const auto& v = ring(d_, h.ring).vertices;
     const Eigen::Vector2d a = v[h.edge], b = v[(h.edge + 1) % v.size()];
     int id;
@@ -293,7 +300,7 @@ class GraphBuilder {
 
   const Domain& d_;
   const double tol_;
-  RingEdgeGrid closest_;
+  RingEdgeGrid ring_edges_;
   Graph g_;
   std::vector<std::size_t> ring_first_;
   // Vertices inserted on ring edges: (ring, edge) -> (edge parameter, id).
@@ -384,8 +391,7 @@ namespace {
 
 // Each cut: two or more finite points, none repeated, each end on a ring or at
 // an end of another cut, and its first segment inside the domain.
-void check_cut_points(const Domain& d, const std::vector<Cut>& cuts, double tol) {
-  RingEdgeGrid closest(d);
+void check_cut_points(const Domain& d, const std::vector<Cut>& cuts, double tol, RingEdgeGrid& ring_edges) {
   // The cuts' ends by cells of size tol (a match lies in one of the 3 x 3 cells around a point).
   auto end_cell = [&](const Eigen::Vector2d& p) {
     return std::pair<long long, long long>(static_cast<long long>(std::floor(p.x() / tol)),
@@ -415,7 +421,7 @@ void check_cut_points(const Domain& d, const std::vector<Cut>& cuts, double tol)
           for (const auto& [o, p] : it->second)
             if (o != c && (p - end).norm() <= tol) at_cut_end = true;
         }
-      if (!at_cut_end && closest.closest(end).distance > tol)
+      if (!at_cut_end && ring_edges.closest(end).distance > tol)
         throw InputError(name + ": its end " + fmt(end) + " lies neither on a ring nor at an end of another cut");
     }
     if (!domain_contains(d, 0.5 * (cuts[c][0] + cuts[c][1])))
@@ -423,7 +429,8 @@ void check_cut_points(const Domain& d, const std::vector<Cut>& cuts, double tol)
   }
 }
 
-void check_cuts_against_rings(const Domain& d, const std::vector<Cut>& cuts, double tol) {
+void check_cuts_against_rings(const Domain& d, const std::vector<Cut>& cuts, double tol,
+                              const RingEdgeGrid& ring_edges) {
   // Cut segments against ring edges: they may meet only at the cut's own ends.
   auto near_end = [&](const Cut& cut, const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
     for (const Eigen::Vector2d& e : {cut.front(), cut.back()})
@@ -432,15 +439,14 @@ void check_cuts_against_rings(const Domain& d, const std::vector<Cut>& cuts, dou
   };
   // (The ring edges near each segment, in ring and edge order: the first
   // crossing found is the one a scan of every edge finds.)
-  const RingEdgeGrid grid(d);
   std::vector<int> near;
   for (std::size_t c = 0; c < cuts.size(); ++c) {
     for (std::size_t k = 0; k + 1 < cuts[c].size(); ++k) {
       const CSegment s(cpoint(cuts[c][k]), cpoint(cuts[c][k + 1]));
       const auto box = s.bbox();
-      grid.edges_near(cuts[c][k].cwiseMin(cuts[c][k + 1]), cuts[c][k].cwiseMax(cuts[c][k + 1]), near);
+      ring_edges.edges_near(cuts[c][k].cwiseMin(cuts[c][k + 1]), cuts[c][k].cwiseMax(cuts[c][k + 1]), near);
       for (const int e : near) {
-        const std::size_t r = grid.ring_of(e), i = grid.index_of(e);
+        const std::size_t r = ring_edges.ring_of(e), i = ring_edges.index_of(e);
         {
           const auto& v = ring(d, r).vertices;
           const Eigen::Vector2d a = v[i], b = v[(i + 1) % v.size()];
@@ -517,8 +523,9 @@ void check_cuts_against_cuts(const std::vector<Cut>& cuts, double tol) {
 
 void validate_cuts(const Domain& d, const std::vector<Cut>& cuts) {
   const double tol = snap_tolerance(d);
-  check_cut_points(d, cuts, tol);
-  check_cuts_against_rings(d, cuts, tol);
+  RingEdgeGrid ring_edges(d);
+  check_cut_points(d, cuts, tol, ring_edges);
+  check_cuts_against_rings(d, cuts, tol, ring_edges);
   check_cuts_against_cuts(cuts, tol);
 }
 
@@ -591,9 +598,9 @@ std::vector<Interface> interfaces_of(const std::vector<Patch>& patches, std::siz
 
 PatchLayout build_patch_layout(const Domain& d, std::vector<Cut> cuts, const std::vector<Eigen::Vector2d>& ring_corners) {
   validate_cuts(d, cuts);
-  RingEdgeGrid closest(d);
+  RingEdgeGrid ring_edges(d);
   for (const Eigen::Vector2d& p : ring_corners)
-    if (!p.allFinite() || closest.closest(p).distance > snap_tolerance(d))
+    if (!p.allFinite() || ring_edges.closest(p).distance > snap_tolerance(d))
       throw InputError("the patch corner " + fmt(p) + " does not lie on a ring");
   PatchLayout L;
   L.cuts = std::move(cuts);
