@@ -162,6 +162,18 @@ TEST_SUITE("layout_quality") {
     CHECK_FALSE(at(200.0));  // reflex
     CHECK_FALSE(at(270.0));
     CHECK_FALSE(tspline::patch_corner_in_range(V(0, 0), V(1, 0)));  // a side of length 0
+    // A narrower range: up to 135 degrees (sin 45 = 0.7071 rounded up to 0.708).
+    auto at_most_135 = [](double degrees) {
+      const double a = degrees * std::numbers::pi / 180.0;
+      return tspline::patch_corner_in_range(V(2, 0), V(3 * std::cos(a), 3 * std::sin(a)), 135.0);
+    };
+    CHECK(at_most_135(134.0));
+    CHECK_FALSE(at_most_135(136.0));
+    CHECK(tspline::obtuse_corner_sine(170.0) == 0.174);  // the check's own threshold, sin 10 deg = 0.17365
+    CHECK(tspline::obtuse_corner_sine(135.0) == 0.708);
+    CHECK_THROWS_AS((void)tspline::obtuse_corner_sine(90.0), tspline::InputError);
+    CHECK_THROWS_AS((void)tspline::obtuse_corner_sine(180.0), tspline::InputError);
+    CHECK_THROWS_AS((void)tspline::obtuse_corner_sine(std::nan("")), tspline::InputError);
   }
 
   TEST_CASE("side kinks: a ring vertex inside a side with domain angle phi gives sin^2(phi / 2)") {

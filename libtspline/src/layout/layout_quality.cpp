@@ -5,6 +5,7 @@
 #include <cmath>
 #include <numbers>
 #include "tspline/boundary/plane.h"
+#include "tspline/errors.h"
 
 namespace tspline {
 namespace {
@@ -19,7 +20,8 @@ double arc_between(double a, double b, double dir, double L) {
 
 }  // namespace
 
-LayoutQuality::LayoutQuality(const LayoutRings& rings) : rings_(rings) {
+LayoutQuality::LayoutQuality(const LayoutRings& rings, double max_corner_degrees)
+    : rings_(rings), max_corner_degrees_(max_corner_degrees), obtuse_sine_(obtuse_corner_sine(max_corner_degrees)) {
   for (std::size_t r = 0; r < rings.curves.size(); ++r) {
     const RingCurve& c = rings.curves[r];
     const std::size_t n = c.size();
@@ -93,10 +95,28 @@ int LayoutQuality::corner_vectors_at(const LayoutMesh& m, const LayoutTopology& 
   return static_cast<int>(scales.size());
 }
 
-bool patch_corner_in_range(const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
+double obtuse_corner_sine(double max_degrees) {
+  if (!(max_degrees > 90.0 && max_degrees < 180.0))
+    throw InputError("the widest patch corner must be between 90 and 180 degrees (exclusive)");
+  return std::ceil(1000.0 * std::sin((180.0 - max_degrees) * std::numbers::pi / 180.0)) / 1000.0;
+}
+
+namespace {
+
+bool corner_in_range_sine(const Eigen::Vector2d& a, const Eigen::Vector2d& b, double obtuse_sine) {
   const double l = a.norm() * b.norm();
   const double sn = l > 0.0 ? cross(a, b) / l : -1.0;
-  return sn > 0.0175 && (a.dot(b) > 0.0 || sn > 0.174);
+  return sn > 0.0175 && (a.dot(b) > 0.0 || sn > obtuse_sine);
+}
+
+}  // namespace
+
+bool patch_corner_in_range(const Eigen::Vector2d& a, const Eigen::Vector2d& b, double max_degrees) {
+  return corner_in_range_sine(a, b, obtuse_corner_sine(max_degrees));
+}
+
+bool LayoutQuality::corner_in_range(const Eigen::Vector2d& a, const Eigen::Vector2d& b) const {
+  return corner_in_range_sine(a, b, obtuse_sine_);
 }
 
 LayoutCornerQuality LayoutQuality::corner(const LayoutMesh& m, const LayoutTopology& t, int q, int j) const {

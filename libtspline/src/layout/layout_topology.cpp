@@ -65,7 +65,7 @@ int rejected_corners(const LayoutMesh& m, const LayoutTopology& t, const LayoutQ
   for (const int q : quads)
     for (int j = 0; j < 4; ++j) {
       const auto [a, b] = Q.corner_vectors(m, t, q, j, 0.0);
-      if (!patch_corner_in_range(a, b)) ++count;
+      if (!Q.corner_in_range(a, b)) ++count;
     }
   return count;
 }

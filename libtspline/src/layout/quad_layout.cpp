@@ -270,8 +270,9 @@ class QuadLayoutBuilder {
   int level_ = 2;
   // Node moves may not put patch corners out of range (LayoutOptimizationOptions::
   // keep_patch_corners_in_range): from the first layout rejected for such a
-  // corner on (the guard also pins nodes where the energy would have them pass).
-  bool guard_corners_ = false;
+  // corner on, or from the start (QuadLayoutOptions::guard_patch_corners; the
+  // guard also pins nodes where the energy would have them pass).
+  bool guard_corners_;
   std::vector<Eigen::Vector2d> level2_failed_at_;  // where a layout optimized in full was rejected
   int repairs_ = 0;  // rounds that added nodes (dropping an optimization level is not one)
   std::vector<Eigen::Vector2d> repaired_at_;  // where a rejected layout got a ring node more
@@ -319,8 +320,9 @@ QuadLayoutBuilder::QuadLayoutBuilder(const Domain& d, const QuadLayoutOptions& o
       node_options_(with_min_size(o.nodes, size_options_.min_size)),
       geometry_(RingGeometry::of_rings(R_.curves)),
       tol_(1e-9 * diam_),
-      quality_(R_),
-      admissible_(admissible_in(geometry_, tol_)) {
+      quality_(R_, o.max_patch_corner_degrees),
+      admissible_(admissible_in(geometry_, tol_)),
+      guard_corners_(o.guard_patch_corners) {
   // Ring pieces are two quad edges long.
   const auto piece_size = [this](const Eigen::Vector2d& x) { return 2.0 * h_(x); };
   if (!o.start_ring_nodes.empty()) {
@@ -375,11 +377,13 @@ QuadLayout QuadLayoutBuilder::build() {
     std::optional<LayoutFirstPass> first_done;
     LayoutFirstPass first_made;
     if (o_.memo && level_ >= 1)
-      first_done = o_.memo->first_pass(memo_domain(), size_options_, nodes_, level_, guard_corners_);
+      first_done = o_.memo->first_pass(memo_domain(), size_options_, nodes_, level_, guard_corners_,
+                                       o_.max_patch_corner_degrees);
     optimize_layout(m, start, R_, quality_, admissible_, level_, o_.corner_sheets, guard_corners_, out_.stats,
                     o_.cancel, first_done ? &*first_done : nullptr, &first_made);
     if (o_.memo && level_ >= 1 && !first_done)
-      o_.memo->store_first_pass(memo_domain(), size_options_, nodes_, level_, guard_corners_, first_made);
+      o_.memo->store_first_pass(memo_domain(), size_options_, nodes_, level_, guard_corners_,
+                                o_.max_patch_corner_degrees, first_made);
     if (debugging())
       std::fprintf(stderr, "layout round %d: mesh %zu quads at %.2f s, optimized in %.2f s\n", round, m.quads.size(),
                    std::chrono::duration<double>(t_opt - t0_).count(), toolkit::seconds_since(t_opt));
@@ -643,17 +647,20 @@ void QuadLayoutBuilder::make_patch_layout(const LayoutMesh& m, const LayoutTopol
     if (m.ring[n] >= 0 && t.valence(static_cast<int>(n)) == 1) out_.ring_corners.push_back(m.x[n]);
   out_.layout = build_patch_layout(d_, std::move(cuts), out_.ring_corners);
   // Every patch corner where the map sees it (at the vertex itself) between 1
-  // and 170 degrees (patch_corner_in_range). (The mesher's own layout, level
-  // 0, only needs convex corners.)
+  // and 170 degrees (QuadLayoutOptions::max_patch_corner_degrees,
+  // patch_corner_in_range). (The mesher's own layout, level 0, only needs
+  // convex corners.)
   for (const Patch& p : out_.layout.patches)
     for (int k = 0; k < 4; ++k) {
       const auto& v = p.polygon.vertices;
       const std::size_t c = p.corners[k], n = v.size();
       const Eigen::Vector2d a = v[(c + 1) % n] - v[c], b = v[(c + n - 1) % n] - v[c];
-      const bool fine = level_ == 0 ? cross(a, b) / (a.norm() * b.norm()) > 1e-3 : patch_corner_in_range(a, b);
-      if (!fine)
-        throw InputError("a patch corner outside 1-170 degrees near (" + std::to_string(v[c].x()) + ", " +
-                         std::to_string(v[c].y()) + ")");
+      const bool fine = level_ == 0 ? cross(a, b) / (a.norm() * b.norm()) > 1e-3 : quality_.corner_in_range(a, b);
+      if (!fine) {
+        std::ostringstream range;
+        range << "a patch corner outside 1-" << quality_.max_corner_degrees() << " degrees near (";
+        throw InputError(range.str() + std::to_string(v[c].x()) + ", " + std::to_string(v[c].y()) + ")");
+      }
     }
 }
 
@@ -686,6 +693,7 @@ void QuadLayoutBuilder::recover_from_rejected_layout(const std::string& what) {
     level2_again = near_one_of(level2_failed_at_);
   }
   if (level_ == 2 && !guard_corners_ && what.find("patch corner") != std::string::npos) {
+    if (o_.throw_when_sheets_rejected && out_.stats.corner_sheets > 0) throw SheetsRejected(mesh_name() + ": " + what, nodes_);
     note(mesh_name() + ": " + what + "; the same mesh, no node move allowed to put a patch corner out of range");
     guard_corners_ = true;
     if (at != std::string::npos) level2_failed_at_.push_back(place);

@@ -38,11 +38,12 @@ void QuadLayoutMemo::store_mesh(const Rings& domain, const SizeFieldOptions& siz
 
 std::optional<LayoutFirstPass> QuadLayoutMemo::first_pass(const Rings& domain, const SizeFieldOptions& size,
                                                           const RingNodes& nodes, int level,
-                                                          bool guard_corners) {
+                                                          bool guard_corners, double max_corner_degrees) {
   std::lock_guard<std::mutex> lock(mutex_);
   if (!serves(domain, size)) return std::nullopt;
   for (const PassEntry& e : passes_)
-    if (e.level == level && e.guard_corners == guard_corners && e.nodes == nodes) {
+    if (e.level == level && e.guard_corners == guard_corners && e.max_corner_degrees == max_corner_degrees &&
+        e.nodes == nodes) {
       ++hits_;
       return e.pass;
     }
@@ -51,12 +52,13 @@ std::optional<LayoutFirstPass> QuadLayoutMemo::first_pass(const Rings& domain, c
 
 void QuadLayoutMemo::store_first_pass(const Rings& domain, const SizeFieldOptions& size,
                                       const RingNodes& nodes, int level, bool guard_corners,
-                                      const LayoutFirstPass& pass) {
+                                      double max_corner_degrees, const LayoutFirstPass& pass) {
   std::lock_guard<std::mutex> lock(mutex_);
   if (!serves(domain, size)) return;
   for (const PassEntry& e : passes_)
-    if (e.level == level && e.guard_corners == guard_corners && e.nodes == nodes) return;
-  passes_.push_back({nodes, level, guard_corners, pass});
+    if (e.level == level && e.guard_corners == guard_corners && e.max_corner_degrees == max_corner_degrees &&
+        e.nodes == nodes) return;
+  passes_.push_back({nodes, level, guard_corners, max_corner_degrees, pass});
 }
 
 std::size_t QuadLayoutMemo::hits() const {

@@ -30,17 +30,27 @@ struct LayoutCornerQuality {
 };
 
 /// Whether a patch corner with sides leaving along a and b (counter-clockwise
-/// from a to b) is one a patch map can take: between 1 and 170 degrees (sin 1
-/// deg = 0.0175, sin 10 deg = 0.174); near 180 degrees det J ~ 0 there, since
-/// det J at a corner of the square is the cross product of the two side
-/// tangents. The layout's final check (quad_layout.cpp) and the edge
-/// rotations (layout_topology.cpp) hold the layout to it.
-bool patch_corner_in_range(const Eigen::Vector2d& a, const Eigen::Vector2d& b);
+/// from a to b) is one a patch map can take: between 1 and max_degrees (sin 1
+/// deg = 0.0175; above 90 degrees the sine must exceed obtuse_corner_sine
+/// (max_degrees), 0.174 for 170); near 180 degrees det J ~ 0 there, since det
+/// J at a corner of the square is the cross product of the two side tangents.
+/// The layout's final check (quad_layout.cpp) and the edge rotations
+/// (layout_topology.cpp) hold the layout to it.
+bool patch_corner_in_range(const Eigen::Vector2d& a, const Eigen::Vector2d& b, double max_degrees = 170.0);
+
+/// The least sine of a patch corner of more than 90 degrees that is in range:
+/// sin(max_degrees) rounded up to three decimals (0.174 for 170 degrees).
+/// \throw InputError unless max_degrees is in (90, 180).
+double obtuse_corner_sine(double max_degrees);
 
 class LayoutQuality {
  public:
-  explicit LayoutQuality(const LayoutRings& rings);
+  /// max_corner_degrees: the widest patch corner in range (patch_corner_in_range).
+  explicit LayoutQuality(const LayoutRings& rings, double max_corner_degrees = 170.0);
   const LayoutRings& rings() const { return rings_; }
+  double max_corner_degrees() const { return max_corner_degrees_; }
+  /// patch_corner_in_range with this quality's widest corner.
+  bool corner_in_range(const Eigen::Vector2d& a, const Eigen::Vector2d& b) const;
 
   /// Length of side j of quad q (from quads[q][j] to the next corner): the ring's
   /// arc length where it lies on a ring, the chord otherwise.
@@ -89,6 +99,7 @@ class LayoutQuality {
   };
   SideVertices side_vertices(const LayoutMesh& m, const LayoutTopology& t, int q, int j) const;
   const LayoutRings& rings_;
+  double max_corner_degrees_, obtuse_sine_;
   std::vector<std::vector<std::vector<double>>> table_;  // per ring, per level
 };
 

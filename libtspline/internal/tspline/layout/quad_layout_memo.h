@@ -42,9 +42,10 @@ class QuadLayoutMemo {
                   const PlanarQuadMesh& mesh);
 
   std::optional<LayoutFirstPass> first_pass(const Rings& domain, const SizeFieldOptions& size,
-                                            const RingNodes& nodes, int level, bool guard_corners);
+                                            const RingNodes& nodes, int level, bool guard_corners,
+                                            double max_corner_degrees);
   void store_first_pass(const Rings& domain, const SizeFieldOptions& size, const RingNodes& nodes, int level,
-                        bool guard_corners, const LayoutFirstPass& pass);
+                        bool guard_corners, double max_corner_degrees, const LayoutFirstPass& pass);
 
   /// Lookups that found an entry (for tests and debugging output).
   std::size_t hits() const;
@@ -61,6 +62,7 @@ class QuadLayoutMemo {
     RingNodes nodes;
     int level = 0;
     bool guard_corners = false;
+    double max_corner_degrees = 0.0;  // QuadLayoutOptions::max_patch_corner_degrees (the rotations keep to it)
     LayoutFirstPass pass;
   };
   mutable std::mutex mutex_;
