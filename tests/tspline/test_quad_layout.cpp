@@ -681,6 +681,73 @@ TEST_SUITE("quad_layout") {
     CHECK(Q.patches->min_scaled_jacobian_dense() == A.patches->min_scaled_jacobian_dense());
   }
 
+  TEST_CASE("auto: a single try whose interpolating map folds widely stops at its frozen boundary; a good layout "
+            "is kept over it, else the try runs in full") {
+    if (!tspline::quad_mesher_available()) return;
+    // Bali's one patch: its interpolating map folds (det J <= 0) at about 2 % of
+    // the untangling's samples, and untangles to a map far below the thresholds.
+    tspline::DomainCleaningOptions how;
+    how.blunt_tips_below_degrees = 17.5;
+    const tspline::Domain bali = tspline::validate_domain(
+        {tspline::io::read_polygon(std::string(TSPLINE_TEST_DATA_DIR) + "/coastlines/bali.txt"), {}}, how);
+    tspline::ParameterizationOptions po;
+    std::vector<std::string> steps;
+    po.progress = [&steps](const tspline::ProgressEvent& e) { steps.push_back(e.text); };
+    const tspline::AdaptiveOptions ad;
+    tspline::DomainParameterizationOptions c;
+    const tspline::DomainParameterization A = tspline::parameterize_domain(bali, po, ad, c);
+    po.progress = nullptr;
+    INFO(A.reason);
+    REQUIRE(A.patches);
+    CHECK(A.layout == "quad");
+    CHECK(contains(A.reason, "one patch is stopped: its interpolating map folds (det J <= 0) at "));
+    CHECK(contains(A.single_stopped, "% of the untangling's "));
+    REQUIRE(A.single_corners);
+    CHECK_FALSE(A.rejected_single);
+    CHECK(std::none_of(steps.begin(), steps.end(), [](const std::string& m) {
+      return contains(m, "untangling:") && !contains(m, "patch ");
+    }));
+    // The whole try: poor, and the same layout kept (the same map).
+    c.first_try_max_folded = 0.0;
+    const tspline::DomainParameterization W = tspline::parameterize_domain(bali, po, ad, c);
+    REQUIRE(W.patches);
+    REQUIRE(W.rejected_single);
+    CHECK(W.rejected_single->min_scaled < c.good.scaled_jacobian);
+    CHECK(W.single_stopped.empty());
+    REQUIRE(W.patches->patches.size() == A.patches->patches.size());
+    CHECK(W.patches->min_mean_ratio_dense() == A.patches->min_mean_ratio_dense());
+    CHECK(W.patches->min_scaled_jacobian_dense() == A.patches->min_scaled_jacobian_dense());
+    // The gear's one patch is good (certified, scaled Jacobian 0.39) though its
+    // interpolating map folds at 0.28 % of its samples; stopped at 0.1 % with
+    // thresholds its layout misses (0.64) but its corners do not rule out, the
+    // try runs again in full and the choice is the whole try's.
+    const tspline::Domain gear{tspline::io::read_polygon(test_support::polygon_file("gear.txt")), {}};
+    tspline::DomainParameterizationOptions g;
+    g.first_try_max_folded = 0.001;
+    g.good = {0.7, 0.7};
+    g.retry_size_factor = 1.0;
+    steps.clear();
+    po.progress = [&steps](const tspline::ProgressEvent& e) { steps.push_back(e.text); };
+    const tspline::DomainParameterization B = tspline::parameterize_domain(gear, po, ad, g);
+    po.progress = nullptr;
+    INFO(B.reason);
+    CHECK(std::any_of(steps.begin(), steps.end(), [](const std::string& m) {
+      return contains(m, "stopped: its interpolating map folds");
+    }));
+    CHECK(std::any_of(steps.begin(), steps.end(), [](const std::string& m) {
+      return contains(m, "one patch tried again to the end, to compare");
+    }));
+    g.first_try_max_folded = 0.0;
+    const tspline::DomainParameterization F = tspline::parameterize_domain(gear, po, ad, g);
+    CHECK(B.layout == F.layout);
+    CHECK(B.single_stopped.empty());
+    REQUIRE(B.rejected_single.has_value() == F.rejected_single.has_value());
+    if (B.rejected_single) CHECK(B.rejected_single->min_mean_ratio == F.rejected_single->min_mean_ratio);
+    c.first_try_max_folded = 1.5;
+    CHECK(contains(message_of<tspline::InputError>([&] { (void)tspline::parameterize_domain(bali, po, ad, c); }),
+                   "largest folded fraction"));
+  }
+
   TEST_CASE_FIXTURE(UnitSquareAtLevel2,
                     "auto: a stopped single try is run to the end where the layout is below its corners") {
     // The unit square's single patch has J = I at its corners (scaled

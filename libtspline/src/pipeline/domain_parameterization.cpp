@@ -16,6 +16,7 @@
 #include "tspline/layout/quad_mesher.h"
 #include "tspline/multipatch/automatic_cuts.h"
 #include "tspline/validity/corner_quality.h"
+#include "tspline/validity/map_energy.h"
 
 namespace tspline {
 
@@ -93,6 +94,24 @@ std::string corners_rule_out(const BoundaryCornerMinima& m, const QualityFloor& 
   return s.str();
 }
 
+// Why one patch is not a quick try where its interpolating map, boundary
+// frozen, folds (det J <= 0) at more than c.first_try_max_folded of the
+// untangling's samples (map_energy.h), or "".
+std::string folds_rule_out(const TSplineMap& map, const MapEnergyOptions& energy_options,
+                           const DomainParameterizationOptions& c) {
+  const MapEnergy energy(map, energy_options);
+  const SampleStats s = energy.stats(energy.variables(map).data());
+  if (s.points == 0) return "";
+  const double folded = static_cast<double>(s.nonpositive) / static_cast<double>(s.points);
+  if (!(folded > c.first_try_max_folded)) return "";
+  std::ostringstream out;
+  out.precision(3);
+  out << "its interpolating map folds (det J <= 0) at " << 100.0 * folded << " % of the untangling's "
+      << s.points << " samples, more than " << 100.0 * c.first_try_max_folded
+      << " %: not a quick try (such maps untangle to poor maps)";
+  return out.str();
+}
+
 // The worse of the two figures: how maps that are not both good are ranked.
 double worse_figure(const DenseMapQuality& q) { return std::min(q.min_scaled, q.min_mean_ratio); }
 
@@ -111,6 +130,8 @@ DomainParameterization parameterize_domain(const Domain& input, const Parameteri
                                            const AdaptiveOptions& adaptive, const DomainParameterizationOptions& c,
                                            const IterationCallback& on_iteration, const PatchCallback& on_patch) {
   if (c.first_try_rounds < 0) throw InputError("the first try's adaptive rounds must be >= 0");
+  if (!(c.first_try_max_folded >= 0.0 && c.first_try_max_folded <= 1.0))
+    throw InputError("the first try's largest folded fraction must be in [0, 1]");
   // One ring goes to run_parameterization as it is (it validates and cleans it
   // itself, with the run's tolerance, and reports the notes); rings with holes
   // are validated here.
@@ -458,11 +479,21 @@ DomainParameterization parameterize_domain(const Domain& input, const Parameteri
   // layout is neither good nor at least as good as those corners: the try is
   // then run again without the stop, so that every choice is the one the
   // whole try would give.
+  // It also stops there where its interpolating map folds at more than
+  // c.first_try_max_folded of the untangling's samples (not a quick try; such
+  // maps untangled to poor maps on every coastline measured): then only a good
+  // layout is kept over it, else the try runs again in full as above.
   std::optional<BoundaryCornerMinima> corners;
+  bool stopped_for_folds = false;
   if (quad_mesher_available())  // (else one patch is all there is)
-    first.stop_when_boundary_frozen = [&c, &corners](const TSplineMap& map) {
+    first.stop_when_boundary_frozen = [&c, &corners, &adaptive, &stopped_for_folds](const TSplineMap& map) {
       corners = boundary_corner_minima(map);
-      return corners_rule_out(*corners, c.good);
+      std::string why = corners_rule_out(*corners, c.good);
+      if (why.empty() && c.first_try_max_folded > 0.0) {
+        why = folds_rule_out(map, adaptive.untangling.energy, c);
+        stopped_for_folds = !why.empty();
+      }
+      return why;
     };
   std::optional<ParameterizationResult> single;
   std::string stopped;
@@ -503,7 +534,7 @@ DomainParameterization parameterize_domain(const Domain& input, const Parameteri
       return out;
     }
   }
-  std::string why = !single      ? "one patch cannot be good: " + stopped
+  std::string why = !single      ? (stopped_for_folds ? "one patch is stopped: " : "one patch cannot be good: ") + stopped
                     : !certified ? std::string("one patch is not certified after ") +
                                        std::to_string(first.max_adapt) + " adaptive rounds"
                                  : "one patch is certified but poor over the whole map (" + figures(q) + ")";
@@ -519,8 +550,11 @@ DomainParameterization parameterize_domain(const Domain& input, const Parameteri
         at_corners.min_scaled = corners->scaled.scaled_jacobian;
         at_corners.min_mean_ratio = corners->mean_ratio.mean_ratio;
       }
-      if (!single && keep_layout_over_single(lq, at_corners, true, c)) {
+      // A try stopped for its folds: a good layout is kept over it.
+      if (!single &&
+          (stopped_for_folds ? reaches_good_quality(lq, c) : keep_layout_over_single(lq, at_corners, true, c))) {
         out.single_corners = corners;
+        out.single_stopped = stopped;
         return out;
       }
       try_in_full();
