@@ -286,7 +286,8 @@ TEST_SUITE("quad_layout") {
   }
 
   TEST_CASE(
-      "sheets rejected for a patch corner out of range: their rings pillowed from the same ring nodes, and the "
+      "sheets rejected for a patch corner out of range: their rings pillowed from the same ring nodes, and "
+      "the "
       "sheets with the guard from the start are the builder's own guarded second try") {
     if (!tspline::quad_mesher_available()) return;
     tspline::DomainCleaningOptions how;
@@ -338,8 +339,9 @@ TEST_SUITE("quad_layout") {
                    "between 90 and 180 degrees"));
   }
 
-  TEST_CASE("parameterize_domain: sheets rejected, their rings pillowed first; the guarded sheets second where the "
-            "pillowed map misses the thresholds") {
+  TEST_CASE(
+      "parameterize_domain: sheets rejected, their rings pillowed first; the guarded sheets second where the "
+      "pillowed map misses the thresholds") {
     if (!tspline::quad_mesher_available()) return;
     tspline::DomainCleaningOptions how;
     how.blunt_tips_below_degrees = 17.5;
@@ -360,8 +362,9 @@ TEST_SUITE("quad_layout") {
     c.good = {0.99, 0.99};
     const tspline::DomainParameterization both = tspline::parameterize_domain(d, po, ad, c);
     REQUIRE(both.patches);
-    CHECK(contains(both.reason, "a second quad layout with sheets through its flat ring corners, no node move "
-                                "allowed to put a patch corner out of range"));
+    CHECK(contains(both.reason,
+                   "a second quad layout with sheets through its flat ring corners, no node move "
+                   "allowed to put a patch corner out of range"));
     // Without a second layout the builder guards the sheets at once.
     c.retry_size_factor = 1.0;
     const tspline::DomainParameterization one = tspline::parameterize_domain(d, po, ad, c);
@@ -681,8 +684,9 @@ TEST_SUITE("quad_layout") {
     CHECK(Q.patches->min_scaled_jacobian_dense() == A.patches->min_scaled_jacobian_dense());
   }
 
-  TEST_CASE("auto: a single try whose interpolating map folds widely stops at its frozen boundary; a good layout "
-            "is kept over it, else the try runs in full") {
+  TEST_CASE(
+      "auto: a single try whose interpolating map folds widely stops at its frozen boundary; a good layout "
+      "is kept over it, else the try runs in full") {
     if (!tspline::quad_mesher_available()) return;
     // Bali's one patch: its interpolating map folds (det J <= 0) at about 2 % of
     // the untangling's samples, and untangles to a map far below the thresholds.
@@ -744,8 +748,9 @@ TEST_SUITE("quad_layout") {
     REQUIRE(B.rejected_single.has_value() == F.rejected_single.has_value());
     if (B.rejected_single) CHECK(B.rejected_single->min_mean_ratio == F.rejected_single->min_mean_ratio);
     c.first_try_max_folded = 1.5;
-    CHECK(contains(message_of<tspline::InputError>([&] { (void)tspline::parameterize_domain(bali, po, ad, c); }),
-                   "largest folded fraction"));
+    CHECK(contains(
+        message_of<tspline::InputError>([&] { (void)tspline::parameterize_domain(bali, po, ad, c); }),
+        "largest folded fraction"));
   }
 
   TEST_CASE_FIXTURE(UnitSquareAtLevel2,

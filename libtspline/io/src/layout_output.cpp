@@ -25,7 +25,8 @@ nlohmann::json layout_report(const DomainParameterization& result) {
   if (result.single_corners)
     out["single_patch_first_try"] = {
         {"stopped", "at its frozen boundary: " + result.single_stopped},
-        {"corners_note", "J at the corners of the square is the boundary's: upper bounds of the try's whole-map minima"},
+        {"corners_note",
+         "J at the corners of the square is the boundary's: upper bounds of the try's whole-map minima"},
         {"corner_min_scaled_jacobian", boundary_corner_json(result.single_corners->scaled)},
         {"corner_min_mean_ratio", boundary_corner_json(result.single_corners->mean_ratio)}};
   return out;

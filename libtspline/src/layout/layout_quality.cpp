@@ -4,6 +4,7 @@
 #include <array>
 #include <cmath>
 #include <numbers>
+
 #include "tspline/boundary/plane.h"
 #include "tspline/errors.h"
 
@@ -21,7 +22,9 @@ double arc_between(double a, double b, double dir, double L) {
 }  // namespace
 
 LayoutQuality::LayoutQuality(const LayoutRings& rings, double max_corner_degrees)
-    : rings_(rings), max_corner_degrees_(max_corner_degrees), obtuse_sine_(obtuse_corner_sine(max_corner_degrees)) {
+    : rings_(rings),
+      max_corner_degrees_(max_corner_degrees),
+      obtuse_sine_(obtuse_corner_sine(max_corner_degrees)) {
   for (std::size_t r = 0; r < rings.curves.size(); ++r) {
     const RingCurve& c = rings.curves[r];
     const std::size_t n = c.size();

@@ -655,7 +655,8 @@ void QuadLayoutBuilder::make_patch_layout(const LayoutMesh& m, const LayoutTopol
       const auto& v = p.polygon.vertices;
       const std::size_t c = p.corners[k], n = v.size();
       const Eigen::Vector2d a = v[(c + 1) % n] - v[c], b = v[(c + n - 1) % n] - v[c];
-      const bool fine = level_ == 0 ? cross(a, b) / (a.norm() * b.norm()) > 1e-3 : quality_.corner_in_range(a, b);
+      const bool fine =
+          level_ == 0 ? cross(a, b) / (a.norm() * b.norm()) > 1e-3 : quality_.corner_in_range(a, b);
       if (!fine) {
         std::ostringstream range;
         range << "a patch corner outside 1-" << quality_.max_corner_degrees() << " degrees near (";
@@ -693,7 +694,8 @@ void QuadLayoutBuilder::recover_from_rejected_layout(const std::string& what) {
     level2_again = near_one_of(level2_failed_at_);
   }
   if (level_ == 2 && !guard_corners_ && what.find("patch corner") != std::string::npos) {
-    if (o_.throw_when_sheets_rejected && out_.stats.corner_sheets > 0) throw SheetsRejected(mesh_name() + ": " + what, nodes_);
+    if (o_.throw_when_sheets_rejected && out_.stats.corner_sheets > 0)
+      throw SheetsRejected(mesh_name() + ": " + what, nodes_);
     note(mesh_name() + ": " + what + "; the same mesh, no node move allowed to put a patch corner out of range");
     guard_corners_ = true;
     if (at != std::string::npos) level2_failed_at_.push_back(place);

@@ -57,7 +57,8 @@ void QuadLayoutMemo::store_first_pass(const Rings& domain, const SizeFieldOption
   if (!serves(domain, size)) return;
   for (const PassEntry& e : passes_)
     if (e.level == level && e.guard_corners == guard_corners && e.max_corner_degrees == max_corner_degrees &&
-        e.nodes == nodes) return;
+        e.nodes == nodes)
+      return;
   passes_.push_back({nodes, level, guard_corners, max_corner_degrees, pass});
 }
 

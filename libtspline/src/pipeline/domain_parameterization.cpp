@@ -200,10 +200,11 @@ DomainParameterization parameterize_domain(const Domain& input, const Parameteri
       a.layout = build_quad_layout(a.valid, q);
     } catch (const SheetsRejected& e) {
       if (q.progress)
-        q.progress(std::string(e.what()) +
-                   "; the rings of its flat corners pillowed instead of sheets through them (the sheets again, with "
-                   "no node move allowed to put a patch corner out of range, only if the pillowed layout's map is "
-                   "not good)");
+        q.progress(
+            std::string(e.what()) +
+            "; the rings of its flat corners pillowed instead of sheets through them (the sheets again, with "
+            "no node move allowed to put a patch corner out of range, only if the pillowed layout's map is "
+            "not good)");
       a.sheets_rejected = e;
       q.corner_sheets = false;
       q.start_ring_nodes = e.ring_nodes;
@@ -257,8 +258,9 @@ DomainParameterization parameterize_domain(const Domain& input, const Parameteri
       return;
     std::ostringstream second;
     if (guarded_sheets)
-      second << "a second quad layout with sheets through its flat ring corners, no node move allowed to put a "
-                "patch corner out of range";
+      second
+          << "a second quad layout with sheets through its flat ring corners, no node move allowed to put a "
+             "patch corner out of range";
     else if (pillow)
       second << "a second quad layout with the rings of its flat corners pillowed instead of sheets through them";
     else
@@ -534,10 +536,11 @@ DomainParameterization parameterize_domain(const Domain& input, const Parameteri
       return out;
     }
   }
-  std::string why = !single      ? (stopped_for_folds ? "one patch is stopped: " : "one patch cannot be good: ") + stopped
-                    : !certified ? std::string("one patch is not certified after ") +
-                                       std::to_string(first.max_adapt) + " adaptive rounds"
-                                 : "one patch is certified but poor over the whole map (" + figures(q) + ")";
+  std::string why =
+      !single      ? (stopped_for_folds ? "one patch is stopped: " : "one patch cannot be good: ") + stopped
+      : !certified ? std::string("one patch is not certified after ") + std::to_string(first.max_adapt) +
+                         " adaptive rounds"
+                   : "one patch is certified but poor over the whole map (" + figures(q) + ")";
   report_step(serial.progress, "layout", why + ": building a quad layout");
   try {
     run_quad(why);
@@ -551,8 +554,8 @@ DomainParameterization parameterize_domain(const Domain& input, const Parameteri
         at_corners.min_mean_ratio = corners->mean_ratio.mean_ratio;
       }
       // A try stopped for its folds: a good layout is kept over it.
-      if (!single &&
-          (stopped_for_folds ? reaches_good_quality(lq, c) : keep_layout_over_single(lq, at_corners, true, c))) {
+      if (!single && (stopped_for_folds ? reaches_good_quality(lq, c)
+                                        : keep_layout_over_single(lq, at_corners, true, c))) {
         out.single_corners = corners;
         out.single_stopped = stopped;
         return out;

@@ -62,7 +62,8 @@ class QuadLayoutMemo {
     RingNodes nodes;
     int level = 0;
     bool guard_corners = false;
-    double max_corner_degrees = 0.0;  // QuadLayoutOptions::max_patch_corner_degrees (the rotations keep to it)
+    // QuadLayoutOptions::max_patch_corner_degrees (the rotations keep to it).
+    double max_corner_degrees = 0.0;
     LayoutFirstPass pass;
   };
   mutable std::mutex mutex_;
