@@ -694,8 +694,6 @@ void QuadLayoutBuilder::recover_from_rejected_layout(const std::string& what) {
     level2_again = near_one_of(level2_failed_at_);
   }
   if (level_ == 2 && !guard_corners_ && what.find("patch corner") != std::string::npos) {
-    if (o_.throw_when_sheets_rejected && out_.stats.corner_sheets > 0)
-      throw SheetsRejected(mesh_name() + ": " + what, nodes_);
     note(mesh_name() + ": " + what + "; the same mesh, no node move allowed to put a patch corner out of range");
     guard_corners_ = true;
     if (at != std::string::npos) level2_failed_at_.push_back(place);

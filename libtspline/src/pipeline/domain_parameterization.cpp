@@ -164,9 +164,6 @@ DomainParameterization parameterize_domain(const Domain& input, const Parameteri
   struct LayoutAhead {
     Domain valid;
     QuadLayout layout;
-    /// Where the sheets through the flat ring corners were rejected (a patch
-    /// corner out of range) and `layout` pillows their rings instead.
-    std::optional<SheetsRejected> sheets_rejected;
     std::string explanation;                 ///< the layout's, before its patches took it
     std::optional<MultiPatchResult> patches;  ///< run ahead of the decision, if the layout was first
     std::string stopped;  ///< why its patches' run was stopped (first_layout_multi), if it was
@@ -183,35 +180,6 @@ DomainParameterization parameterize_domain(const Domain& input, const Parameteri
     return cb ? std::function<void(const std::string&)>(
                     [cb, prefix](const std::string& text) { report_step(cb, "layout", prefix + text); })
               : std::function<void(const std::string&)>();
-  };
-  // The first quad layout of `valid` into a: sheets through its flat ring
-  // corners; where the sheets' mesh, optimized in full, puts a patch corner
-  // out of range, their rings pillowed instead, from the same ring nodes,
-  // before the guard that would forbid such node moves everywhere (it costs
-  // quality where nothing needs it). The sheets with the guard are then the
-  // second layout (retry_with_another_layout). Without a second layout
-  // (retry_possible) the guard comes at once, in build_quad_layout.
-  const bool retry_possible = c.retry_size_factor > 0.0 && c.retry_size_factor != 1.0;
-  auto build_first_layout = [retry_possible, layout_progress](LayoutAhead& a, QuadLayoutOptions q,
-                                                              const std::string& prefix) {
-    q.throw_when_sheets_rejected = retry_possible;
-    q.progress = layout_progress(prefix + ": ");
-    try {
-      a.layout = build_quad_layout(a.valid, q);
-    } catch (const SheetsRejected& e) {
-      if (q.progress)
-        q.progress(
-            std::string(e.what()) +
-            "; the rings of its flat corners pillowed instead of sheets through them (the sheets again, with "
-            "no node move allowed to put a patch corner out of range, only if the pillowed layout's map is "
-            "not good)");
-      a.sheets_rejected = e;
-      q.corner_sheets = false;
-      q.start_ring_nodes = e.ring_nodes;
-      q.progress = layout_progress(prefix + ", pillowed: ");
-      a.layout = build_quad_layout(a.valid, q);
-    }
-    a.explanation = a.layout.explanation();
   };
   // The patches' own options (run_quad's, or the run ahead's).
   ParameterizationOptions patch_options = options;
@@ -230,6 +198,7 @@ DomainParameterization parameterize_domain(const Domain& input, const Parameteri
   // cannot be good (its figures are the least over its patches), and the rest
   // of its patches would only be needed if the other layout does no better
   // (then they are run after all; retry_with_another_layout).
+  const bool retry_possible = c.retry_size_factor > 0.0 && c.retry_size_factor != 1.0;
   MultiPatchOptions first_layout_multi = c.multi;
   if (retry_possible)
     first_layout_multi.stop_when = [&c, &adaptive](std::size_t, const ParameterizationResult& r) {
@@ -240,28 +209,20 @@ DomainParameterization parameterize_domain(const Domain& input, const Parameteri
   // A certified map of a quad layout below the thresholds: one more layout of
   // `valid`, kept where its map is certified and the worse of its two figures
   // is higher. Where the first gave flat ring corners sheets of quads, the
-  // second pillows their rings instead (the same ring nodes); where the first
-  // pillowed them because the sheets were rejected (build_first_layout), the
-  // second is the sheets with the guard (the same ring nodes); else its
+  // second pillows their rings instead (the same ring nodes); else its
   // patches are c.retry_size_factor times larger (another mesh of the domain,
   // whose worst corners fall elsewhere). `stopped`: why the first layout's
   // patches were stopped (first_layout_multi), its map not made; it is made
   // in full only if the second's map is not good, to compare the two.
   auto retry_with_another_layout = [&](const Domain& valid, const QuadLayout& first_layout,
-                                       const std::optional<SheetsRejected>& sheets_rejected,
                                        const std::string& first_explanation, const std::string& stopped) {
-    const bool guarded_sheets = sheets_rejected.has_value();
-    const bool pillow = !guarded_sheets && first_layout.stats.corner_sheets > 0;
+    const bool pillow = first_layout.stats.corner_sheets > 0;
     if (!retry_possible) return;
     if (stopped.empty() &&
         (good_patches(*out.patches) || (adaptive.certify && !out.patches->certified_valid())))
       return;
     std::ostringstream second;
-    if (guarded_sheets)
-      second
-          << "a second quad layout with sheets through its flat ring corners, no node move allowed to put a "
-             "patch corner out of range";
-    else if (pillow)
+    if (pillow)
       second << "a second quad layout with the rings of its flat corners pillowed instead of sheets through them";
     else
       second << "a second quad layout with patches " << c.retry_size_factor << " times larger";
@@ -285,17 +246,12 @@ DomainParameterization parameterize_domain(const Domain& input, const Parameteri
     std::string outcome;
     try {
       QuadLayoutOptions q = layout_options;
-      if (guarded_sheets) {
-        q.guard_patch_corners = true;
-        q.start_ring_nodes = sheets_rejected->ring_nodes;
-      } else if (pillow) {
+      if (pillow) {
         q.corner_sheets = false;
         q.start_ring_nodes = first_layout.ring_nodes;  // its repairs done already
       } else
         q.size.factor *= c.retry_size_factor;
-      q.progress = layout_progress(guarded_sheets ? "quad layout, sheets with the guard: "
-                                   : pillow       ? "quad layout, pillowed: "
-                                                  : "quad layout, larger patches: ");
+      q.progress = layout_progress(pillow ? "quad layout, pillowed: " : "quad layout, larger patches: ");
       QuadLayout L = build_quad_layout(valid, q);
       const std::string explanation = L.explanation();
       report_step(serial.progress, "layout", explanation);
@@ -330,15 +286,15 @@ DomainParameterization parameterize_domain(const Domain& input, const Parameteri
       a = ahead.get();
     } else {
       a.valid = holes || c.layout == LayoutMode::Quad ? domain : validate_domain(input);
-      build_first_layout(a, layout_options, "quad layout");
+      QuadLayoutOptions q = layout_options;
+      q.progress = layout_progress("quad layout: ");
+      a.layout = build_quad_layout(a.valid, q);
+      a.explanation = a.layout.explanation();
     }
     if (!a.patches && a.stopped.empty())
       report_step(serial.progress, "layout", a.explanation);  // (else the run ahead did)
     out.layout = "quad";
     out.reason = reason;
-    if (a.sheets_rejected)
-      out.reason += std::string("; the sheets through the layout's flat ring corners were rejected (") +
-                    a.sheets_rejected->what() + "), so their rings were pillowed";
     out.quad_stats = a.layout.stats;
     if (a.patches) {
       out.patches.emplace(std::move(*a.patches));
@@ -350,7 +306,7 @@ DomainParameterization parameterize_domain(const Domain& input, const Parameteri
         a.stopped = e.what();
       }
     }
-    retry_with_another_layout(a.valid, a.layout, a.sheets_rejected, a.explanation, a.stopped);
+    retry_with_another_layout(a.valid, a.layout, a.explanation, a.stopped);
   };
   if (c.layout == LayoutMode::Quad) {
     run_quad("layout quad was asked for");
@@ -426,6 +382,7 @@ DomainParameterization parameterize_domain(const Domain& input, const Parameteri
   if (quad_mesher_available()) {
     QuadLayoutOptions q = layout_options;
     q.cancel = &cancel;
+    q.progress = layout_progress("quad layout (built while one patch is tried): ");
     // Once the layout is built, its patches are run at once, while the single
     // patch may still be tried: kept if one patch is not (their progress held
     // back until then), cancelled if it is. Their result does not depend on
@@ -443,11 +400,11 @@ DomainParameterization parameterize_domain(const Domain& input, const Parameteri
     PatchCallback ahead_on_patch;
     if (on_patch)
       ahead_on_patch = [&held, on_patch](std::size_t p, int round) { held.pass([on_patch, p, round] { on_patch(p, round); }); };
-    ahead = std::async(std::launch::async, [&input, q, &adaptive, ahead_multi, ahead_options, ahead_on_patch,
-                                            &build_first_layout] {
+    ahead = std::async(std::launch::async, [&input, q, &adaptive, ahead_multi, ahead_options, ahead_on_patch] {
       LayoutAhead a;
       a.valid = validate_domain(input);
-      build_first_layout(a, q, "quad layout (built while one patch is tried)");
+      a.layout = build_quad_layout(a.valid, q);
+      a.explanation = a.layout.explanation();
       report_step(ahead_options.progress, "layout", a.explanation);
       try {
         a.patches.emplace(run_multipatch_parameterization(
@@ -536,11 +493,10 @@ DomainParameterization parameterize_domain(const Domain& input, const Parameteri
       return out;
     }
   }
-  std::string why =
-      !single      ? (stopped_for_folds ? "one patch is stopped: " : "one patch cannot be good: ") + stopped
-      : !certified ? std::string("one patch is not certified after ") + std::to_string(first.max_adapt) +
-                         " adaptive rounds"
-                   : "one patch is certified but poor over the whole map (" + figures(q) + ")";
+  std::string why = !single      ? (stopped_for_folds ? "one patch is stopped: " : "one patch cannot be good: ") + stopped
+                    : !certified ? std::string("one patch is not certified after ") +
+                                       std::to_string(first.max_adapt) + " adaptive rounds"
+                                 : "one patch is certified but poor over the whole map (" + figures(q) + ")";
   report_step(serial.progress, "layout", why + ": building a quad layout");
   try {
     run_quad(why);

@@ -30,7 +30,6 @@
 #include <vector>
 
 #include "tspline/boundary/domain.h"
-#include "tspline/errors.h"
 #include "tspline/layout/layout_optimizer.h"
 #include "tspline/layout/ring_nodes.h"
 #include "tspline/layout/size_field.h"
@@ -68,12 +67,6 @@ struct QuadLayoutOptions {
   /// corner, and that mesh is optimized again (the guard costs quality where
   /// nothing needs it: fjords' certified scaled Jacobian 0.267 against 0.503).
   bool guard_patch_corners = false;
-  /// Where a mesh with sheets through flat ring corners, optimized in full
-  /// and without the guard, is rejected for a patch corner out of range:
-  /// false, the guard is turned on and the mesh optimized again; true,
-  /// build_quad_layout throws SheetsRejected instead, so that the caller may
-  /// pillow those rings first (parameterize_domain).
-  bool throw_when_sheets_rejected = false;
   /// Rounds of "add nodes where the true geometry breaks the layout, mesh again".
   int max_repair_rounds = 40;
   /// Set by another thread when the layout is no longer wanted (parameterize_domain
@@ -136,19 +129,9 @@ struct QuadLayout {
   std::string explanation() const;
 };
 
-/// A layout with sheets through flat ring corners rejected for a patch corner
-/// out of range (QuadLayoutOptions::throw_when_sheets_rejected).
-struct SheetsRejected : NumericalError {
-  SheetsRejected(const std::string& what, std::vector<std::vector<double>> nodes)
-      : NumericalError(what), ring_nodes(std::move(nodes)) {}
-  /// Per ring, the arc lengths of the nodes of the mesh rejected (repairs included).
-  std::vector<std::vector<double>> ring_nodes;
-};
-
 /// \pre `domain` is validated (validate_domain).
 /// \throw InputError if this build has no quad mesher (quad_mesher.h);
-/// NumericalError if no valid layout was found within the repair rounds;
-/// SheetsRejected as QuadLayoutOptions::throw_when_sheets_rejected says.
+/// NumericalError if no valid layout was found within the repair rounds.
 QuadLayout build_quad_layout(const Domain& domain, const QuadLayoutOptions& options = {});
 
 /// Scaled Jacobian of a straight quadrilateral: min over its corners of

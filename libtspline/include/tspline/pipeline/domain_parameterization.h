@@ -69,13 +69,7 @@ struct DomainParameterizationOptions {
   /// four reached it, with 0.85 times one.) Where the first layout gave flat
   /// ring corners sheets of quads (QuadLayoutOptions::corner_sheets), the
   /// second pillows their rings instead, from the first's ring nodes (any
-  /// factor other than 1 or 0). Where the sheets' mesh, optimized in full,
-  /// puts a patch corner out of range, the first layout pillows their rings
-  /// at once (QuadLayoutOptions::throw_when_sheets_rejected) and the second,
-  /// made only if the first's map misses the thresholds, is the sheets with
-  /// no node move allowed to put a patch corner out of range
-  /// (QuadLayoutOptions::guard_patch_corners), from the same ring nodes; with
-  /// a factor of 1 or 0 the sheets get that guard at once.
+  /// factor other than 1 or 0).
   double retry_size_factor = 1.2;
   /// Initial T-mesh level of the patches of a quad layout (they are small and
   /// nearly square; refinement adds what they need); unset: the options' own.
