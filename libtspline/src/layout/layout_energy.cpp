@@ -32,12 +32,16 @@ using CornerVectors = std::array<std::pair<Eigen::Vector2d, Eigen::Vector2d>, La
 // 2 / 1e-9, so a quality sweep could trade a pinched side for a fold, which
 // the untangling then could not undo (Corsica: the worst corner fell from 0.27
 // to -0.95 in one sweep, and 60 sweeps of untangling left it at -0.86).
-double corner_term(const CornerVectors& vectors, int scales, double p, double eps_rel, bool barrier) {
+using CornerNorms = std::array<std::pair<double, double>, LayoutQuality::corner_scales.size()>;
+
+// corner_term with the vectors' lengths given (|e1|, |e2| per scale: the same values).
+double corner_term(const CornerVectors& vectors, const CornerNorms& norms, int scales, double p,
+                   double eps_rel, bool barrier) {
   double e = 0.0;  // the worst over the scales
   for (int k = 0; k < scales; ++k) {
     const auto& [e1, e2] = vectors[k];
     const double det = cross(e1, e2);
-    const double n1 = e1.norm(), n2 = e2.norm();
+    const auto [n1, n2] = norms[k];
     const double s = n1 + n2;
     if (!(n1 > 0.0 && n2 > 0.0) || (barrier && !(det > 0.0))) return std::numeric_limits<double>::infinity();
     const double eps = eps_rel * n1 * n2;
@@ -45,6 +49,12 @@ double corner_term(const CornerVectors& vectors, int scales, double p, double ep
     e = std::max(e, s * s / (2.0 * chi));
   }
   return power(e, p);
+}
+
+double corner_term(const CornerVectors& vectors, int scales, double p, double eps_rel, bool barrier) {
+  CornerNorms norms;
+  for (int k = 0; k < scales; ++k) norms[k] = {vectors[k].first.norm(), vectors[k].second.norm()};
+  return corner_term(vectors, norms, scales, p, eps_rel, barrier);
 }
 
 // The term of corner j of quad q.
@@ -61,10 +71,12 @@ double kink_energy(const LayoutMesh& m, const LayoutTopology& t, const LayoutQua
   return k < 1.0 ? power(2.0 / std::max(k, 1e-9), p) : 0.0;
 }
 
-// The term of side j's shape (0 for a cut or a side that keeps its shape).
+// The term of a side of shape figure g (0 for a cut or a side that keeps its shape).
+double shape_term(double g, double p) { return g < 1.0 ? power(2.0 / std::max(g, 1e-9), p) : 0.0; }
+
+// The term of side j's shape.
 double shape_energy(const LayoutMesh& m, const LayoutTopology& t, const LayoutQuality& Q, int q, int j, double p) {
-  const double g = Q.side_shape(m, t, q, j);
-  return g < 1.0 ? power(2.0 / std::max(g, 1e-9), p) : 0.0;
+  return shape_term(Q.side_shape(m, t, q, j), p);
 }
 
 }  // namespace
@@ -113,45 +125,68 @@ double layout_moving_energy(const LayoutMesh& m, const LayoutTopology& t, const 
 LayoutMovingEnergy::LayoutMovingEnergy(const LayoutMesh& m, const LayoutTopology& t, const LayoutQuality& Q, int n,
                                        double p, double eps_rel, bool barrier)
     : m_(m), t_(t), Q_(Q), n_(n), p_(p), eps_rel_(eps_rel), barrier_(barrier) {
-  if (m.ring[n] >= 0) return;  // a ring node: every term computed afresh
-  // Inner node: at corners j +- 1 the side away from n is the same wherever
-  // n goes (as corner_vectors_at gives it, at each scale); the side to n is a
-  // cut, x[n] - x[v] at every scale.
+  // At corners j +- 1 whose side to n is a cut (every side of an inner n),
+  // that side is x[n] - x[v] at every scale and the other side is the same
+  // wherever n goes (as corner_vectors_at gives it, at each scale). Where the
+  // side to n runs along a ring (ring n), the corner is computed afresh.
   for (const auto& [q, j] : t.corners_of(n))
     for (const int k : {1, 3}) {
-      CornerVectors v;
       Neighbour c;
       c.node = m.quads[q][(j + k) % 4];
-      c.scales = Q.corner_vectors_at(m, t, q, (j + k) % 4, LayoutQuality::corner_scales, v.data());
       c.n_is_next = k == 3;  // corner j - 1's next corner is n
-      for (int s = 0; s < c.scales; ++s) c.fixed[s] = c.n_is_next ? v[s].second : v[s].first;
+      const int side_to_n = k == 3 ? (j + 3) % 4 : j;
+      c.fresh = m.ring[c.node] >= 0 && m.ring[n] == m.ring[c.node] && t.on_ring(q, side_to_n);
+      if (!c.fresh) {
+        CornerVectors v;
+        c.scales = Q.corner_vectors_at(m, t, q, (j + k) % 4, LayoutQuality::corner_scales, v.data());
+        for (int s = 0; s < c.scales; ++s) {
+          c.fixed[s] = c.n_is_next ? v[s].second : v[s].first;
+          c.fixed_norm[s] = c.fixed[s].norm();
+        }
+      }
       neighbours_.push_back(c);
     }
+  for (const auto& [q, j] : t.corners_of(n))
+    for (const int k : {1, 2}) far_sides_.push_back(Q.side_vertices(m, t, q, (j + k) % 4));
 }
 
 double LayoutMovingEnergy::operator()(double stop_at) const {
-  if (m_.ring[n_] >= 0) return layout_moving_energy(m_, t_, Q_, n_, p_, eps_rel_, barrier_, stop_at);
   // The terms of layout_moving_energy, in its order (the same sums).
   double sum = 0.0;
-  std::size_t at = 0;
+  const bool on_ring = m_.ring[n_] >= 0;
+  std::size_t at = 0, side = 0;
   CornerVectors v;
+  CornerNorms norms;
   for (const auto& [q, j] : t_.corners_of(n_)) {
     for (const int k : {0, 1, 3}) {
       double e;
       if (k == 0) {
         e = corner_energy(m_, t_, Q_, q, j, p_, eps_rel_, barrier_);
+      } else if (const Neighbour& c = neighbours_[at++]; c.fresh) {
+        e = corner_energy(m_, t_, Q_, q, (j + k) % 4, p_, eps_rel_, barrier_);
       } else {
-        const Neighbour& c = neighbours_[at++];
         const Eigen::Vector2d to_n = m_.x[n_] - m_.x[c.node];
-        for (int s = 0; s < c.scales; ++s)
+        const double to_n_norm = to_n.norm();
+        for (int s = 0; s < c.scales; ++s) {
           v[s] = c.n_is_next ? std::pair{to_n, c.fixed[s]} : std::pair{c.fixed[s], to_n};
-        e = corner_term(v, c.scales, p_, eps_rel_, barrier_);
+          norms[s] =
+              c.n_is_next ? std::pair{to_n_norm, c.fixed_norm[s]} : std::pair{c.fixed_norm[s], to_n_norm};
+        }
+        e = corner_term(v, norms, c.scales, p_, eps_rel_, barrier_);
       }
       if (!std::isfinite(e)) return e;
       sum += e;
       if (sum >= stop_at) return sum;
     }
-    sum += shape_energy(m_, t_, Q_, q, (j + 1) % 4, p_) + shape_energy(m_, t_, Q_, q, (j + 2) % 4, p_);
+    const double next_side = shape_term(Q_.side_shape(m_, q, (j + 1) % 4, far_sides_[side]), p_);
+    const double far_side = shape_term(Q_.side_shape(m_, q, (j + 2) % 4, far_sides_[side + 1]), p_);
+    side += 2;
+    sum += next_side + far_side;
+    if (on_ring)
+      for (const int k : {0, 3}) {
+        const int ring_side = (j + k) % 4;
+        sum += kink_energy(m_, t_, Q_, q, ring_side, p_) + shape_energy(m_, t_, Q_, q, ring_side, p_);
+      }
     if (sum >= stop_at) return sum;
   }
   return sum;

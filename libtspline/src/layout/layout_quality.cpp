@@ -168,7 +168,10 @@ double LayoutQuality::side_kinks(const LayoutMesh& m, const LayoutTopology& t, i
 }
 
 double LayoutQuality::side_shape(const LayoutMesh& m, const LayoutTopology& t, int q, int j) const {
-  const SideVertices v = side_vertices(m, t, q, j);
+  return side_shape(m, q, j, side_vertices(m, t, q, j));
+}
+
+double LayoutQuality::side_shape(const LayoutMesh& m, int q, int j, const SideVertices& v) const {
   if (v.ring < 0 || v.i1 <= v.i0) return 1.0;
   const RingCurve& c = rings_.curves[v.ring];
   const Eigen::Vector2d a = m.x[m.quads[q][j]], b = m.x[m.quads[q][(j + 1) % 4]];

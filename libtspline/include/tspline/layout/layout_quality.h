@@ -87,17 +87,22 @@ class LayoutQuality {
   /// The worst of the quad's corners and side kinks.
   LayoutCornerQuality quad(const LayoutMesh& m, const LayoutTopology& t, int q) const;
 
- private:
-  // Minimum of the kink figures of ring r's vertices i0 .. i1 - 1 (i1 may pass
-  // size(): the range wraps), by a sparse table over the doubled vertex list.
-  double kink_min(int r, std::size_t i0, std::size_t i1) const;
-  // The ring vertices strictly inside ring side j of quad q: ring r, indices i0 .. i1 - 1
-  // (wrapping past size()); r = -1 for a cut.
+  /// The ring vertices strictly inside ring side j of quad q: ring r, indices
+  /// i0 .. i1 - 1 (wrapping past size()); r = -1 for a cut. They depend only
+  /// on the side's two end nodes.
   struct SideVertices {
     int ring = -1;
     std::size_t i0 = 0, i1 = 0;
   };
   SideVertices side_vertices(const LayoutMesh& m, const LayoutTopology& t, int q, int j) const;
+  /// side_shape with the side's vertices given (side_vertices of the same
+  /// side, its end nodes where they were then): the same value.
+  double side_shape(const LayoutMesh& m, int q, int j, const SideVertices& v) const;
+
+ private:
+  // Minimum of the kink figures of ring r's vertices i0 .. i1 - 1 (i1 may pass
+  // size(): the range wraps), by a sparse table over the doubled vertex list.
+  double kink_min(int r, std::size_t i0, std::size_t i1) const;
   const LayoutRings& rings_;
   double max_corner_degrees_, obtuse_sine_;
   std::vector<std::vector<std::vector<double>>> table_;  // per ring, per level

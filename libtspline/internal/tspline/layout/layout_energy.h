@@ -43,8 +43,10 @@ double layout_moving_energy(const LayoutMesh& m, const LayoutTopology& t, const 
                             double stop_at = std::numeric_limits<double>::infinity());
 
 /// layout_moving_energy of one node, prepared for a search that moves only
-/// that node (the mesh is read where the node stands at each call): at an
-/// inner node's neighbouring corners, the side away from it is measured once.
+/// that node (the mesh is read where the node stands at each call): at its
+/// neighbouring corners joined to it by a cut, the side away from it is
+/// measured once, and so are the ring vertices of the sides that do not end
+/// at it.
 class LayoutMovingEnergy {
  public:
   LayoutMovingEnergy(const LayoutMesh& m, const LayoutTopology& t, const LayoutQuality& Q, int n, double p,
@@ -57,7 +59,9 @@ class LayoutMovingEnergy {
     int node = -1;           ///< the corner's node (corner j + 1 or j - 1 of a quad at n's corner j)
     int scales = 1;          ///< as corner_vectors_at
     bool n_is_next = false;  ///< n is the corner's next corner (its first side), else its previous
+    bool fresh = false;      ///< the side to n runs along a ring: the corner is computed afresh
     std::array<Eigen::Vector2d, LayoutQuality::corner_scales.size()> fixed;  ///< the other side, per scale
+    std::array<double, LayoutQuality::corner_scales.size()> fixed_norm;      ///< its length, per scale
   };
   const LayoutMesh& m_;
   const LayoutTopology& t_;
@@ -65,7 +69,10 @@ class LayoutMovingEnergy {
   int n_;
   double p_, eps_rel_;
   bool barrier_;
-  std::vector<Neighbour> neighbours_;  ///< per quad at n, corners j + 1 and j - 1 (inner n only)
+  std::vector<Neighbour> neighbours_;  ///< per quad at n, corners j + 1 and j - 1
+  /// per quad at n, the ring vertices of sides j + 1 and j + 2 (which do not
+  /// end at n: they stay where n goes)
+  std::vector<LayoutQuality::SideVertices> far_sides_;
 };
 
 }  // namespace tspline
