@@ -325,6 +325,56 @@ TEST_SUITE("layout_quality") {
     }
   }
 
+  TEST_CASE(
+      "node optimization: while the layout is tangled only a ring node with an inverted corner slides") {
+    // The 2 x 2 square with a notch in its bottom coast, the bottom ring node
+    // at the notch's tip (0.5, -0.3) and the centre to its upper right: the
+    // node's corner towards the notch's right flank is inverted. While the
+    // layout is tangled, ring nodes stay where they are but such a node
+    // (untangle_ring_corners); the right ring node (1, 0.5), whose corners are
+    // fine, stays either way.
+    const tspline::LayoutRings ring =
+        one_ring({V(0, 0), V(0.4, 0), V(0.5, -0.3), V(0.6, 0), V(1, 0), V(1, 1), V(0, 1)});
+    const tspline::LayoutQuality Q(ring);
+    const tspline::RingCurve& c = ring.curves[0];
+    const double tip = 0.4 + std::hypot(0.1, 0.3);
+    auto start = [&] {
+      tspline::LayoutMesh m = square_2x2(c, V(0.8, 0.3), 0.5);
+      m.arc[1] = tip;
+      m.x[1] = c.point(tip);
+      return m;
+    };
+    auto inverted_at = [&](const tspline::LayoutMesh& m, int n) {
+      const tspline::LayoutTopology t(m);
+      bool inverted = false;
+      for (const auto& [q, j] : t.corners_of(n))
+        inverted = inverted || Q.corner(m, t, q, j).scaled_jacobian <= 0.0;
+      return inverted;
+    };
+    {
+      const tspline::LayoutMesh m = start();
+      REQUIRE((m.x[1] - V(0.5, -0.3)).norm() < 1e-12);
+      REQUIRE(inverted_at(m, 1));
+      REQUIRE(!inverted_at(m, 3));
+    }
+    for (const bool on : {false, true}) {
+      CAPTURE(on);
+      tspline::LayoutOptimizationOptions o;
+      o.untangle_ring_corners = on;
+      o.max_sweeps = 1;  // a tangled sweep
+      tspline::LayoutMesh m = start();
+      const tspline::LayoutOptimizationReport r = tspline::optimize_layout_nodes(m, Q, anywhere, {}, o);
+      CHECK(r.before.scaled_jacobian < 0.0);
+      CHECK((m.x[1] != V(0.5, -0.3)) == on);
+      CHECK((m.x[1] - c.point(m.arc[1])).norm() < 1e-12);  // slid along its ring
+      CHECK(m.x[3] == V(1, 0.5));
+      // In full: untangled.
+      o.max_sweeps = 60;
+      m = start();
+      CHECK(tspline::optimize_layout_nodes(m, Q, anywhere, {}, o).after.scaled_jacobian > 0.0);
+    }
+  }
+
   TEST_CASE("node optimization: an untangled layout stays untangled, even to relieve a pinched side") {
     // The 2 x 2 square whose bottom coast rises in a spike at x = 0.25 to height
     // h, through the top of the lower-left quad: its bottom side is pinched

@@ -290,9 +290,11 @@ TEST_SUITE("quad_layout") {
     tspline::DomainCleaningOptions how;
     how.blunt_tips_below_degrees = 17.5;
     const tspline::Domain d = tspline::validate_domain(
-        {tspline::io::read_polygon(std::string(TSPLINE_TEST_DATA_DIR) + "/coastlines/bali.txt"), {}}, how);
-    // Bali's optimized mesh has a patch corner wider than 135 degrees: the same
-    // mesh is optimized again with node moves that keep corners in range.
+        {tspline::io::read_polygon(std::string(TSPLINE_TEST_DATA_DIR) + "/coastlines/isle_of_man.txt"), {}},
+        how);
+    // The Isle of Man's optimized mesh has a patch corner wider than 135
+    // degrees: the same mesh is optimized again with node moves that keep
+    // corners in range.
     tspline::QuadLayoutOptions o;
     o.max_patch_corner_degrees = 135.0;
     std::vector<std::string> notes;

@@ -303,10 +303,18 @@ LayoutOptimizationReport optimize_layout_nodes(LayoutMesh& m, const LayoutQualit
     };
     // The nodes that may move this sweep, in order. While the layout is
     // tangled the rings stay where they are: sliding a ring node across a fold
-    // only drags the fold along the coast.
+    // only drags the fold along the coast; but a ring node whose own corner
+    // is inverted slides (untangle_ring_corners).
     order.clear();
+    auto own_corner_inverted = [&](int n) {
+      for (const auto& [q, j] : t.corners_of(n))
+        if (Q.corner(m, t, q, j).scaled_jacobian <= 0.0) return true;
+      return false;
+    };
     for (const int n : (tangled || quality_sweeps < 3 ? active : moving))
-      if (t.valence(n) != 0 && !(tangled && m.ring[n] >= 0)) order.push_back(n);
+      if (t.valence(n) != 0 &&
+          !(tangled && m.ring[n] >= 0 && !(o.untangle_ring_corners && own_corner_inverted(n))))
+        order.push_back(n);
     moves.assign(order.size(), NodeMove{});
     sweep_in_batches(m, t, order, reached, o.in_batches, [&](std::size_t k) { moves[k] = update(order[k]); });
     double gain = 0.0;

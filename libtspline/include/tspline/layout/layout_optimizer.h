@@ -44,6 +44,13 @@ struct LayoutOptimizationOptions {
   /// than were before it: the energy sees the corners at larger scales, where
   /// a cut leaving a ring node nearly along the ring's first edge looks fine.
   bool keep_patch_corners_in_range = false;
+  /// While the layout is tangled, ring nodes stay where they are (sliding one
+  /// across a fold only drags the fold along the coast), except those with an
+  /// inverted corner of their own (a corner of theirs with scaled Jacobian <= 0
+  /// at one of LayoutQuality::corner_scales): where the coast turns at the
+  /// node, only the node's slide can unfold that corner. false: every ring
+  /// node stays.
+  bool untangle_ring_corners = true;
   /// Checked before every sweep: once set (by another thread), LayoutCancelled is thrown.
   const std::atomic<bool>* cancel = nullptr;
   /// A sweep's moves in batches on the pool's threads (nodes that share no
