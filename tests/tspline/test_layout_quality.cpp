@@ -330,7 +330,7 @@ TEST_SUITE("layout_quality") {
     // The 2 x 2 square with a notch in its bottom coast, the bottom ring node
     // at the notch's tip (0.5, -0.3) and the centre to its upper right: the
     // node's corner towards the notch's right flank is inverted. While the
-    // layout is tangled, ring nodes stay where they are but such a node
+    // layout is tangled, ring nodes stay where they are, except such a node
     // (untangle_ring_corners); the right ring node (1, 0.5), whose corners are
     // fine, stays either way.
     const tspline::LayoutRings ring =
