@@ -298,7 +298,10 @@ TEST_SUITE("map_quality_bounds") {
     const MapQualityBounds q1 = tspline::certified_map_quality(map, opt);
     CHECK(q1.mean_ratio.lower_bound == q.mean_ratio.lower_bound);
     CHECK(q1.scaled.sampled == q.scaled.sampled);
-    CHECK(q1.patches == q.patches);
+    // (Carried to the gap only where the minimum can be: fewer sub-patches.)
+    CHECK(q.bounded_elements == q.elements);
+    CHECK(q1.bounded_elements < q1.elements);
+    CHECK(q1.patches <= q.patches);
     const MapQualityBounds two = tspline::certified_map_quality({&map, &map}, opt);
     CHECK(two.elements == 2 * q.elements);
     CHECK(two.mean_ratio.lower_bound == q.mean_ratio.lower_bound);
@@ -306,10 +309,12 @@ TEST_SUITE("map_quality_bounds") {
     CHECK(two.scaled.sampled == q.scaled.sampled);
   }
 
-  TEST_CASE("dense sample where the minimum can be: the figures of a sample of every element") {
+  TEST_CASE("bounds and dense sample where the minimum can be: the figures of every element's") {
     // Without per_element only the elements whose bounds do not exceed the
-    // least sampled value are sampled; the sampled minima, their elements and
-    // their points must be those of sampling every element, bit for bit.
+    // least sampled value are sampled, and only those whose cone bounds do not
+    // exceed the least corner values are carried to the gap; the bounds, the
+    // attained and sampled minima, their elements and their points must be
+    // those of every element carried to the gap and sampled, bit for bit.
     auto same_sample = [](const TSplineMap& map, const char* what) {
       QualityBoundOptions every;
       every.per_element = true;
@@ -324,17 +329,25 @@ TEST_SUITE("map_quality_bounds") {
         CHECK(a.sampled_element == b.sampled_element);
         CHECK(a.sampled_at == b.sampled_at);
         CHECK(a.lower_bound == b.lower_bound);
+        CHECK(a.lower_bound_element == b.lower_bound_element);
         CHECK(a.attained == b.attained);
+        CHECK(a.attained_element == b.attained_element);
+        CHECK(a.attained_at == b.attained_at);
       }
+      CHECK(all.bounded_elements == all.elements);
+      CHECK(some.bounded_elements <= some.elements);
       return some;
     };
     const auto poly = tspline::io::read_polygon(test_support::polygon_file("flower.txt"));
     const tspline::ParameterizationResult r = tspline::run_parameterization(poly, {}, {});
     REQUIRE(r.map);
     const MapQualityBounds flower = same_sample(*r.map, "flower");
-    // The pruning works: a small fraction of the elements is sampled.
+    // The pruning works: a small fraction of the elements is sampled, and
+    // fewer than all are carried to the gap.
     CHECK(flower.sampled_elements >= 1);
     CHECK(flower.sampled_elements * 4 < flower.elements);
+    CHECK(flower.bounded_elements >= 1);
+    CHECK(flower.bounded_elements < flower.elements);
     // A fold: the folded elements have the lowest bounds and hold the minimum.
     const MapQualityBounds folded = same_sample(test_support::fold_between_gauss_points(), "folded");
     CHECK(folded.mean_ratio.sampled < 0.0);

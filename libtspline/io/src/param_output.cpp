@@ -260,6 +260,7 @@ nlohmann::json whole_map_quality_json(const MapQualityBounds& q, const QualityBo
           {"certified_bounds",
            {{"method", "Bernstein bounds of det J, |S_xi|, |S_eta| with subdivision (map_quality_bounds.h)"},
             {"elements", q.elements},
+            {"elements_bounded_to_the_gap", q.bounded_elements},  // the others cannot hold the minimum
             {"max_subdivision_depth", q.max_depth_used},
             {"sub_patches", q.patches},
             {"elements_stopped_at_a_limit", q.elements_not_converged},

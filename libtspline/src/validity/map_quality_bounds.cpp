@@ -363,8 +363,11 @@ void sample_element(const BezierElement& e, const std::vector<Eigen::Vector2d>& 
   dense_sample(element_forms(e, P).xyw, tab, aspect(e), e, out);
 }
 
+// The bounds of one element, to the gap (to_gap), or only the cone bound (b)
+// on the whole element and its corner values (the first step of the former).
 ElementQualityBound bound_element(const BezierElement& e, const std::vector<Eigen::Vector2d>& P,
-                                  const QualityBoundOptions& opt, const SampleTable& tab) {
+                                  const QualityBoundOptions& opt, const SampleTable& tab,
+                                  bool to_gap = true) {
   ElementQualityBound res;
   const double hx = e.hi.x() - e.lo.x(), hy = e.hi.y() - e.lo.y();
   const double r = aspect(e);
@@ -414,6 +417,11 @@ ElementQualityBound bound_element(const BezierElement& e, const std::vector<Eige
       }
   };
   sample_corners(leaves.front());
+  if (!to_gap) {
+    res.mean_ratio.lower_bound = leaves[0].jr_lo;
+    res.scaled.lower_bound = leaves[0].sj_lo;
+    return res;
+  }
   auto open = [&](double lo, double attained) {
     return attained - lo > opt.relative_gap * std::abs(attained) + opt.absolute_gap;
   };
@@ -562,29 +570,53 @@ MapQualityBounds certified_map_quality(const BezierExtraction& extraction, const
   // varies with the subdivision); the results are merged in element order, so
   // the figures do not depend on the number of threads.
   constexpr std::size_t kChunk = 64;
-  const std::size_t chunks = (es.size() + kChunk - 1) / kChunk;
   const unsigned hw = detail::hardware_threads();
-  const std::size_t threads =
-      std::max<std::size_t>(1, std::min<std::size_t>(chunks, opt.threads > 0 ? opt.threads : hw));
+  const std::size_t threads = std::max<std::size_t>(1, opt.threads > 0 ? opt.threads : hw);
   // Without per-element results, the dense sample is taken afterwards, only
-  // where it can hold the map's sampled minimum (sample_where_minimum_can_be).
+  // where it can hold the map's sampled minimum (sample_where_minimum_can_be),
+  // and the bounds are carried to the gap only where they can hold the map's
+  // minimum (header, "Over a map").
   const bool sample_all = opt.per_element;
   const SampleTable none(0);
-  std::atomic<std::size_t> next{0};
-  auto work = [&] {
-    for (std::size_t c; (c = next.fetch_add(1)) < chunks;)
-      for (std::size_t k = c * kChunk; k < std::min(es.size(), (c + 1) * kChunk); ++k)
-        per[k] = bound_element(es[k], P, opt, sample_all ? tab : none);
+  auto each = [&](const std::vector<std::size_t>* which, bool to_gap) {
+    const std::size_t n = which ? which->size() : es.size();
+    const std::size_t chunks = (n + kChunk - 1) / kChunk;
+    std::atomic<std::size_t> next{0};
+    auto work = [&] {
+      for (std::size_t c; (c = next.fetch_add(1)) < chunks;)
+        for (std::size_t i = c * kChunk; i < std::min(n, (c + 1) * kChunk); ++i) {
+          const std::size_t k = which ? (*which)[i] : i;
+          per[k] = bound_element(es[k], P, opt, sample_all ? tab : none, to_gap);
+        }
+    };
+    std::vector<std::thread> pool;
+    for (std::size_t t = 1; t < std::min<std::size_t>(threads, chunks); ++t) pool.emplace_back(work);
+    work();
+    for (std::thread& t : pool) t.join();
   };
-  std::vector<std::thread> pool;
-  for (std::size_t t = 1; t < threads; ++t) pool.emplace_back(work);
-  work();
-  for (std::thread& t : pool) t.join();
+  std::size_t bounded = es.size();
+  if (sample_all) {
+    each(nullptr, true);
+  } else {
+    each(nullptr, false);
+    double least_jr = 1.0, least_sj = 1.0;  // values of the map (corners of elements)
+    for (const ElementQualityBound& b : per) {
+      least_jr = std::min(least_jr, b.mean_ratio.attained);
+      least_sj = std::min(least_sj, b.scaled.attained);
+    }
+    std::vector<std::size_t> to_gap;
+    for (std::size_t k = 0; k < per.size(); ++k)  // (a NaN bound is carried to the gap)
+      if (!(per[k].mean_ratio.lower_bound > least_jr && per[k].scaled.lower_bound > least_sj))
+        to_gap.push_back(k);
+    bounded = to_gap.size();
+    each(&to_gap, true);
+  }
   std::size_t sampled_elements = tab.k > 0 ? es.size() : 0;
   if (!sample_all && tab.k > 0) sampled_elements = sample_where_minimum_can_be(es, P, tab, per);
 
   MapQualityBounds m;
   m.elements = es.size();
+  m.bounded_elements = bounded;
   m.sampled_elements = sampled_elements;
   m.samples_per_edge = opt.samples_per_edge;
   m.samples_per_element =
@@ -619,6 +651,7 @@ MapQualityBounds merge_map_quality(std::vector<MapQualityBounds>&& parts) {
     merge_into(m.mean_ratio, b.mean_ratio, m.elements, true);
     merge_into(m.scaled, b.scaled, m.elements, true);
     m.elements += b.elements;
+    m.bounded_elements += b.bounded_elements;
     m.sampled_elements += b.sampled_elements;
     m.samples_per_element = b.samples_per_element;
     m.max_depth_used = std::max(m.max_depth_used, b.max_depth_used);
