@@ -97,6 +97,59 @@ TEST_SUITE("parameterization") {
 }
 
 TEST_SUITE("parameterization") {
+  TEST_CASE("stop_when_tangled stops a front whose every trial is tangled, and changes no other run") {
+    // The fjords with default options: a corner trial's T-mesh keeps inverted
+    // cells after its nested stages, another's does not. With the option the
+    // tangled trials wait before their repair rounds and then go on: the same
+    // front, bit for bit, as without it (the kept one had a repair round).
+    const auto fjords = tspline::io::read_polygon(test_support::polygon_file("fjords.txt"));
+    tspline::ParameterizationOptions opt;
+    const tspline::FrontResult full = tspline::run_front(fjords, opt);
+    REQUIRE_FALSE(full.repair_refined_cells.empty());
+    CHECK(full.quality_optimized.inverted_cells == 0);
+    opt.stop_when_tangled = true;
+    const tspline::FrontResult waited = tspline::run_front(fjords, opt);
+    CHECK(waited.boundary.corners().index == full.boundary.corners().index);
+    CHECK(waited.repair_refined_cells == full.repair_refined_cells);
+    CHECK(waited.optimized == full.optimized);
+    REQUIRE(waited.corner_trials.size() == full.corner_trials.size());
+    for (std::size_t k = 0; k < full.corner_trials.size(); ++k) {
+      CHECK(waited.corner_trials[k].inverted_cells == full.corner_trials[k].inverted_cells);
+      CHECK(waited.corner_trials[k].min_mean_ratio == full.corner_trials[k].min_mean_ratio);
+    }
+    // At 20 sweeps a stage every trial's T-mesh is tangled after its stages:
+    // the run stops, naming each trial's inverted cells (without the option,
+    // repair rounds go on).
+    opt.smoothing.max_sweeps = 20;
+    const std::string why =
+        test_support::message_of<tspline::FrontTangled>([&] { (void)tspline::run_front(fjords, opt); });
+    CHECK(contains(why, "every corner trial's T-mesh is tangled after its nested stages (inverted cells: "));
+    opt.stop_when_tangled = false;
+    CHECK_FALSE(tspline::run_front(fjords, opt).repair_refined_cells.empty());
+    // One choice of corners (no trials): the run's own T-mesh.
+    opt.stop_when_tangled = true;
+    opt.corners.emplace();
+    for (int k = 0; k < 4; ++k)
+      (*opt.corners)[k] =
+          static_cast<long long>(full.boundary.polygon().file_index[full.boundary.corners().index[k]]);
+    const std::string own =
+        test_support::message_of<tspline::FrontTangled>([&] { (void)tspline::run_front(fjords, opt); });
+    CHECK(contains(own, "the optimized T-mesh is tangled after its nested stages ("));
+    CHECK(contains(own, " inverted cells of "));
+    // The gear needs no repair round: the same front, bit for bit.
+    const auto gear = tspline::io::read_polygon(test_support::polygon_file("gear.txt"));
+    tspline::ParameterizationOptions quick_options;
+    quick_options.stop_when_tangled = true;
+    const tspline::FrontResult plain = tspline::run_front(gear, {});
+    const tspline::FrontResult quick = tspline::run_front(gear, quick_options);
+    REQUIRE(plain.repair_refined_cells.empty());
+    CHECK(quick.boundary.corners().index == plain.boundary.corners().index);
+    CHECK(quick.optimized == plain.optimized);
+    CHECK(quick.total_sweeps == plain.total_sweeps);
+  }
+}
+
+TEST_SUITE("parameterization") {
   TEST_CASE("best_corner_trial: fewest inverted cells first, then the highest min + mean quality") {
     using tspline::CornerTrial;
     using tspline::best_corner_trial;

@@ -18,6 +18,7 @@
 #include "tspline/boundary/polygon_validation.h"
 #include "tspline/errors.h"
 #include "tspline/io/gis_reader.h"
+#include "tspline/io/layout_output.h"
 #include "tspline/io/polygon_reader.h"
 #include "tspline/layout/quad_layout.h"
 #include "tspline/layout/quad_layout_memo.h"
@@ -703,6 +704,38 @@ TEST_SUITE("quad_layout") {
     CHECK(contains(
         message_of<tspline::InputError>([&] { (void)tspline::parameterize_domain(bali, po, ad, c); }),
         "largest folded fraction"));
+  }
+
+  TEST_CASE("auto: a single try whose every corner trial is tangled after its stages stops there") {
+    if (!tspline::quad_mesher_available()) return;
+    // The fjords with 20 sweeps per stage: every corner trial's T-mesh keeps
+    // inverted cells after its nested stages. The try stops there, before any
+    // repair round and fit; a good layout is kept over it, the same map as
+    // when the try runs on (it is then stopped by a corner of 179 degrees).
+    const tspline::Domain fjords{tspline::io::read_polygon(test_support::polygon_file("fjords.txt")), {}};
+    tspline::ParameterizationOptions po;
+    po.smoothing.max_sweeps = 20;
+    const tspline::AdaptiveOptions ad;
+    tspline::DomainParameterizationOptions c;
+    const tspline::DomainParameterization A = tspline::parameterize_domain(fjords, po, ad, c);
+    INFO(A.reason);
+    REQUIRE(A.patches);
+    CHECK(A.layout == "quad");
+    CHECK(contains(A.reason,
+                   "one patch is stopped: every corner trial's T-mesh is tangled after its nested stages"));
+    CHECK(contains(A.single_stopped, "not a quick try (it would need repair rounds)"));
+    CHECK_FALSE(A.single_corners);
+    CHECK_FALSE(A.rejected_single);
+    CHECK(tspline::io::layout_report(A)["single_patch_first_try"]["stopped"].get<std::string>().rfind(
+              "after its T-mesh optimization: ", 0) == 0);
+    c.first_try_stop_when_tangled = false;
+    const tspline::DomainParameterization W = tspline::parameterize_domain(fjords, po, ad, c);
+    INFO(W.reason);
+    REQUIRE(W.patches);
+    CHECK(contains(W.reason, "one patch cannot be good: its corner at "));
+    REQUIRE(W.patches->patches.size() == A.patches->patches.size());
+    CHECK(W.patches->min_mean_ratio_dense() == A.patches->min_mean_ratio_dense());
+    CHECK(W.patches->min_scaled_jacobian_dense() == A.patches->min_scaled_jacobian_dense());
   }
 
   TEST_CASE_FIXTURE(UnitSquareAtLevel2,

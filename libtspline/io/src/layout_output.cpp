@@ -29,6 +29,8 @@ nlohmann::json layout_report(const DomainParameterization& result) {
          "J at the corners of the square is the boundary's: upper bounds of the try's whole-map minima"},
         {"corner_min_scaled_jacobian", boundary_corner_json(result.single_corners->scaled)},
         {"corner_min_mean_ratio", boundary_corner_json(result.single_corners->mean_ratio)}};
+  else if (!result.single_stopped.empty())  // stopped before its first fit: no corners yet
+    out["single_patch_first_try"] = {{"stopped", "after its T-mesh optimization: " + result.single_stopped}};
   return out;
 }
 

@@ -442,22 +442,31 @@ DomainParameterization parameterize_domain(const Domain& input, const Parameteri
   // c.first_try_max_folded of the untangling's samples (not a quick try; such
   // maps untangled to poor maps on every coastline measured): then only a good
   // layout is kept over it, else the try runs again in full as above.
+  // Before all that, a try whose T-mesh (optimized without repair rounds) is
+  // still tangled stops at its front half (c.first_try_stop_when_tangled),
+  // with the same consequences as a stop for folds.
   std::optional<BoundaryCornerMinima> corners;
-  bool stopped_for_folds = false;
-  if (quad_mesher_available())  // (else one patch is all there is)
-    first.stop_when_boundary_frozen = [&c, &corners, &adaptive, &stopped_for_folds](const TSplineMap& map) {
+  bool stopped_not_quick = false;  // for its folds, or its tangled T-mesh
+  ParameterizationOptions try_options = serial;
+  if (quad_mesher_available()) {  // (else one patch is all there is)
+    first.stop_when_boundary_frozen = [&c, &corners, &adaptive, &stopped_not_quick](const TSplineMap& map) {
       corners = boundary_corner_minima(map);
       std::string why = corners_rule_out(*corners, c.good);
       if (why.empty() && c.first_try_max_folded > 0.0) {
         why = folds_rule_out(map, adaptive.untangling.energy, c);
-        stopped_for_folds = !why.empty();
+        stopped_not_quick = !why.empty();
       }
       return why;
     };
+    try_options.stop_when_tangled = c.first_try_stop_when_tangled;
+  }
   std::optional<ParameterizationResult> single;
   std::string stopped;
   try {
-    single.emplace(run_parameterization(domain.outer, serial, first, on_iteration));
+    single.emplace(run_parameterization(domain.outer, try_options, first, on_iteration));
+  } catch (const FrontTangled& e) {
+    stopped = std::string(e.what()) + ": not a quick try (it would need repair rounds)";
+    stopped_not_quick = true;
   } catch (const ParameterizationStopped& e) {
     stopped = e.what();
   }
@@ -493,10 +502,11 @@ DomainParameterization parameterize_domain(const Domain& input, const Parameteri
       return out;
     }
   }
-  std::string why = !single      ? (stopped_for_folds ? "one patch is stopped: " : "one patch cannot be good: ") + stopped
-                    : !certified ? std::string("one patch is not certified after ") +
-                                       std::to_string(first.max_adapt) + " adaptive rounds"
-                                 : "one patch is certified but poor over the whole map (" + figures(q) + ")";
+  std::string why =
+      !single      ? (stopped_not_quick ? "one patch is stopped: " : "one patch cannot be good: ") + stopped
+      : !certified ? std::string("one patch is not certified after ") + std::to_string(first.max_adapt) +
+                         " adaptive rounds"
+                   : "one patch is certified but poor over the whole map (" + figures(q) + ")";
   report_step(serial.progress, "layout", why + ": building a quad layout");
   try {
     run_quad(why);
@@ -509,8 +519,8 @@ DomainParameterization parameterize_domain(const Domain& input, const Parameteri
         at_corners.min_scaled = corners->scaled.scaled_jacobian;
         at_corners.min_mean_ratio = corners->mean_ratio.mean_ratio;
       }
-      // A try stopped for its folds: a good layout is kept over it.
-      if (!single && (stopped_for_folds ? reaches_good_quality(lq, c)
+      // A try stopped for its folds or its tangled T-mesh: a good layout is kept over it.
+      if (!single && (stopped_not_quick ? reaches_good_quality(lq, c)
                                         : keep_layout_over_single(lq, at_corners, true, c))) {
         out.single_corners = corners;
         out.single_stopped = stopped;

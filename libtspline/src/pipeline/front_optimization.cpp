@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <memory>
 #include <sstream>
 #include <string>
 #include <utility>
@@ -65,7 +66,10 @@ void refine_below(TMesh& mesh, int level) {
   }
 }
 
-// One run of optimize_front: the result it builds and the options it reads.
+}  // namespace
+
+// One run of optimize_front: the result it builds and the options it reads
+// (its own copy: a FrontRun outlives its caller's options).
 class FrontOptimizer {
  public:
   FrontOptimizer(BoundaryMap boundary, const ParameterizationOptions& opt);
@@ -74,6 +78,8 @@ class FrontOptimizer {
 
   void run_nested_stages();
   void repair();
+  void stop_if_tangled() const;
+  const FrontResult& result() const { return r_; }
   FrontResult take_result() { return std::move(r_); }
 
  private:
@@ -82,7 +88,7 @@ class FrontOptimizer {
   void report_final_tmesh(const BoundaryRefinementReport& rep);
   bool repair_round(int round);
 
-  const ParameterizationOptions& opt_;
+  const ParameterizationOptions opt_;
   FrontResult r_;
   StageClock clock_;
   double diag_ = 0.0;
@@ -220,6 +226,14 @@ void FrontOptimizer::run_nested_stages() {
   }
 }
 
+// ParameterizationOptions::stop_when_tangled, before any repair round.
+void FrontOptimizer::stop_if_tangled() const {
+  if (!opt_.stop_when_tangled || r_.quality_optimized.inverted_cells == 0) return;
+  throw FrontTangled("the optimized T-mesh is tangled after its nested stages (" +
+                     std::to_string(r_.quality_optimized.inverted_cells) + " inverted cells of " +
+                     std::to_string(r_.mesh.num_cells()) + ")");
+}
+
 // Repair: cells that stay inverted lack interior freedom (typically thin
 // features of the domain). Refine them, place the new vertices in the current
 // physical mesh, re-balance and optimize again.
@@ -280,11 +294,28 @@ bool FrontOptimizer::repair_round(int round) {
   return false;
 }
 
-}  // namespace
+FrontRun::FrontRun(BoundaryMap boundary, const ParameterizationOptions& options)
+    : front_(std::make_unique<FrontOptimizer>(std::move(boundary), options)) {
+  front_->run_nested_stages();
+}
+FrontRun::FrontRun(FrontRun&&) noexcept = default;
+FrontRun& FrontRun::operator=(FrontRun&&) noexcept = default;
+FrontRun::~FrontRun() = default;
+
+std::size_t FrontRun::inverted_cells() const { return front_->result().quality_optimized.inverted_cells; }
+std::size_t FrontRun::cells() const { return front_->result().mesh.num_cells(); }
+
+FrontResult FrontRun::finish() {
+  front_->repair();
+  FrontResult r = front_->take_result();
+  front_.reset();
+  return r;
+}
 
 FrontResult optimize_front(BoundaryMap boundary, const ParameterizationOptions& options) {
   FrontOptimizer front(std::move(boundary), options);
   front.run_nested_stages();
+  front.stop_if_tangled();
   front.repair();
   return front.take_result();
 }

@@ -97,11 +97,13 @@ struct CornerTrials {
   std::vector<ProgressEvent> kept_events;  // its progress, replayed if it is the run's
 };
 
-// The front half of one trial, its steps and notes collected in `events`;
-// sweeps of concurrent trials become heartbeats (the caller may stop the run).
-FrontResult run_corner_trial(const Polygon& poly, const Corners& corners, ParameterizationOptions o,
-                             const ProgressCallback& progress, std::size_t k, std::vector<ProgressEvent>& events,
-                             std::mutex& report_mutex) {
+// The front half of one trial up to the end of its nested stages (FrontRun:
+// the repair rounds come with finish()), its steps and notes collected in
+// `events`; sweeps of concurrent trials become heartbeats (the caller may stop
+// the run).
+FrontRun start_corner_trial(const Polygon& poly, const Corners& corners, ParameterizationOptions o,
+                            const ProgressCallback& progress, std::size_t k,
+                            std::vector<ProgressEvent>& events, std::mutex& report_mutex) {
   o.progress = nullptr;
   if (progress)
     o.progress = [&events, &report_mutex, &progress, k](const ProgressEvent& e) {
@@ -116,7 +118,7 @@ FrontResult run_corner_trial(const Polygon& poly, const Corners& corners, Parame
       const std::lock_guard<std::mutex> lock(report_mutex);
       progress(beat);
     };
-  return optimize_front(BoundaryMap(poly, corners), o);
+  return FrontRun(BoundaryMap(poly, corners), o);
 }
 
 // The options of a corner trial: at most the default resolution (level <= 5,
@@ -167,11 +169,20 @@ CornerTrials try_corners(const Polygon& poly, std::vector<Corners> cands, const 
     report_step(opt.progress, "corners",
                 "corners: trial " + std::to_string(++finished) + " of " + std::to_string(cands.size()) + text);
   };
-  for_each_concurrently(cands.size(), [&](std::size_t k) {
+  // Under stop_when_tangled a trial whose T-mesh is tangled after its nested
+  // stages waits there, before its repair rounds, until some trial's is not:
+  // then every waiting trial goes on as it would have (FrontRun), and the
+  // choice is the one without the option; if none is, the run stops.
+  const bool wait = topt.stop_when_tangled;
+  std::vector<std::optional<FrontRun>> runs(cands.size());
+  std::atomic<bool> untangled{false};
+  auto finish = [&](std::size_t k) {
     try {
-      results[k].emplace(run_corner_trial(poly, cands[k], topt, opt.progress, k, events[k], report_mutex));
+      results[k].emplace(runs[k]->finish());
+      runs[k].reset();
     } catch (const InputError& e) {
       over_budget[k] = std::current_exception();
+      runs[k].reset();
       const std::lock_guard<std::mutex> lock(report_mutex);
       if (opt.progress) report(" failed (choice " + std::to_string(k + 1) + "): " + e.what());
       return;
@@ -183,7 +194,32 @@ CornerTrials try_corners(const Polygon& poly, std::vector<Corners> cands, const 
       << t.quality_optimized.mean_mean_ratio;
     const std::lock_guard<std::mutex> lock(report_mutex);
     if (opt.progress) report(s.str());
+  };
+  for_each_concurrently(cands.size(), [&](std::size_t k) {
+    try {
+      runs[k].emplace(start_corner_trial(poly, cands[k], topt, opt.progress, k, events[k], report_mutex));
+    } catch (const InputError& e) {
+      over_budget[k] = std::current_exception();
+      const std::lock_guard<std::mutex> lock(report_mutex);
+      if (opt.progress) report(" failed (choice " + std::to_string(k + 1) + "): " + e.what());
+      return;
+    }
+    if (runs[k]->inverted_cells() == 0) untangled = true;
+    if (wait && !untangled) return;  // waits
+    finish(k);
   });
+  std::vector<std::size_t> waiting;
+  for (std::size_t k = 0; k < cands.size(); ++k)
+    if (runs[k]) waiting.push_back(k);
+  if (!waiting.empty() && !untangled) {
+    std::ostringstream s;
+    s << "every corner trial's T-mesh is tangled after its nested stages (inverted cells:";
+    for (std::size_t i = 0; i < waiting.size(); ++i)
+      s << (i ? ", " : " ") << runs[waiting[i]]->inverted_cells() << " of " << runs[waiting[i]]->cells();
+    s << ")";
+    throw FrontTangled(s.str());
+  }
+  for_each_concurrently(waiting.size(), [&](std::size_t i) { finish(waiting[i]); });
   CornerTrials out;
   out.trials = trial_rows(cands, results);
   const std::size_t best = best_corner_trial(out.trials);

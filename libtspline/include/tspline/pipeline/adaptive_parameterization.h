@@ -100,12 +100,6 @@ struct AdaptiveOptions {
   std::function<std::string(const TSplineMap&)> stop_when_boundary_frozen;
 };
 
-/// Thrown where AdaptiveOptions::stop_when_boundary_frozen stopped the run;
-/// what() is its text.
-struct ParameterizationStopped : std::runtime_error {
-  using std::runtime_error::runtime_error;
-};
-
 struct AdaptIteration {
   std::size_t cells = 0;
   std::size_t vertices = 0;

@@ -6,6 +6,7 @@
 #include <array>
 #include <functional>
 #include <optional>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -13,9 +14,9 @@
 #include "tspline/boundary/border_knots.h"
 #include "tspline/boundary/boundary_map.h"
 #include "tspline/boundary/boundary_refinement.h"
-#include "tspline/tmesh/mesh_quality.h"
 #include "tspline/boundary/polygon.h"
 #include "tspline/pipeline/progress_event.h"
+#include "tspline/tmesh/mesh_quality.h"
 #include "tspline/tmesh/tmesh.h"
 
 namespace tspline {
@@ -42,6 +43,13 @@ struct ParameterizationOptions {
   /// If inverted cells remain after optimization, refine them, re-balance,
   /// re-optimize; at most this many rounds (0 disables the repair).
   int max_repair_rounds = 8;
+  /// Stop the front half (FrontTangled) where the optimized T-mesh is still
+  /// tangled after its last nested stage, before any repair round; with corner
+  /// trials, only where every trial's is (a trial waits there until one is
+  /// not; then all go on with their repair rounds). A run not stopped so is the
+  /// run without this option, bit for bit. For callers that only want a quick
+  /// answer (auto's single-patch try, domain_parameterization.h).
+  bool stop_when_tangled = false;
   /// Optimize on a nested sequence of coarser T-meshes first (same final mesh,
   /// far fewer sweeps on fine meshes). false: optimize the final mesh from Coons.
   bool nested_optimization = true;
@@ -52,6 +60,18 @@ struct ParameterizationOptions {
   meshopt::SmoothingOptions smoothing;
   /// Progress events (progress_event.h); may be empty.
   ProgressCallback progress;
+};
+
+/// Thrown where a run was stopped on purpose (ParameterizationOptions::
+/// stop_when_tangled, AdaptiveOptions::stop_when_boundary_frozen); what() is
+/// why.
+struct ParameterizationStopped : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+/// The stop of ParameterizationOptions::stop_when_tangled.
+struct FrontTangled : ParameterizationStopped {
+  using ParameterizationStopped::ParameterizationStopped;
 };
 
 struct StageTime {
