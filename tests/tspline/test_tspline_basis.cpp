@@ -158,6 +158,60 @@ KindCounts count_kinds(const TSplineBasis& B) {
 }  // namespace
 
 TEST_SUITE("tspline_basis") {
+  TEST_CASE(
+      "cubic_bspline_vanishes only where cubic_bspline is +0; values-only evaluation is the full one's") {
+    // Knot vectors with simple, double, triple and quadruple end knots, at the
+    // border and inside, at every knot and at random points around them.
+    const std::vector<std::array<double, 5>> vectors = {
+        K(0, 0.25, 0.5, 0.75, 1),     K(0, 0, 0, 0, 0.5),         K(0, 0, 0, 0.3, 0.7),
+        K(0, 0, 0.2, 0.6, 0.65),      K(0.2, 0.2, 0.2, 0.2, 0.8), K(0.2, 0.2, 0.2, 0.5, 0.8),
+        K(0.5, 1, 1, 1, 1),           K(0.25, 0.5, 1, 1, 1),      K(0.3, 0.6, 0.6, 0.6, 0.6),
+        K(0.3, 0.3, 0.55, 0.55, 0.9), K(0.4, 0.4, 0.4, 0.4, 0.4)};
+    std::mt19937 rng(5);
+    std::size_t said = 0;
+    for (const auto& k : vectors) {
+      std::vector<double> ts(k.begin(), k.end());
+      std::uniform_real_distribution<double> u(k[0] - 0.1, k[4] + 0.1);
+      for (int i = 0; i < 50; ++i) ts.push_back(u(rng));
+      ts.push_back(0.0), ts.push_back(1.0);
+      for (double t : ts) {
+        if (!tspline::cubic_bspline_vanishes(k, t)) continue;
+        ++said;
+        const double v = tspline::cubic_bspline(k, t);
+        CAPTURE(t);
+        CHECK(v == 0.0);
+        CHECK_FALSE(std::signbit(v));
+      }
+    }
+    CHECK(said > 100);
+    // The same function right of a simple knot, and a clamped start: not zero.
+    CHECK_FALSE(tspline::cubic_bspline_vanishes(K(0, 0, 0, 0, 0.5), 0.0));
+    CHECK_FALSE(tspline::cubic_bspline_vanishes(K(0.5, 1, 1, 1, 1), 1.0));
+    // TSplineBasis::evaluate with values only skips such factors: the values
+    // must be those of the evaluation with derivatives, bit for bit, at cell
+    // corners, on edges and inside, on a graded T-mesh.
+    const TMesh m = boundary_mesh(3);
+    const TSplineBasis B(m);
+    tspline::BasisValues full, values;
+    std::size_t points = 0, zeros = 0;
+    for (int c = 0; c < static_cast<int>(m.num_cells()); ++c)
+      for (const double s : {0.0, 0.25, 0.5, 1.0})
+        for (const double t : {0.0, 0.3, 1.0}) {
+          const Eigen::Vector2d uv = in_cell(m, c, s, t);
+          B.evaluate(c, uv, full, 1);
+          B.evaluate(c, uv, values, 0);
+          REQUIRE(values.ids == full.ids);
+          for (std::size_t a = 0; a < full.R.size(); ++a) {
+            CHECK(values.R[a] == full.R[a]);
+            CHECK(std::signbit(values.R[a]) == std::signbit(full.R[a]));
+            zeros += full.R[a] == 0.0;
+          }
+          ++points;
+        }
+    CHECK(points > 100);
+    CHECK(zeros > points);  // (most functions of a cell vanish on its edges)
+  }
+
   TEST_CASE("cubic_bspline matches Cox-de Boor, values and derivatives") {
     const std::vector<std::array<double, 5>> vectors = {
         K(0, 0.25, 0.5, 0.75, 1),      K(0.1, 0.3, 0.35, 0.7, 0.9),  K(0, 0, 0, 0, 0.5),

@@ -241,6 +241,11 @@ void TSplineBasis::evaluate(const Eigen::Vector2d& uv, BasisValues& out, int ord
 //   R_i  = (N_i - R S_i) / S
 //   R_ij = (N_ij - R_i S_j - R_j S_i - R S_ij) / S
 // (differentiate N = R S twice: N_ij = R_ij S + R_i S_j + R_j S_i + R S_ij).
+bool cubic_bspline_vanishes(const std::array<double, 5>& k, double t) {
+  return !(t >= k[0] && t <= k[4]) || k[0] == k[4] || (t == k[4] && k[4] != 1.0) ||
+         (t == k[0] && k[3] > k[0]);
+}
+
 void TSplineBasis::evaluate(int c, const Eigen::Vector2d& uv, BasisValues& out, int order) const {
   if (order < 0 || order > 2) throw toolkit::InputError("TSplineBasis::evaluate: order must be 0, 1 or 2");
   const std::vector<int>& ids = cell_functions_.at(static_cast<std::size_t>(c));
@@ -256,6 +261,13 @@ void TSplineBasis::evaluate(int c, const Eigen::Vector2d& uv, BasisValues& out, 
   double S = 0, Sx = 0, Sy = 0, Sxx = 0, Sxy = 0, Syy = 0;
   for (std::size_t k = 0; k < n; ++k) {
     const BlendingFunction& f = functions_[ids[k]];
+    // Values only: a factor known to be +0 makes N = +0 (the other factor is
+    // finite), which adds nothing to S. Most of a cell's functions vanish so
+    // at points on its edges (interface gaps, interpolation at vertices).
+    if (!d1 && (cubic_bspline_vanishes(f.knots_xi, uv.x()) || cubic_bspline_vanishes(f.knots_eta, uv.y()))) {
+      out.R[k] = 0.0;
+      continue;
+    }
     double u1 = 0, u2 = 0, w1 = 0, w2 = 0;
     const double u = cubic_bspline(f.knots_xi, uv.x(), d1 ? &u1 : nullptr, d2 ? &u2 : nullptr);
     const double w = cubic_bspline(f.knots_eta, uv.y(), d1 ? &w1 : nullptr, d2 ? &w2 : nullptr);

@@ -51,6 +51,12 @@ struct BlendingFunction {
 /// used so that the basis is defined on the closed square. d1, d2 may be null.
 double cubic_bspline(const std::array<double, 5>& knots, double t, double* d1 = nullptr, double* d2 = nullptr);
 
+/// Whether cubic_bspline(knots, t) is +0 without evaluating it: t outside the
+/// support, at its right end below 1 (right-continuous), or at its left end
+/// where that knot has multiplicity below 4 (the function is continuous there
+/// and starts at 0). Not every zero: a sufficient test, exact where it says yes.
+bool cubic_bspline_vanishes(const std::array<double, 5>& knots, double t);
+
 /// True iff blending function f is non-zero somewhere on the border of [0,1]^2
 /// (four repeated knots at 0 or 1 in some direction): the functions whose
 /// control points define the boundary curve.
