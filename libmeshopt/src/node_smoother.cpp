@@ -165,20 +165,34 @@ std::vector<std::vector<int>> build_dependents(std::size_t num_positions, const 
 
 SmoothingReport smooth(std::vector<Eigen::Vector2d>& positions, const SmoothingProblem& problem,
                        const SmoothingOptions& options) {
-  detail::validate_options(options);
-  validate_problem(positions, problem);
-  SmoothingReport rep;
-  rep.tangled_nodes_before = count_tangled(positions, problem);
+  SmoothingRun run;
+  return smooth_until(positions, problem, options, options.max_sweeps, run);
+}
+
+SmoothingReport smooth_until(std::vector<Eigen::Vector2d>& positions, const SmoothingProblem& problem,
+                             const SmoothingOptions& options, int sweeps, SmoothingRun& run) {
+  SmoothingReport& rep = run.report;
+  if (!run.started) {
+    detail::validate_options(options);
+    validate_problem(positions, problem);
+    rep.tangled_nodes_before = count_tangled(positions, problem);
+    // Active set: a node is visited again only if it, or a node of its submesh,
+    // moved by more than the tolerance since its last visit. Converged parts of the
+    // mesh then cost nothing, and the stopping rule (largest relative move below
+    // the tolerance) is unchanged: a skipped node's objective has not changed
+    // beyond the tolerance, so it would not move either.
+    run.dependents = build_dependents(positions.size(), problem);
+    run.active.assign(problem.size(), 1);
+    run.started = true;
+  }
   const std::span<const Eigen::Vector2d> pos(positions);
   Counters cnt;
-  // Active set: a node is visited again only if it, or a node of its submesh,
-  // moved by more than the tolerance since its last visit. Converged parts of the
-  // mesh then cost nothing, and the stopping rule (largest relative move below
-  // the tolerance) is unchanged: a skipped node's objective has not changed
-  // beyond the tolerance, so it would not move either.
-  const std::vector<std::vector<int>> dependents = build_dependents(positions.size(), problem);
-  std::vector<char> active(problem.size(), 1);
-  for (int sweep = 0; sweep < options.max_sweeps; ++sweep) {
+  cnt.newton = rep.newton_steps;
+  cnt.gradient = rep.gradient_fallbacks;
+  const std::vector<std::vector<int>>& dependents = run.dependents;
+  std::vector<char>& active = run.active;
+  const int limit = std::min(sweeps, options.max_sweeps);
+  for (int sweep = rep.sweeps; !run.finished && sweep < limit; ++sweep) {
     double max_move = 0.0;
     std::size_t visited = 0;
     for (std::size_t k = 0; k < problem.size(); ++k) {
@@ -210,9 +224,10 @@ SmoothingReport smooth(std::vector<Eigen::Vector2d>& positions, const SmoothingP
     if (options.progress) options.progress(sweep, max_move, count_tangled(positions, problem));
     if (max_move < options.relative_displacement_tolerance) {
       rep.converged = true;
-      break;
+      run.finished = true;
     }
   }
+  if (rep.sweeps >= options.max_sweeps) run.finished = true;
   rep.tangled_nodes_after = count_tangled(positions, problem);
   rep.newton_steps = cnt.newton;
   rep.gradient_fallbacks = cnt.gradient;

@@ -332,6 +332,36 @@ TEST_CASE("smooth untangles a perturbed quad grid and converges to the regular g
   CHECK(pos2 == pos);
 }
 
+TEST_CASE("smooth_until in parts gives smooth's positions and report bit for bit") {
+  const Grid g = make_quad_grid(8);
+  SmoothingOptions opt;
+  opt.relative_displacement_tolerance = 1e-8;
+  opt.max_sweeps = 200;
+  std::vector<Vector2d> whole = perturb(g, 42);
+  const SmoothingReport all = smooth(whole, g.problem, opt);
+  REQUIRE(all.sweeps > 12);
+  std::vector<Vector2d> parts = perturb(g, 42);
+  meshopt::SmoothingRun run;
+  const SmoothingReport first = meshopt::smooth_until(parts, g.problem, opt, 3, run);
+  CHECK(first.sweeps == 3);
+  CHECK_FALSE(run.finished);
+  CHECK(first.tangled_nodes_before == all.tangled_nodes_before);
+  (void)meshopt::smooth_until(parts, g.problem, opt, 3, run);  // nothing more to do
+  CHECK(run.report.sweeps == 3);
+  (void)meshopt::smooth_until(parts, g.problem, opt, 12, run);
+  const SmoothingReport rest =
+      meshopt::smooth_until(parts, g.problem, opt, 10000, run);  // (capped at max_sweeps)
+  CHECK(run.finished);
+  CHECK(parts == whole);
+  CHECK(rest.sweeps == all.sweeps);
+  CHECK(rest.converged == all.converged);
+  CHECK(rest.node_visits == all.node_visits);
+  CHECK(rest.newton_steps == all.newton_steps);
+  CHECK(rest.gradient_fallbacks == all.gradient_fallbacks);
+  CHECK(rest.last_max_relative_move == all.last_max_relative_move);
+  CHECK(rest.tangled_nodes_after == all.tangled_nodes_after);
+}
+
 TEST_CASE("smooth untangles a perturbed triangle grid with the default options") {
   const Grid g = make_triangle_grid(10);
   std::vector<Vector2d> pos = perturb(g, 3);

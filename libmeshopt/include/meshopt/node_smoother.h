@@ -64,6 +64,25 @@ struct SmoothingReport {
 SmoothingReport smooth(std::vector<Eigen::Vector2d>& positions, const SmoothingProblem& problem,
                        const SmoothingOptions& options = {});
 
+/// A smooth() run between its parts (smooth_until): the sweeps made, the
+/// nodes still active, the report so far. Default: not started.
+struct SmoothingRun {
+  bool started = false;
+  bool finished = false;  ///< converged, or options.max_sweeps made
+  std::vector<char> active;
+  std::vector<std::vector<int>> dependents;
+  SmoothingReport report;
+};
+
+/// smooth() in parts: sweeps until `sweeps` in all (at most options.max_sweeps)
+/// or convergence, then returns the report so far (tangled_nodes_after: now).
+/// Called again with the same positions, problem, options and run and a larger
+/// limit, it goes on where it stopped: parts up to options.max_sweeps give
+/// smooth()'s positions and report bit for bit. Lets a caller look at the
+/// mesh after a few sweeps before it pays for the rest.
+SmoothingReport smooth_until(std::vector<Eigen::Vector2d>& positions, const SmoothingProblem& problem,
+                             const SmoothingOptions& options, int sweeps, SmoothingRun& run);
+
 /// Optimizes a single free node (used by smooth(); exposed for tests and for
 /// callers with their own sweep logic). Returns the new position. Counters, if given,
 /// are incremented by the accepted Newton / gradient steps.

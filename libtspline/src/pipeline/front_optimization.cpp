@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <memory>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <utility>
@@ -68,6 +69,10 @@ void refine_below(TMesh& mesh, int level) {
 
 }  // namespace
 
+// Sweeps of an intermediate stage at most (they only provide a start); also
+// where a final stage pauses under stop_when_tangled.
+constexpr int kStageSweeps = 100;
+
 // One run of optimize_front: the result it builds and the options it reads
 // (its own copy: a FrontRun outlives its caller's options).
 class FrontOptimizer {
@@ -77,14 +82,27 @@ class FrontOptimizer {
   FrontOptimizer& operator=(const FrontOptimizer&) = delete;
 
   void run_nested_stages();
+  /// The rest of a final stage paused by run_nested_stages (none: nothing).
+  void resume();
   void repair();
   void stop_if_tangled() const;
+  bool paused() const { return paused_.has_value(); }
+  /// Of the optimized T-mesh: at the pause, if paused.
+  std::size_t inverted_cells() const {
+    return paused_ ? paused_inverted_ : r_.quality_optimized.inverted_cells;
+  }
   const FrontResult& result() const { return r_; }
   FrontResult take_result() { return std::move(r_); }
 
  private:
   void log(const char* stage, const std::string& text) const { report_step(opt_.progress, stage, text); }
   void optimize(const std::string& what);
+  // optimize() in parts: the problem of the current mesh; sweeps until
+  // `sweeps` in all (meshopt::smooth_until); the figures and the log line.
+  void begin_optimize();
+  void advance_optimize(int sweeps);
+  void end_optimize(const std::string& what);
+  void end_stage(FrontStage stage);
   void report_final_tmesh(const BoundaryRefinementReport& rep);
   bool repair_round(int round);
 
@@ -93,6 +111,12 @@ class FrontOptimizer {
   StageClock clock_;
   double diag_ = 0.0;
   meshopt::SmoothingOptions sopt_;
+  meshopt::SmoothingProblem problem_;
+  meshopt::SmoothingRun run_;
+  // stop_when_tangled: the final stage paused kTangledProbeSweeps in, tangled
+  // (its record, and its inverted cells then).
+  std::optional<FrontStage> paused_;
+  std::size_t paused_inverted_ = 0;
 };
 
 FrontOptimizer::FrontOptimizer(BoundaryMap boundary, const ParameterizationOptions& opt)
@@ -119,8 +143,22 @@ FrontOptimizer::FrontOptimizer(BoundaryMap boundary, const ParameterizationOptio
 // The K* smoothing of the interior nodes of the current mesh (paper Eq. 5-7),
 // from r_.optimized.
 void FrontOptimizer::optimize(const std::string& what) {
-  const meshopt::SmoothingProblem problem = build_smoothing_problem(r_.mesh, true);
-  r_.smoothing = meshopt::smooth(r_.optimized, problem, sopt_);
+  begin_optimize();
+  advance_optimize(sopt_.max_sweeps);
+  end_optimize(what);
+}
+
+void FrontOptimizer::begin_optimize() {
+  problem_ = build_smoothing_problem(r_.mesh, true);
+  run_ = meshopt::SmoothingRun();
+}
+
+void FrontOptimizer::advance_optimize(int sweeps) {
+  r_.smoothing = meshopt::smooth_until(r_.optimized, problem_, sopt_, sweeps, run_);
+}
+
+void FrontOptimizer::end_optimize(const std::string& what) {
+  problem_ = meshopt::SmoothingProblem();
   r_.total_sweeps += r_.smoothing.sweeps;
   r_.node_visits += r_.smoothing.node_visits;
   r_.quality_optimized = mesh_quality(r_.mesh, r_.optimized);
@@ -216,22 +254,53 @@ void FrontOptimizer::run_nested_stages() {
                               (stage.carried ? "Coons " : "carried over ") +
                               std::to_string(*stage.other_start_inverted) + ")");
     // Intermediate stages only provide a start: a bounded number of sweeps.
-    sopt_.max_sweeps = last ? opt_.smoothing.max_sweeps : std::min(opt_.smoothing.max_sweeps, 100);
-    optimize(last ? "final mesh" : "stage " + std::to_string(k + 1) + " of " + std::to_string(st.size()));
-    stage.cells = r_.mesh.num_cells();
-    stage.end_inverted = r_.quality_optimized.inverted_cells;
-    stage.sweeps = r_.smoothing.sweeps;
-    r_.stages.push_back(stage);
-    clock_.stop("optimization");
+    sopt_.max_sweeps = last ? opt_.smoothing.max_sweeps : std::min(opt_.smoothing.max_sweeps, kStageSweeps);
+    begin_optimize();
+    // stop_when_tangled: the final stage pauses once it has had an
+    // intermediate stage's sweeps, if its mesh is still tangled then (resume()
+    // goes on as if it had not: meshopt::smooth_until).
+    if (last && opt_.stop_when_tangled) {
+      advance_optimize(kStageSweeps);
+      if (!run_.finished) {
+        const std::size_t inverted = mesh_quality(r_.mesh, r_.optimized).inverted_cells;
+        if (inverted > 0) {
+          paused_ = stage;
+          paused_inverted_ = inverted;
+          clock_.stop("optimization");
+          return;
+        }
+      }
+    }
+    advance_optimize(sopt_.max_sweeps);
+    end_optimize(last ? "final mesh" : "stage " + std::to_string(k + 1) + " of " + std::to_string(st.size()));
+    end_stage(stage);
   }
+}
+
+void FrontOptimizer::end_stage(FrontStage stage) {
+  stage.cells = r_.mesh.num_cells();
+  stage.end_inverted = r_.quality_optimized.inverted_cells;
+  stage.sweeps = r_.smoothing.sweeps;
+  r_.stages.push_back(stage);
+  clock_.stop("optimization");
+}
+
+void FrontOptimizer::resume() {
+  clock_.restart();  // (a corner trial may have waited since its stages)
+  if (!paused_) return;
+  advance_optimize(sopt_.max_sweeps);
+  end_optimize("final mesh");
+  end_stage(*paused_);
+  paused_.reset();
 }
 
 // ParameterizationOptions::stop_when_tangled, before any repair round.
 void FrontOptimizer::stop_if_tangled() const {
-  if (!opt_.stop_when_tangled || r_.quality_optimized.inverted_cells == 0) return;
-  throw FrontTangled("the optimized T-mesh is tangled after its nested stages (" +
-                     std::to_string(r_.quality_optimized.inverted_cells) + " inverted cells of " +
-                     std::to_string(r_.mesh.num_cells()) + ")");
+  if (!opt_.stop_when_tangled || inverted_cells() == 0) return;
+  throw FrontTangled(
+      "the optimized T-mesh is tangled " +
+      std::string(paused_ ? "100 sweeps into its final stage (" : "after its nested stages (") +
+      std::to_string(inverted_cells()) + " inverted cells of " + std::to_string(r_.mesh.num_cells()) + ")");
 }
 
 // Repair: cells that stay inverted lack interior freedom (typically thin
@@ -302,10 +371,11 @@ FrontRun::FrontRun(FrontRun&&) noexcept = default;
 FrontRun& FrontRun::operator=(FrontRun&&) noexcept = default;
 FrontRun::~FrontRun() = default;
 
-std::size_t FrontRun::inverted_cells() const { return front_->result().quality_optimized.inverted_cells; }
+std::size_t FrontRun::inverted_cells() const { return front_->inverted_cells(); }
 std::size_t FrontRun::cells() const { return front_->result().mesh.num_cells(); }
 
 FrontResult FrontRun::finish() {
+  front_->resume();
   front_->repair();
   FrontResult r = front_->take_result();
   front_.reset();
@@ -316,6 +386,7 @@ FrontResult optimize_front(BoundaryMap boundary, const ParameterizationOptions& 
   FrontOptimizer front(std::move(boundary), options);
   front.run_nested_stages();
   front.stop_if_tangled();
+  front.resume();
   front.repair();
   return front.take_result();
 }

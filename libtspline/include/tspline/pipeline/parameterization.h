@@ -44,11 +44,13 @@ struct ParameterizationOptions {
   /// re-optimize; at most this many rounds (0 disables the repair).
   int max_repair_rounds = 8;
   /// Stop the front half (FrontTangled) where the optimized T-mesh is still
-  /// tangled after its last nested stage, before any repair round; with corner
-  /// trials, only where every trial's is (a trial waits there until one is
-  /// not; then all go on with their repair rounds). A run not stopped so is the
-  /// run without this option, bit for bit. For callers that only want a quick
-  /// answer (auto's single-patch try, domain_parameterization.h).
+  /// tangled after its nested stages, before any repair round; the final
+  /// stage is looked at once it has had an intermediate stage's 100 sweeps
+  /// (if not converged by then). With corner trials, only where every trial's
+  /// is (a trial waits there until one is not; then all go on as they would
+  /// have: meshopt::smooth_until). A run not stopped so is the run without
+  /// this option, bit for bit. For callers that only want a quick answer
+  /// (auto's single-patch try, domain_parameterization.h).
   bool stop_when_tangled = false;
   /// Optimize on a nested sequence of coarser T-meshes first (same final mesh,
   /// far fewer sweeps on fine meshes). false: optimize the final mesh from Coons.

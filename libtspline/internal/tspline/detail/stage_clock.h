@@ -22,6 +22,8 @@ class StageClock {
       if (t.stage == stage) return void(t.seconds += dt);
     times_.push_back({stage, dt});
   }
+  /// Counts from now (time spent waiting elsewhere goes to no stage).
+  void restart() { start_ = std::chrono::steady_clock::now(); }
 
  private:
   std::vector<StageTime>& times_;
