@@ -69,10 +69,6 @@ void refine_below(TMesh& mesh, int level) {
 
 }  // namespace
 
-// Sweeps of an intermediate stage at most (they only provide a start); also
-// where a final stage pauses under stop_when_tangled.
-constexpr int kStageSweeps = 100;
-
 // One run of optimize_front: the result it builds and the options it reads
 // (its own copy: a FrontRun outlives its caller's options).
 class FrontOptimizer {
@@ -86,7 +82,6 @@ class FrontOptimizer {
   void resume();
   void repair();
   void stop_if_tangled() const;
-  bool paused() const { return paused_.has_value(); }
   /// Of the optimized T-mesh: at the pause, if paused.
   std::size_t inverted_cells() const {
     return paused_ ? paused_inverted_ : r_.quality_optimized.inverted_cells;
@@ -113,8 +108,8 @@ class FrontOptimizer {
   meshopt::SmoothingOptions sopt_;
   meshopt::SmoothingProblem problem_;
   meshopt::SmoothingRun run_;
-  // stop_when_tangled: the final stage paused kTangledProbeSweeps in, tangled
-  // (its record, and its inverted cells then).
+  // stop_when_tangled: the final stage paused kIntermediateStageSweeps in,
+  // tangled (its record, and its inverted cells then).
   std::optional<FrontStage> paused_;
   std::size_t paused_inverted_ = 0;
 };
@@ -254,13 +249,13 @@ void FrontOptimizer::run_nested_stages() {
                               (stage.carried ? "Coons " : "carried over ") +
                               std::to_string(*stage.other_start_inverted) + ")");
     // Intermediate stages only provide a start: a bounded number of sweeps.
-    sopt_.max_sweeps = last ? opt_.smoothing.max_sweeps : std::min(opt_.smoothing.max_sweeps, kStageSweeps);
+    sopt_.max_sweeps = last ? opt_.smoothing.max_sweeps : std::min(opt_.smoothing.max_sweeps, kIntermediateStageSweeps);
     begin_optimize();
     // stop_when_tangled: the final stage pauses once it has had an
     // intermediate stage's sweeps, if its mesh is still tangled then (resume()
     // goes on as if it had not: meshopt::smooth_until).
     if (last && opt_.stop_when_tangled) {
-      advance_optimize(kStageSweeps);
+      advance_optimize(kIntermediateStageSweeps);
       if (!run_.finished) {
         const std::size_t inverted = mesh_quality(r_.mesh, r_.optimized).inverted_cells;
         if (inverted > 0) {
@@ -299,7 +294,8 @@ void FrontOptimizer::stop_if_tangled() const {
   if (!opt_.stop_when_tangled || inverted_cells() == 0) return;
   throw FrontTangled(
       "the optimized T-mesh is tangled " +
-      std::string(paused_ ? "100 sweeps into its final stage (" : "after its nested stages (") +
+      (paused_ ? std::to_string(kIntermediateStageSweeps) + " sweeps into its final stage ("
+               : std::string("after its nested stages (")) +
       std::to_string(inverted_cells()) + " inverted cells of " + std::to_string(r_.mesh.num_cells()) + ")");
 }
 

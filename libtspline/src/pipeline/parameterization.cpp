@@ -213,8 +213,8 @@ CornerTrials try_corners(const Polygon& poly, std::vector<Corners> cands, const 
     if (runs[k]) waiting.push_back(k);
   if (!waiting.empty() && !untangled) {
     std::ostringstream s;
-    s << "every corner trial's T-mesh is tangled after its nested stages, at most 100 sweeps into the final "
-         "one (inverted cells:";
+    s << "every corner trial's T-mesh is tangled after its nested stages, at most " << kIntermediateStageSweeps
+      << " sweeps into the final one (inverted cells:";
     for (std::size_t i = 0; i < waiting.size(); ++i)
       s << (i ? ", " : " ") << runs[waiting[i]]->inverted_cells() << " of " << runs[waiting[i]]->cells();
     s << ")";

@@ -157,6 +157,11 @@ double cubic_bspline(const std::array<double, 5>& k, double t, double* d1, doubl
   return n3;
 }
 
+bool cubic_bspline_vanishes(const std::array<double, 5>& k, double t) {
+  return !(t >= k[0] && t <= k[4]) || k[0] == k[4] || (t == k[4] && k[4] != 1.0) ||
+         (t == k[0] && k[3] > k[0]);
+}
+
 TSplineBasis::TSplineBasis(const TMesh& mesh) : mesh_(&mesh) {
   if (!mesh.has_topology()) throw toolkit::InternalError("TSplineBasis: the T-mesh has no topology");
   const RayCaster rays{mesh};
@@ -241,11 +246,6 @@ void TSplineBasis::evaluate(const Eigen::Vector2d& uv, BasisValues& out, int ord
 //   R_i  = (N_i - R S_i) / S
 //   R_ij = (N_ij - R_i S_j - R_j S_i - R S_ij) / S
 // (differentiate N = R S twice: N_ij = R_ij S + R_i S_j + R_j S_i + R S_ij).
-bool cubic_bspline_vanishes(const std::array<double, 5>& k, double t) {
-  return !(t >= k[0] && t <= k[4]) || k[0] == k[4] || (t == k[4] && k[4] != 1.0) ||
-         (t == k[0] && k[3] > k[0]);
-}
-
 void TSplineBasis::evaluate(int c, const Eigen::Vector2d& uv, BasisValues& out, int order) const {
   if (order < 0 || order > 2) throw toolkit::InputError("TSplineBasis::evaluate: order must be 0, 1 or 2");
   const std::vector<int>& ids = cell_functions_.at(static_cast<std::size_t>(c));

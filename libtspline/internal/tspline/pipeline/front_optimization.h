@@ -11,6 +11,10 @@
 
 namespace tspline {
 
+/// Sweeps of an intermediate nested stage at most (they only provide a start);
+/// also where a final stage is looked at under stop_when_tangled.
+inline constexpr int kIntermediateStageSweeps = 100;
+
 /// The T-mesh, Coons start and optimized nodes for `boundary`; the stage
 /// times go to the result's `times`, progress to `options.progress`.
 /// \throw InputError if the domain needs more than `options.max_cells` cells.
