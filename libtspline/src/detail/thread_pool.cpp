@@ -16,6 +16,8 @@ namespace {
 // True on a worker, and on a caller while its own range runs: a nested call
 // must not try the busy lock it may already hold.
 thread_local bool inside_pool = false;
+// Set by SerialRanges: this thread's calls take the busy path.
+thread_local bool serial_ranges = false;
 
 class Pool {
  public:
@@ -122,7 +124,7 @@ void parallel_ranges(std::size_t n, int threads, const std::function<void(std::s
                      std::size_t min_parallel) {
   const int ranges = std::min(threads, pool_threads());
   if (ranges > 1 && n >= min_parallel && !inside_pool) {
-    if (pool().run(n, ranges, body)) return;
+    if (!serial_ranges && pool().run(n, ranges, body)) return;
     // Busy: the same ranges here, in slot order (as the pool's caller, nested
     // calls inside them run as one range).
     const std::size_t chunk = (n + ranges - 1) / ranges;
@@ -139,6 +141,9 @@ void parallel_ranges(std::size_t n, int threads, const std::function<void(std::s
   }
   body(0, n, 0);
 }
+
+SerialRanges::SerialRanges() : previous_(serial_ranges) { serial_ranges = true; }
+SerialRanges::~SerialRanges() { serial_ranges = previous_; }
 
 void parallel_items(std::size_t n, int threads, const std::function<void(std::size_t)>& item,
                     std::size_t min_parallel) {

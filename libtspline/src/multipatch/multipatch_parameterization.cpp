@@ -348,7 +348,12 @@ void for_each_patch(std::size_t n, unsigned threads, const std::function<void(st
   if (k <= 1) work();
   else {
     std::vector<std::thread> pool;
-    for (unsigned t = 0; t < k; ++t) pool.emplace_back(work);
+    // The patches keep the cores busy: a patch's own parallel calls run their
+    // ranges in its thread (the same results) instead of waking pool workers.
+    for (unsigned t = 0; t < k; ++t) pool.emplace_back([&work] {
+        const detail::SerialRanges serial;
+        work();
+      });
     for (std::thread& t : pool) t.join();
   }
   if (error) std::rethrow_exception(error);

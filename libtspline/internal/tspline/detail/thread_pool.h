@@ -43,4 +43,20 @@ void parallel_ranges(std::size_t n, int threads, const std::function<void(std::s
 void parallel_items(std::size_t n, int threads, const std::function<void(std::size_t)>& item,
                     std::size_t min_parallel = 2);
 
+/// While one lives, parallel_ranges calls of this thread run their ranges one
+/// after the other in it (the ranges of a pool call, so the same results):
+/// for threads that are themselves one of several busy workers (the patches
+/// of a layout), where handing a small call's ranges to the pool costs more
+/// than it gains.
+class SerialRanges {
+ public:
+  SerialRanges();
+  ~SerialRanges();
+  SerialRanges(const SerialRanges&) = delete;
+  SerialRanges& operator=(const SerialRanges&) = delete;
+
+ private:
+  bool previous_;
+};
+
 }  // namespace tspline::detail
