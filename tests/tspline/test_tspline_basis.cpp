@@ -9,10 +9,11 @@
 #include <set>
 
 #include "test_support.h"
-
 #include "tspline/errors.h"
-#include "tspline/tmesh/tmesh.h"
+#include "tspline/spline/map_side.h"
 #include "tspline/spline/tspline_basis.h"
+#include "tspline/spline/tspline_map.h"
+#include "tspline/tmesh/tmesh.h"
 
 using tspline::BasisValues;
 using tspline::BlendingFunction;
@@ -210,6 +211,42 @@ TEST_SUITE("tspline_basis") {
         }
     CHECK(points > 100);
     CHECK(zeros > points);  // (most functions of a cell vanish on its edges)
+  }
+
+  TEST_CASE("MapSide gives TSplineMap::point's doubles along each side of the square") {
+    // A T-mesh graded towards the border, with random control points (a
+    // rational map where the functions do not sum to 1): at every knot of a
+    // side, on a fine grid and at random parameters, bit for bit.
+    TMesh m = boundary_mesh(3);
+    const tspline::TSplineMap shape(m);
+    std::mt19937 rng(11);
+    std::uniform_real_distribution<double> jitter(-0.2, 0.2), t01(0.0, 1.0);
+    std::vector<Eigen::Vector2d> P;
+    for (const BlendingFunction& f : shape.basis().functions())
+      P.emplace_back(1e3 + f.interpolation_point.x() + 0.1 * jitter(rng),
+                     -2e3 + f.interpolation_point.y() + 0.1 * jitter(rng));
+    const tspline::TSplineMap map(m, P);
+    std::size_t points = 0;
+    for (int side = 0; side < 4; ++side) {
+      const tspline::MapSide along(map, side);
+      std::vector<double> ts;
+      for (int k = 0; k <= 256; ++k) ts.push_back(k / 256.0);
+      for (int k = 0; k < 200; ++k) ts.push_back(t01(rng));
+      for (const double t : ts) {
+        const Eigen::Vector2d uv = side == 0   ? Eigen::Vector2d(t, 0.0)
+                                   : side == 1 ? Eigen::Vector2d(1.0, t)
+                                   : side == 2 ? Eigen::Vector2d(1.0 - t, 1.0)
+                                               : Eigen::Vector2d(0.0, 1.0 - t);
+        const Eigen::Vector2d a = along.at(t), b = map.point(uv);
+        CAPTURE(side);
+        CAPTURE(t);
+        CHECK(a.x() == b.x());
+        CHECK(a.y() == b.y());
+        ++points;
+      }
+    }
+    CHECK(points == 4 * 457);
+    CHECK_THROWS_AS(tspline::MapSide(map, 4), tspline::InputError);
   }
 
   TEST_CASE("cubic_bspline matches Cox-de Boor, values and derivatives") {

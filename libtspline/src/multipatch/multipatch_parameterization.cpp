@@ -1,7 +1,6 @@
 #include "tspline/multipatch/multipatch_parameterization.h"
 
 #include <Eigen/LU>
-
 #include <algorithm>
 #include <atomic>
 #include <exception>
@@ -11,15 +10,16 @@
 #include <set>
 #include <thread>
 
-#include "tspline/detail/thread_pool.h"
-#include "tspline/multipatch/automatic_cuts.h"
-#include "tspline/spline/bezier_extraction.h"
 #include "tspline/boundary/border_knots.h"
 #include "tspline/boundary/polygon_validation.h"
+#include "tspline/detail/thread_pool.h"
 #include "tspline/errors.h"
+#include "tspline/multipatch/automatic_cuts.h"
+#include "tspline/spline/bezier_extraction.h"
+#include "tspline/spline/map_side.h"
+#include "tspline/spline/tspline_fit.h"
 #include "tspline/validity/map_certification.h"
 #include "tspline/validity/map_quality.h"
-#include "tspline/spline/tspline_fit.h"
 
 namespace tspline {
 
@@ -66,9 +66,10 @@ double interface_gap(const TSplineMap& a, int side_a, const TSplineMap& b, int s
   std::vector<double> t = border_params(a.mesh(), static_cast<Side>(side_a));
   for (double s : border_params(b.mesh(), static_cast<Side>(side_b))) t.push_back(reversed_param(s));
   for (int k = 0; k <= 64; ++k) t.push_back(k / 64.0);
+  // Both sides' points as TSplineMap::point gives them (map_side.h).
+  const MapSide sa(a, side_a), sb(b, side_b);
   double gap = 0.0;
-  for (double s : t)
-    gap = std::max(gap, (a.point(side_point_uv(side_a, s)) - b.point(side_point_uv(side_b, reversed_param(s)))).norm());
+  for (double s : t) gap = std::max(gap, (sa.at(s) - sb.at(reversed_param(s))).norm());
   return gap;
 }
 
