@@ -193,19 +193,35 @@ void FrontOptimizer::run_nested_stages() {
   // The last stage's T-mesh first (milliseconds: a test per cell), so that a
   // tolerance that needs more than max_cells fails at once (refine_to_boundary
   // throws), not after the optimization of every coarser stage.
+  // Its cells also tell which stages are the last one's T-mesh already (a
+  // patch of a layout often has 16 cells at every stage): those are not run,
+  // the last stage gets their sweeps (they would only have optimized its own
+  // mesh, from the same start, in parts).
+  std::size_t last_cells = 0;
   if (st.size() > 1) {
     TMesh last(opt_.initial_level);
     refine_to_boundary(last, r_.boundary, {r_.tolerance_area, opt_.max_level, opt_.max_cells});
+    refine_to_border_params(last, opt_.border_params, opt_.max_level);
+    last_cells = last.num_cells();
   }
+  bool ran = false;  // a stage was optimized (its mesh and positions are r_'s)
+  int skipped_sweeps = 0;
   for (std::size_t k = 0; k < st.size(); ++k) {
     const bool last = k + 1 == st.size();
-    TMesh coarse = k == 0 ? TMesh(st.level[0]) : r_.mesh;
-    if (k == 0) r_.mesh = TMesh(st.level[0]);
+    // (Each stage's T-mesh depends only on its level and tolerance: from the
+    // previous stage's or from the coarsest, it is the same tree.)
+    TMesh coarse = ran ? r_.mesh : TMesh(st.level[0]);
+    if (!ran) r_.mesh = TMesh(st.level[0]);
     refine_below(r_.mesh, st.level[k]);
     const BoundaryRefinementReport rep =
         refine_to_boundary(r_.mesh, r_.boundary, {st.tol[k], opt_.max_level, opt_.max_cells});
     refine_to_border_params(r_.mesh, opt_.border_params, opt_.max_level);
     clock_.stop("tmesh");
+    if (!last && r_.mesh.num_cells() == last_cells) {
+      skipped_sweeps += std::min(opt_.smoothing.max_sweeps, kIntermediateStageSweeps);
+      if (ran) r_.mesh = std::move(coarse);
+      continue;
+    }
     if (last) {
       r_.refinement = rep;
       report_final_tmesh(rep);
@@ -222,7 +238,7 @@ void FrontOptimizer::run_nested_stages() {
     FrontStage stage;
     // (The Coons positions only where they are compared or taken.)
     auto coons_start = [&]() { return last ? r_.coons : coons_positions(r_.mesh, r_.boundary); };
-    if (k > 0) {
+    if (ran) {
       std::vector<Eigen::Vector2d> carried = transfer_positions(coarse, r_.optimized, r_.mesh, r_.boundary);
       stage.start_inverted = mesh_quality(r_.mesh, carried).inverted_cells;
       stage.carried = true;
@@ -242,14 +258,16 @@ void FrontOptimizer::run_nested_stages() {
       r_.optimized = coons_start();
       stage.start_inverted = mesh_quality(r_.mesh, r_.optimized).inverted_cells;
     }
-    if (k > 0 && stage.other_start_inverted)
+    if (ran && stage.other_start_inverted)
       log("optimization", "stage " + std::to_string(k + 1) + " starts from " +
                               (stage.carried ? "the previous stage carried over (" : "Coons (") +
                               std::to_string(stage.start_inverted) + " inverted cells; " +
                               (stage.carried ? "Coons " : "carried over ") +
                               std::to_string(*stage.other_start_inverted) + ")");
     // Intermediate stages only provide a start: a bounded number of sweeps.
-    sopt_.max_sweeps = last ? opt_.smoothing.max_sweeps : std::min(opt_.smoothing.max_sweeps, kIntermediateStageSweeps);
+    sopt_.max_sweeps = last ? opt_.smoothing.max_sweeps + skipped_sweeps
+                            : std::min(opt_.smoothing.max_sweeps, kIntermediateStageSweeps);
+    ran = true;
     begin_optimize();
     // stop_when_tangled: the final stage pauses once it has had an
     // intermediate stage's sweeps, if its mesh is still tangled then (resume()
