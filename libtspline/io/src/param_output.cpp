@@ -1,13 +1,14 @@
 #include "tspline/io/param_output.h"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <filesystem>
 #include <limits>
-#include <map>
-#include <set>
 #include <stdexcept>
+#include <unordered_map>
 #include <utility>
 
 #include "toolkit/io/atomic_file.h"
@@ -77,14 +78,17 @@ toolkit::io::VtuMesh control_net_vtu(const TSplineMap& map) {
   std::vector<int> anchor(mesh.num_vertices(), -1);
   for (int a = 0; a < static_cast<int>(map.basis().size()); ++a)
     if (map.basis().function(a).kind == BlendingFunction::Kind::Anchor) anchor[map.basis().function(a).vertex] = a;
-  std::set<std::pair<int, int>> edges;
+  std::vector<std::pair<int, int>> edges;  // each once, in ascending order
+  edges.reserve(4 * mesh.num_cells());
   for (int c = 0; c < static_cast<int>(mesh.num_cells()); ++c) {
     const std::vector<int> poly = mesh.cell_polygon(c);
     for (std::size_t k = 0; k < poly.size(); ++k) {
       const int u = poly[k], v = poly[(k + 1) % poly.size()];
-      edges.insert({std::min(u, v), std::max(u, v)});
+      edges.push_back({std::min(u, v), std::max(u, v)});
     }
   }
+  std::sort(edges.begin(), edges.end());
+  edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
   for (const auto& [u, v] : edges)
     if (anchor[u] >= 0 && anchor[v] >= 0) out.cells.push_back({anchor[u], anchor[v]});
   for (int a = 0; a < static_cast<int>(map.basis().size()); ++a) {
@@ -110,7 +114,17 @@ toolkit::io::VtuMesh physical_tmesh_vtu(const TSplineMap& map, int k, const MapC
   std::vector<int> vertex;
   // One point per parametric position: a segment is sampled from its
   // lexicographically smaller end, so both cells along it get the same doubles.
-  std::map<std::pair<double, double>, int> index;
+  // (Hashed by the bits of the two doubles, +0 for -0; parametric positions
+  // are finite.)
+  struct UvHash {
+    std::size_t operator()(const std::pair<double, double>& p) const {
+      const std::uint64_t a = std::bit_cast<std::uint64_t>(p.first + 0.0);
+      const std::uint64_t b = std::bit_cast<std::uint64_t>(p.second + 0.0);
+      return static_cast<std::size_t>((a * 0x9E3779B97F4A7C15ull) ^ (b + 0x632BE59BD9B4E019ull + (a << 6) + (a >> 2)));
+    }
+  };
+  std::unordered_map<std::pair<double, double>, int, UvHash> index;
+  index.reserve(static_cast<std::size_t>(nc) * static_cast<std::size_t>(2 * k + 2));
   const BezierExtraction extraction(map.basis());
   CellMapEvaluator cell_map(extraction, map.control_points());
   auto point = [&](const Eigen::Vector2d& uv, int c, int v) {
