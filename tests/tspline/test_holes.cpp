@@ -416,13 +416,14 @@ TEST_SUITE("holes") {
     }
 
     SUBCASE(
-        "report.json comes last: where a file of either lane cannot be written, there is none, nor a "
+        "report.json comes last: where a file of any lane cannot be written, there is none, nor a "
         "temporary") {
       const nlohmann::json report = tspline::io::multipatch_report(R, "plate_with_hole.txt", 0.0);
-      // A directory where the file should go: its rename fails. surface.vtu
-      // is in the lane that does not write report.json, physical_tmesh.vtu in
-      // the one that does.
-      for (const char* blocked : {"surface.vtu", "physical_tmesh.vtu"}) {
+      // A directory where the file should go: its rename fails. One file of
+      // each of the three lanes (physical_tmesh.vtu's lane writes report.json),
+      // and a file after the shared pieces.
+      for (const char* blocked :
+           {"surface.vtu", "surface_bezier.vtu", "physical_tmesh.vtu", "control_net.vtu"}) {
         CAPTURE(blocked);
         const auto dir = test_support::scratch_dir("holes", std::string("blocked_") + blocked);
         std::filesystem::create_directory(dir / blocked);

@@ -1,27 +1,30 @@
 #include "tspline/io/multipatch_output.h"
 
+#include <algorithm>
 #include <array>
+#include <condition_variable>
 #include <exception>
 #include <filesystem>
 #include <fstream>
 #include <functional>
-#include <iomanip>
 #include <future>
-#include <optional>
 #include <initializer_list>
+#include <iomanip>
+#include <mutex>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <string_view>
 #include <type_traits>
 #include <utility>
 
+#include "toolkit/errors.h"
 #include "toolkit/io/atomic_file.h"
 #include "tspline/detail/thread_pool.h"
 #include "tspline/io/front_output.h"
 #include "tspline/io/multipatch_file.h"
-#include "tspline/io/param_output.h"
 #include "tspline/io/output_files.h"
-#include "toolkit/errors.h"
+#include "tspline/io/param_output.h"
 
 namespace tspline::io {
 namespace {
@@ -52,6 +55,77 @@ json whole_map_of(const json& patch_reports) {
     w.push_back(p.contains("jacobian") && p["jacobian"].contains("whole_map") ? p["jacobian"]["whole_map"] : json());
   return combine_whole_map_quality_json(w);
 }
+
+// The pieces of the files made from each patch's Bezier elements
+// (surface.vtu, surface_bezier.vtu, physical_tmesh.vtu), made together: one
+// extraction per patch for all of them. Each file's lane takes its pieces in
+// order (VTK asks for them so); the lane that asks for a piece nobody made
+// yet makes it, for every file. A lane may make a piece only while it is at
+// most `ahead` pieces beyond the slowest lane, so that at most ahead + 1
+// pieces of every file wait in memory (the lanes compress at different
+// speeds). An error in one lane (fail()) stops the others' waits.
+class SharedPieces {
+ public:
+  using Make = std::function<std::vector<toolkit::io::VtuMesh>(int)>;
+  SharedPieces(int pieces, std::size_t files, int ahead, Make make)
+      : made_(static_cast<std::size_t>(pieces)), taken_(files, 0), ahead_(ahead), make_(std::move(make)) {}
+
+  // Piece i of file f (files in make's order); every lane asks for 0, 1, ...
+  toolkit::io::VtuMesh take(std::size_t f, int i) {
+    std::unique_lock<std::mutex> lock(m_);
+    if (i != taken_[f])
+      throw toolkit::InternalError("SharedPieces: piece " + std::to_string(i) + " asked for out of order");
+    for (;;) {
+      if (error_) std::rethrow_exception(error_);
+      Slot& slot = made_[static_cast<std::size_t>(i)];
+      if (slot.ready) {
+        toolkit::io::VtuMesh out = std::move(slot.meshes[f]);
+        slot.meshes[f] = toolkit::io::VtuMesh();
+        ++taken_[f];
+        if (++slot.taken == taken_.size()) slot.meshes.clear(), slot.meshes.shrink_to_fit();
+        changed_.notify_all();
+        return out;
+      }
+      const int slowest = *std::min_element(taken_.begin(), taken_.end());
+      if (!slot.making && i - slowest <= ahead_) {
+        slot.making = true;
+        lock.unlock();
+        std::vector<toolkit::io::VtuMesh> meshes;
+        try {
+          meshes = make_(i);
+        } catch (...) {
+          fail(std::current_exception());
+          throw;
+        }
+        lock.lock();
+        slot.meshes = std::move(meshes);
+        slot.ready = true;
+        continue;
+      }
+      changed_.wait(lock);
+    }
+  }
+
+  void fail(std::exception_ptr e) {
+    std::lock_guard<std::mutex> lock(m_);
+    if (!error_) error_ = e;
+    changed_.notify_all();
+  }
+
+ private:
+  struct Slot {
+    std::vector<toolkit::io::VtuMesh> meshes;
+    bool making = false, ready = false;
+    std::size_t taken = 0;
+  };
+  std::mutex m_;
+  std::condition_variable changed_;
+  std::vector<Slot> made_;
+  std::vector<int> taken_;
+  int ahead_;
+  Make make_;
+  std::exception_ptr error_;
+};
 
 }  // namespace
 
@@ -149,12 +223,11 @@ void write_multipatch_outputs(const MultiPatchResult& R, const std::string& out_
   // never holds a whole file (it held the parts of surface.vtu and its VTK
   // grid at once: 0.7 GiB).
   using Part = std::function<toolkit::io::VtuMesh(std::size_t)>;
+  // Files of one patch's own parts (the others are made from the Bezier
+  // elements: SharedPieces).
   const std::vector<std::pair<std::string_view, Part>> files = {
-      {output_files::kSurface, [&](std::size_t p) { return surface_vtu(*R.patches[p].map, samples); }},
       {output_files::kControlNet, [&](std::size_t p) { return control_net_vtu(*R.patches[p].map); }},
-      {output_files::kBezierSurface, [&](std::size_t p) { return bezier_vtu(R.patches[p]); }},
       {output_files::kBoundary, [&](std::size_t p) { return boundary_vtu(R.patches[p].front.boundary); }},
-      {output_files::kPhysicalTMesh, [&](std::size_t p) { return physical_tmesh_vtu(R.patches[p], samples); }},
       {output_files::kParametricTMesh, [&](std::size_t p) {
          // The patches side by side in the parameter plane.
          const TMesh& mesh = R.patches[p].front.mesh;
@@ -163,6 +236,8 @@ void write_multipatch_outputs(const MultiPatchResult& R, const std::string& out_
            uv[v] = mesh.vertex_param(v) + Eigen::Vector2d(1.25 * static_cast<double>(p), 0.0);
          return tmesh_vtu(mesh, uv);
        }}};
+  const std::array<std::string_view, 3> shared_files = {output_files::kSurface, output_files::kBezierSurface,
+                                                        output_files::kPhysicalTMesh};
   if (piece_cells < 1) throw toolkit::InputError("write_multipatch_outputs: piece_cells must be >= 1");
   std::vector<std::size_t> piece_begin = {0};  // patches [piece_begin[i], piece_begin[i + 1]) make piece i
   for (std::size_t p = 0, cells = 0; p < n; ++p) {
@@ -171,91 +246,124 @@ void write_multipatch_outputs(const MultiPatchResult& R, const std::string& out_
   }
   piece_begin.push_back(n);
   const int pieces = static_cast<int>(piece_begin.size() - 1);
-  // Piece i of file f: the patches' parts on the pool's threads, merged.
-  auto make_piece = [&](std::size_t f, int i) {
+  // The patches [first, first + parts.size()) of piece i merged, patch ids
+  // counted from the first patch of the layout.
+  auto merged = [&](int i, std::vector<toolkit::io::VtuMesh>&& parts) {
     const std::size_t first = piece_begin[static_cast<std::size_t>(i)];
-    std::vector<toolkit::io::VtuMesh> parts(piece_begin[static_cast<std::size_t>(i) + 1] - first);
-    detail::parallel_items(parts.size(), detail::pool_threads(),
-                           [&](std::size_t k) { parts[k] = files[f].second(first + k); });
     toolkit::io::VtuMesh piece = merge_patches(std::move(parts));
     for (int& patch : piece.cell_ints.at("patch")) patch += static_cast<int>(first);
     return piece;
   };
-  // Two lanes of files written at once, each on its own thread (VTK
-  // compresses serially: one lane held a core idle while it compressed the
-  // large surface files; new_caledonia's outputs took 3.5 s so), of about equal
-  // weight: tspline.json and surface.vtu with the small files, and
-  // surface_bezier.vtu with the T-mesh files. In a lane, while VTK compresses
-  // a piece, the next piece (of this file or the lane's next one) is made on
-  // another thread: one piece ahead at most.
-  auto write_lane = [&](const std::vector<std::size_t>& lane, bool with_tspline_file) {
-    if (with_tspline_file)
-      write_multipatch_file((dir / output_files::kTSpline).string(), maps, metas, R.layout.interfaces, R.layout.cuts,
-                            report.value("input", ""), &R.domain);
-    struct Ahead {
-      std::size_t file = 0;
-      int piece = -1;
-      std::future<toolkit::io::VtuMesh> mesh;
-    } ahead;
-    for (std::size_t k = 0; k < lane.size(); ++k) {
-      const std::size_t f = lane[k];
-      toolkit::io::write_vtu_pieces((dir / files[f].first).string(), pieces, [&](int i) {
-        toolkit::io::VtuMesh piece;
-        if (ahead.mesh.valid() && ahead.file == f && ahead.piece == i) piece = ahead.mesh.get();
-        else piece = make_piece(f, i);
-        if (ahead.mesh.valid()) ahead.mesh.wait();  // not the one asked for (VTK asks in order): dropped
-        const bool last = i + 1 == pieces;
-        if (!(last && k + 1 == lane.size())) {
-          ahead.file = last ? lane[k + 1] : f;
-          ahead.piece = last ? 0 : i + 1;
-          ahead.mesh = std::async(std::launch::async, make_piece, ahead.file, ahead.piece);
-        }
-        return piece;
-      });
-    }
-    if (ahead.mesh.valid()) ahead.mesh.get();  // raises its error, if any (none is left unused)
+  auto patches_of = [&](int i) {
+    return piece_begin[static_cast<std::size_t>(i) + 1] - piece_begin[static_cast<std::size_t>(i)];
   };
-  auto lane_of = [&](std::initializer_list<std::string_view> names) {
-    std::vector<std::size_t> lane;
-    for (const std::string_view name : names)
-      for (std::size_t f = 0; f < files.size(); ++f)
-        if (files[f].first == name) lane.push_back(f);
-    return lane;
+  // Piece i of file f: the patches' parts on the pool's threads, merged.
+  auto make_piece = [&](std::size_t f, int i) {
+    const std::size_t first = piece_begin[static_cast<std::size_t>(i)];
+    std::vector<toolkit::io::VtuMesh> parts(patches_of(i));
+    detail::parallel_items(parts.size(), detail::pool_threads(),
+                           [&](std::size_t k) { parts[k] = files[f].second(first + k); });
+    return merged(i, std::move(parts));
+  };
+  // Piece i of the three files made from the Bezier elements: one extraction
+  // per patch (three before: 15 % of Newfoundland's files).
+  SharedPieces shared(pieces, shared_files.size(), 1, [&](int i) {
+    const std::size_t first = piece_begin[static_cast<std::size_t>(i)];
+    const std::size_t m = patches_of(i);
+    std::array<std::vector<toolkit::io::VtuMesh>, 3> parts;
+    for (auto& p : parts) p.resize(m);
+    detail::parallel_items(m, detail::pool_threads(), [&](std::size_t k) {
+      const ParameterizationResult& r = R.patches[first + k];
+      const BezierExtraction extraction(r.map->basis());
+      parts[0][k] = surface_vtu(*r.map, samples, &extraction);
+      parts[1][k] = bezier_vtu(r, &extraction);
+      parts[2][k] = physical_tmesh_vtu(r, samples, &extraction);
+    });
+    std::vector<toolkit::io::VtuMesh> out;
+    for (auto& p : parts) out.push_back(merged(i, std::move(p)));
+    return out;
+  });
+  // Three lanes of files written at once, each on its own thread (VTK
+  // compresses serially), one for each of the shared files, with the small
+  // files after them: the shared pieces are made by whichever lane asks first
+  // and taken by the others. In a lane, while VTK compresses a piece of a file
+  // of its own parts, the next piece of it is made on another thread.
+  auto write_own = [&](std::size_t f) {
+    std::future<toolkit::io::VtuMesh> ahead;
+    int ahead_piece = -1;
+    toolkit::io::write_vtu_pieces((dir / files[f].first).string(), pieces, [&](int i) {
+      toolkit::io::VtuMesh piece;
+      if (ahead.valid() && ahead_piece == i)
+        piece = ahead.get();
+      else
+        piece = make_piece(f, i);
+      if (ahead.valid()) ahead.wait();  // not the one asked for (VTK asks in order): dropped
+      if (i + 1 < pieces) ahead_piece = i + 1, ahead = std::async(std::launch::async, make_piece, f, i + 1);
+      return piece;
+    });
+    if (ahead.valid()) ahead.get();  // raises its error, if any
+  };
+  auto write_lane = [&](std::size_t s, std::initializer_list<std::string_view> own, bool with_tspline_file) {
+    try {
+      if (with_tspline_file)
+        write_multipatch_file((dir / output_files::kTSpline).string(), maps, metas, R.layout.interfaces,
+                              R.layout.cuts, report.value("input", ""), &R.domain);
+      toolkit::io::write_vtu_pieces((dir / shared_files[s]).string(), pieces,
+                                    [&](int i) { return shared.take(s, i); });
+      for (const std::string_view name : own)
+        for (std::size_t f = 0; f < files.size(); ++f)
+          if (files[f].first == name) write_own(f);
+    } catch (...) {
+      shared.fail(std::current_exception());  // (the other lanes stop waiting for this one)
+      throw;
+    }
   };
   // report.json appears last, after every other file, and is streamed: its
   // text whole (92 MB on Newfoundland, and the copy when the string grows) set
   // the run's peak memory, 1,060 MiB against 915 MiB while the other files
-  // were written. The lane of the T-mesh files, which ends first, streams it
-  // to its temporary name while the other lane still writes, and renames it
-  // once that lane has written its files too (if that lane fails, it is
-  // removed): on Newfoundland it took 0.7 s after both lanes.
+  // were written. The lane of physical_tmesh.vtu, which ends first, streams it
+  // to its temporary name while the other lanes still write, and renames it
+  // once they have written their files too (if one fails, it is removed).
   {
     namespace of = output_files;
-    std::promise<void> surface_lane;
-    std::shared_future<void> surface_lane_done = surface_lane.get_future().share();
+    std::promise<void> surface_lane, bezier_lane;
+    std::shared_future<void> surface_done = surface_lane.get_future().share();
+    std::shared_future<void> bezier_done = bezier_lane.get_future().share();
     const std::string report_path = (dir / of::kReport).string();
-    std::future<void> other = std::async(std::launch::async, [&] {
-      write_lane(lane_of({of::kBezierSurface, of::kPhysicalTMesh, of::kParametricTMesh}), false);
+    std::future<void> tmesh = std::async(std::launch::async, [&] {
+      write_lane(2, {of::kParametricTMesh}, false);
       toolkit::io::write_atomic(report_path, [&](const std::string& tmp) {
         std::ofstream out(tmp, std::ios::binary);
         out << std::setw(2) << report << '\n';
         out.close();
         if (!out) throw toolkit::IoError("cannot write " + report_path);
-        surface_lane_done.get();  // (rethrows that lane's error: the temporary file goes)
+        surface_done.get();  // (rethrows that lane's error: the temporary file goes)
+        bezier_done.get();
       });
+    });
+    std::future<void> bezier = std::async(std::launch::async, [&] {
+      try {
+        write_lane(1, {}, false);
+        bezier_lane.set_value();
+      } catch (...) {
+        bezier_lane.set_exception(std::current_exception());
+        throw;
+      }
     });
     std::exception_ptr error;
     try {
-      write_lane(lane_of({of::kSurface, of::kControlNet, of::kBoundary}), true);
+      write_lane(0, {of::kControlNet, of::kBoundary}, true);
       surface_lane.set_value();
     } catch (...) {
       error = std::current_exception();
       surface_lane.set_exception(error);
     }
-    try {
-      other.get();  // waits for the other lane in any case
-    } catch (...) {
-      if (!error) error = std::current_exception();
+    for (std::future<void>* lane : {&bezier, &tmesh}) {
+      try {
+        lane->get();  // waits for the lane in any case
+      } catch (...) {
+        if (!error) error = std::current_exception();
+      }
     }
     if (error) std::rethrow_exception(error);
   }

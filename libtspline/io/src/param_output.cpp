@@ -7,10 +7,12 @@
 #include <cstdio>
 #include <filesystem>
 #include <limits>
+#include <optional>
 #include <stdexcept>
 #include <unordered_map>
 #include <utility>
 
+#include "toolkit/errors.h"
 #include "toolkit/io/atomic_file.h"
 #include "tspline/detail/vtu_fields.h"
 #include "tspline/io/bezier_vtu.h"
@@ -24,7 +26,6 @@
 #include "tspline/validity/map_quality.h"
 #include "tspline/validity/map_quality_bounds.h"
 #include "tspline/validity/map_untangling.h"
-#include "toolkit/errors.h"
 
 namespace tspline {
 
@@ -46,12 +47,14 @@ NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(MapUntanglingReport, free_points, fixed_point
 
 namespace tspline::io {
 
-toolkit::io::VtuMesh surface_vtu(const TSplineMap& map, int k) {
+toolkit::io::VtuMesh surface_vtu(const TSplineMap& map, int k, const BezierExtraction* given) {
   if (k < 1 || k > 64) throw toolkit::InputError("samples per cell edge must be in [1, 64]");
   detail::SampleQualityFields quality;
   quality.reserve(map.mesh().num_cells() * static_cast<std::size_t>((k + 1) * (k + 1)));
   // The samples of a cell from its Bezier elements (element_map.h).
-  const BezierExtraction extraction(map.basis());
+  const std::optional<BezierExtraction> own =
+      given ? std::nullopt : std::optional<BezierExtraction>(std::in_place, map.basis());
+  const BezierExtraction& extraction = given ? *given : *own;
   CellMapEvaluator cell_map(extraction, map.control_points());
   toolkit::io::VtuMesh out = cell_grid_vtu(map.mesh(), k, [&](int c, const Eigen::Vector2d& uv) {
     cell_map.set_cell(c);
@@ -102,7 +105,8 @@ toolkit::io::VtuMesh control_net_vtu(const TSplineMap& map) {
 
 toolkit::io::VtuMesh physical_tmesh_vtu(const TSplineMap& map, int k, const MapCertification* certificate,
                                         const CertificationOptions& options,
-                                        const std::vector<CellMapQuality>* quality) {
+                                        const std::vector<CellMapQuality>* quality,
+                                        const BezierExtraction* given) {
   if (k < 1 || k > 64) throw toolkit::InputError("samples per cell edge must be in [1, 64]");
   const TMesh& mesh = map.mesh();
   const int nc = static_cast<int>(mesh.num_cells());
@@ -125,7 +129,9 @@ toolkit::io::VtuMesh physical_tmesh_vtu(const TSplineMap& map, int k, const MapC
   };
   std::unordered_map<std::pair<double, double>, int, UvHash> index;
   index.reserve(static_cast<std::size_t>(nc) * static_cast<std::size_t>(2 * k + 2));
-  const BezierExtraction extraction(map.basis());
+  const std::optional<BezierExtraction> own =
+      given ? std::nullopt : std::optional<BezierExtraction>(std::in_place, map.basis());
+  const BezierExtraction& extraction = given ? *given : *own;
   CellMapEvaluator cell_map(extraction, map.control_points());
   auto point = [&](const Eigen::Vector2d& uv, int c, int v) {
     const auto [it, added] = index.emplace(std::make_pair(uv.x(), uv.y()), static_cast<int>(out.points.size()));
@@ -191,15 +197,17 @@ toolkit::io::VtuMesh physical_tmesh_vtu(const TSplineMap& map, int k, const MapC
   return out;
 }
 
-toolkit::io::VtuMesh bezier_vtu(const ParameterizationResult& r) {
+toolkit::io::VtuMesh bezier_vtu(const ParameterizationResult& r, const BezierExtraction* extraction) {
   if (!r.map) throw toolkit::InputError("bezier_vtu: the result has no map");
-  return bezier_vtu(*r.map, r.adaptive.certify ? &r.certification : nullptr, r.adaptive.certification);
+  return bezier_vtu(*r.map, r.adaptive.certify ? &r.certification : nullptr, r.adaptive.certification,
+                    extraction);
 }
 
-toolkit::io::VtuMesh physical_tmesh_vtu(const ParameterizationResult& r, int k) {
+toolkit::io::VtuMesh physical_tmesh_vtu(const ParameterizationResult& r, int k,
+                                        const BezierExtraction* extraction) {
   if (!r.map) throw toolkit::InputError("physical_tmesh_vtu: the result has no map");
-  return physical_tmesh_vtu(*r.map, k, r.adaptive.certify ? &r.certification : nullptr, r.adaptive.certification,
-                            &r.cell_quality);
+  return physical_tmesh_vtu(*r.map, k, r.adaptive.certify ? &r.certification : nullptr,
+                            r.adaptive.certification, &r.cell_quality, extraction);
 }
 
 AdaptSeriesWriter::AdaptSeriesWriter(std::string out_dir, int samples) : out_dir_(std::move(out_dir)), samples_(samples) {}

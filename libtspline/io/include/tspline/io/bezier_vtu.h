@@ -24,6 +24,7 @@
 // certified on the element, map_certification.h), parametric_lo and
 // parametric_hi (the element's parametric box).
 #include "toolkit/io/vtu_writer.h"
+#include "tspline/spline/bezier_extraction.h"
 #include "tspline/spline/tspline_map.h"
 #include "tspline/validity/map_certification.h"
 
@@ -38,8 +39,10 @@ int vtk_bezier_quad_index(int i, int j);
 
 /// The cells of `map` as above. `certification`: the map's certificate if
 /// already computed (certify_map on the same map, every failure listed); else
-/// the elements are certified here with `options`.
+/// the elements are certified here with `options`. `extraction`: the map's
+/// Bezier extraction, if made already.
 toolkit::io::VtuMesh bezier_vtu(const TSplineMap& map, const MapCertification* certification = nullptr,
-                                const CertificationOptions& options = {});
+                                const CertificationOptions& options = {},
+                                const BezierExtraction* extraction = nullptr);
 
 }  // namespace tspline::io

@@ -6,17 +6,21 @@
 #include <string>
 #include <vector>
 
+#include "toolkit/io/vtu_writer.h"
 #include "tspline/pipeline/adaptive_parameterization.h"
+#include "tspline/spline/bezier_extraction.h"
 #include "tspline/validity/corner_quality.h"
 #include "tspline/validity/map_quality_bounds.h"
-#include "toolkit/io/vtu_writer.h"
 
 namespace tspline::io {
 
 /// The map sampled on every cell with k x k sub-quads. Point data:
 /// mean_ratio_jacobian (J_r = 2 det J / |J|^2), det_jacobian, scaled_jacobian,
 /// parametric (xi, eta). Cell data: cell (T-mesh cell id), level.
-toolkit::io::VtuMesh surface_vtu(const TSplineMap& map, int samples);
+/// `extraction`: the map's Bezier extraction, if made already (here and in
+/// physical_tmesh_vtu and bezier_vtu: one for all three files of a patch).
+toolkit::io::VtuMesh surface_vtu(const TSplineMap& map, int samples,
+                                 const BezierExtraction* extraction = nullptr);
 
 /// The control points as vertex cells (one per function, first), then the
 /// control net as line cells: T-mesh edges between the anchors of their end
@@ -44,11 +48,13 @@ toolkit::io::VtuMesh control_net_vtu(const TSplineMap& map);
 /// \throw InputError unless 1 <= k <= 64.
 toolkit::io::VtuMesh physical_tmesh_vtu(const TSplineMap& map, int k, const MapCertification* certificate,
                                         const CertificationOptions& options,
-                                        const std::vector<CellMapQuality>* quality);
+                                        const std::vector<CellMapQuality>* quality,
+                                        const BezierExtraction* extraction = nullptr);
 
 /// The same for a result: its map, certificate (if AdaptiveOptions::certify
 /// was on), certification options and per-cell quality.
-toolkit::io::VtuMesh physical_tmesh_vtu(const ParameterizationResult& result, int k);
+toolkit::io::VtuMesh physical_tmesh_vtu(const ParameterizationResult& result, int k,
+                                        const BezierExtraction* extraction = nullptr);
 
 /// Writes adapt/mesh_NNN.vtu (the iteration's T-mesh drawn through its map,
 /// physical_tmesh_vtu without a certificate: `valid` from the cells' quadrature
@@ -110,7 +116,8 @@ nlohmann::json param_report(const ParameterizationResult& result, const std::str
 
 /// The map of a result as Bezier cells (bezier_vtu.h), with the result's
 /// certificate if it was certified.
-toolkit::io::VtuMesh bezier_vtu(const ParameterizationResult& result);
+toolkit::io::VtuMesh bezier_vtu(const ParameterizationResult& result,
+                                const BezierExtraction* extraction = nullptr);
 
 /// Writes parametric_tmesh.vtu, physical_tmesh.vtu (physical_tmesh_vtu with
 /// `samples` segments per cell edge), boundary.vtu, tspline.json, surface.vtu,
