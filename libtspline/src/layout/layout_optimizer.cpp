@@ -169,10 +169,21 @@ LayoutOptimizationReport optimize_layout_nodes(LayoutMesh& m, const LayoutQualit
       for (const auto& [q, j] : t.corners_of(n))
         if (!seen[q]) seen[q] = 1, region.push_back(q);
   }
+  // The worst figures over the region, on the pool's threads (a minimum: the
+  // same in any order; Newfoundland's layout: 5,000 quads before every sweep).
+  const int slots = detail::pool_threads();
   auto worst = [&]() {
+    std::vector<LayoutCornerQuality> part(static_cast<std::size_t>(slots), LayoutCornerQuality{1.0, 1.0});
+    detail::parallel_ranges(region.size(), slots, [&](std::size_t b, std::size_t e, int slot) {
+      LayoutCornerQuality& w = part[static_cast<std::size_t>(slot)];
+      for (std::size_t i = b; i < e; ++i) {
+        const LayoutCornerQuality c = Q.quad(m, t, region[i]);
+        w.mean_ratio = std::min(w.mean_ratio, c.mean_ratio);
+        w.scaled_jacobian = std::min(w.scaled_jacobian, c.scaled_jacobian);
+      }
+    });
     LayoutCornerQuality w{1.0, 1.0};
-    for (const int q : region) {
-      const LayoutCornerQuality c = Q.quad(m, t, q);
+    for (const LayoutCornerQuality& c : part) {
       w.mean_ratio = std::min(w.mean_ratio, c.mean_ratio);
       w.scaled_jacobian = std::min(w.scaled_jacobian, c.scaled_jacobian);
     }
@@ -200,10 +211,13 @@ LayoutOptimizationReport optimize_layout_nodes(LayoutMesh& m, const LayoutQualit
   bool barrier = false;
   auto local = [&](int n) { return layout_node_energy(m, t, Q, n, p, eps_rel, barrier); };
   auto worst_sin = [&]() {
-    double w = 1.0;
-    for (const int q : region)
-      for (int j = 0; j < 4; ++j) w = std::min(w, Q.corner(m, t, q, j).scaled_jacobian);
-    return w;
+    std::vector<double> part(static_cast<std::size_t>(slots), 1.0);
+    detail::parallel_ranges(region.size(), slots, [&](std::size_t b, std::size_t e, int slot) {
+      double& w = part[static_cast<std::size_t>(slot)];
+      for (std::size_t i = b; i < e; ++i)
+        for (int j = 0; j < 4; ++j) w = std::min(w, Q.corner(m, t, region[i], j).scaled_jacobian);
+    });
+    return *std::min_element(part.begin(), part.end());
   };
   // Pattern-search steps of the inner nodes, kept between sweeps.
   std::vector<double> step(n_nodes, 0.0);
