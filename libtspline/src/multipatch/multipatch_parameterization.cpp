@@ -188,13 +188,16 @@ std::size_t equalize_interface_knots(MultiPatchResult& R, const AdaptiveOptions&
     TMesh mesh = r.map->mesh();
     if (refine_to_border_params(mesh, want[p], max_level) == 0) return;
     TSplineMap map = transfer_map(*r.map, std::move(mesh));
-    MapCertification cert = ad.certify ? certify_map(map, ad.certification) : MapCertification{};
+    const BezierExtraction extraction(map.basis());  // (one for the three checks)
+    MapCertification cert =
+        ad.certify ? certify_map(extraction, map.mesh().num_cells(), map.control_points(), ad.certification)
+                   : MapCertification{};
     if (ad.certify && r.certified_valid() && !cert.certified_valid()) return;
     ++count;
     std::vector<CellMapQuality> cells;
-    r.quality = map_quality(map, ad.gauss, &cells);
+    r.quality = map_quality(map, extraction, ad.gauss, &cells);
     r.cell_quality = std::move(cells);
-    r.dense_quality = dense_map_quality(map, ad.dense_samples);
+    r.dense_quality = dense_map_quality(extraction, map.control_points(), ad.dense_samples);
     r.certification = std::move(cert);
     r.front.mesh = map.mesh();
     r.front.optimized.assign(r.front.mesh.num_vertices(), Eigen::Vector2d::Zero());
