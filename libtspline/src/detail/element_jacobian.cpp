@@ -19,7 +19,8 @@ double ElementJacobian::det_param(const BezierElement& e, double s, double t) co
   return numerator(s, t) / (w * w * w * (e.hi.x() - e.lo.x()) * (e.hi.y() - e.lo.y()));
 }
 
-ElementJacobian element_jacobian(const BezierElement& e, const std::vector<Eigen::Vector2d>& P) {
+ElementJacobian element_jacobian(const BezierElement& e, const std::vector<Eigen::Vector2d>& P,
+                                 bool numerator) {
   const Eigen::Index nf = e.C.rows();
   Eigen::Vector2d centre = Eigen::Vector2d::Zero();
   for (Eigen::Index r = 0; r < nf; ++r) centre += P[e.functions[r]];
@@ -36,14 +37,19 @@ ElementJacobian element_jacobian(const BezierElement& e, const std::vector<Eigen
   }
   const BernsteinPoly Xs = bernstein_ds(X), Ys = bernstein_ds(Y), Xt = bernstein_dt(X), Yt = bernstein_dt(Y);
   const BernsteinPoly Ws = bernstein_ds(W), Wt = bernstein_dt(W);
-  // det(X_s, X_t), det(X_s, X), det(X, X_t)
-  const BernsteinPoly d_st = bernstein_axpy(bernstein_product(Xs, Yt), -1.0, bernstein_product(Ys, Xt));
-  const BernsteinPoly d_s0 = bernstein_axpy(bernstein_product(Xs, Y), -1.0, bernstein_product(Ys, X));
-  const BernsteinPoly d_0t = bernstein_axpy(bernstein_product(X, Yt), -1.0, bernstein_product(Y, Xt));
   ElementJacobian J;
   J.weight = W;
-  J.numerator = bernstein_axpy(bernstein_axpy(bernstein_product(W, d_st), -1.0, bernstein_product(Wt, d_s0)),
-                               -1.0, bernstein_product(Ws, d_0t));
+  if (numerator) {
+    // det(X_s, X_t), det(X_s, X), det(X, X_t)
+    const BernsteinPoly d_st = bernstein_axpy(bernstein_product(Xs, Yt), -1.0, bernstein_product(Ys, Xt));
+    const BernsteinPoly d_s0 = bernstein_axpy(bernstein_product(Xs, Y), -1.0, bernstein_product(Ys, X));
+    const BernsteinPoly d_0t = bernstein_axpy(bernstein_product(X, Yt), -1.0, bernstein_product(Y, Xt));
+    J.numerator =
+        bernstein_axpy(bernstein_axpy(bernstein_product(W, d_st), -1.0, bernstein_product(Wt, d_s0)), -1.0,
+                       bernstein_product(Ws, d_0t));
+  } else {
+    J.numerator = BernsteinPoly(0, 0);
+  }
   // |D| <= the same expression with every factor replaced by its largest
   // absolute coefficient (Bernstein coefficients of a product are convex
   // combinations of products of coefficients).

@@ -334,8 +334,9 @@ struct ElementForms {
   std::array<BernsteinPoly, 3> xyw;
 };
 
-ElementForms element_forms(const BezierElement& e, const std::vector<Eigen::Vector2d>& P) {
-  ElementForms f{detail::element_jacobian(e, P),
+ElementForms element_forms(const BezierElement& e, const std::vector<Eigen::Vector2d>& P,
+                           bool numerator = true) {
+  ElementForms f{detail::element_jacobian(e, P, numerator),
                  {BernsteinPoly(3, 3), BernsteinPoly(3, 3), BernsteinPoly(3, 3)}};
   f.xyw[2] = f.J.weight;
   // X, Y relative to the element's mean control point (as element_jacobian:
@@ -360,7 +361,7 @@ double aspect(const BezierElement& e) { return (e.hi.y() - e.lo.y()) / (e.hi.x()
 // bound_element's): into out's `sampled` fields.
 void sample_element(const BezierElement& e, const std::vector<Eigen::Vector2d>& P, const SampleTable& tab,
                     ElementQualityBound& out) {
-  dense_sample(element_forms(e, P).xyw, tab, aspect(e), e, out);
+  dense_sample(element_forms(e, P, false).xyw, tab, aspect(e), e, out);
 }
 
 // The bounds of one element, to the gap (to_gap), or only the cone bound (b)
@@ -371,17 +372,28 @@ ElementQualityBound bound_element(const BezierElement& e, const std::vector<Eige
   ElementQualityBound res;
   const double hx = e.hi.x() - e.lo.x(), hy = e.hi.y() - e.lo.y();
   const double r = aspect(e);
-  const ElementForms forms = element_forms(e, P);
+  // (The cone bound alone needs D's scale, not D: to_gap makes it.)
+  const ElementForms forms = element_forms(e, P, to_gap);
   const detail::ElementJacobian& J = forms.J;
   const std::array<BernsteinPoly, 3>& xyw = forms.xyw;
   const BernsteinPoly& W = xyw[2];
   const BernsteinPoly Ws = bernstein_ds(W), Wt = bernstein_dt(W);
-  // (1): N_s = X_s w - X w_s, N_t = X_t w - X w_t per component.
+  // (1): N_s = X_s w - X w_s, N_t = X_t w - X w_t per component. Where w is
+  // constant (the functions sum to 1 on the element) w_s = w_t = 0: X w_s is
+  // +0 everywhere and subtracting it changes no coefficient, so it is not made.
+  auto zero = [](const BernsteinPoly& f) {
+    for (int k = 0; k < f.size(); ++k)
+      if (f.c[k] != 0.0) return false;
+    return true;
+  };
+  const bool ws_zero = zero(Ws), wt_zero = zero(Wt);
   auto ns = [&](const BernsteinPoly& X) {
-    return bernstein_axpy(bernstein_product(bernstein_ds(X), W), -1.0, bernstein_product(X, Ws));
+    const BernsteinPoly a = bernstein_product(bernstein_ds(X), W);
+    return ws_zero ? a : bernstein_axpy(a, -1.0, bernstein_product(X, Ws));
   };
   auto nt = [&](const BernsteinPoly& X) {
-    return bernstein_axpy(bernstein_product(bernstein_dt(X), W), -1.0, bernstein_product(X, Wt));
+    const BernsteinPoly a = bernstein_product(bernstein_dt(X), W);
+    return wt_zero ? a : bernstein_axpy(a, -1.0, bernstein_product(X, Wt));
   };
   auto sum12 = [](Poly12 x, const Poly12& y) {
     for (int k = 0; k < x.size(); ++k) x.c[k] += y.c[k];

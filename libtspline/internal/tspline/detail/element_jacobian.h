@@ -22,7 +22,10 @@ struct ElementJacobian {
 
 /// D and w for element e of the map with control points P (the control points
 /// are taken relative to their mean on the element: det J is translation
-/// invariant and this avoids cancellation far from the origin).
-ElementJacobian element_jacobian(const BezierElement& e, const std::vector<Eigen::Vector2d>& P);
+/// invariant and this avoids cancellation far from the origin). Without
+/// `numerator`, D is not made (numerator has degree (0,0) and value 0): w and
+/// the scale only, the same doubles.
+ElementJacobian element_jacobian(const BezierElement& e, const std::vector<Eigen::Vector2d>& P,
+                                 bool numerator = true);
 
 }  // namespace tspline::detail
