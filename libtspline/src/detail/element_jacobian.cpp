@@ -39,7 +39,18 @@ ElementJacobian element_jacobian(const BezierElement& e, const std::vector<Eigen
   const BernsteinPoly Ws = bernstein_ds(W), Wt = bernstein_dt(W);
   ElementJacobian J;
   J.weight = W;
-  if (numerator) {
+  auto zero = [](const BernsteinPoly& f) {
+    for (int k = 0; k < f.size(); ++k)
+      if (f.c[k] != 0.0) return false;
+    return true;
+  };
+  if (numerator && zero(Ws) && zero(Wt)) {
+    // w constant (the functions sum to 1 on the element): the products with
+    // w_t and w_s below are +0 in every coefficient, and subtracting them
+    // changes none: D = w det(X_s, X_t), the same doubles.
+    J.numerator =
+        bernstein_product(W, bernstein_axpy(bernstein_product(Xs, Yt), -1.0, bernstein_product(Ys, Xt)));
+  } else if (numerator) {
     // det(X_s, X_t), det(X_s, X), det(X, X_t)
     const BernsteinPoly d_st = bernstein_axpy(bernstein_product(Xs, Yt), -1.0, bernstein_product(Ys, Xt));
     const BernsteinPoly d_s0 = bernstein_axpy(bernstein_product(Xs, Y), -1.0, bernstein_product(Ys, X));
