@@ -1,8 +1,6 @@
 #include "tspline/io/multipatch_output.h"
 
-#include <algorithm>
 #include <array>
-#include <condition_variable>
 #include <exception>
 #include <filesystem>
 #include <fstream>
@@ -10,7 +8,6 @@
 #include <future>
 #include <initializer_list>
 #include <iomanip>
-#include <mutex>
 #include <optional>
 #include <stdexcept>
 #include <string>
@@ -20,6 +17,7 @@
 
 #include "toolkit/errors.h"
 #include "toolkit/io/atomic_file.h"
+#include "tspline/detail/shared_pieces.h"
 #include "tspline/detail/thread_pool.h"
 #include "tspline/io/front_output.h"
 #include "tspline/io/multipatch_file.h"
@@ -55,77 +53,6 @@ json whole_map_of(const json& patch_reports) {
     w.push_back(p.contains("jacobian") && p["jacobian"].contains("whole_map") ? p["jacobian"]["whole_map"] : json());
   return combine_whole_map_quality_json(w);
 }
-
-// The pieces of the files made from each patch's Bezier elements
-// (surface.vtu, surface_bezier.vtu, physical_tmesh.vtu), made together: one
-// extraction per patch for all of them. Each file's lane takes its pieces in
-// order (VTK asks for them so); the lane that asks for a piece nobody made
-// yet makes it, for every file. A lane may make a piece only while it is at
-// most `ahead` pieces beyond the slowest lane, so that at most ahead + 1
-// pieces of every file wait in memory (the lanes compress at different
-// speeds). An error in one lane (fail()) stops the others' waits.
-class SharedPieces {
- public:
-  using Make = std::function<std::vector<toolkit::io::VtuMesh>(int)>;
-  SharedPieces(int pieces, std::size_t files, int ahead, Make make)
-      : made_(static_cast<std::size_t>(pieces)), taken_(files, 0), ahead_(ahead), make_(std::move(make)) {}
-
-  // Piece i of file f (files in make's order); every lane asks for 0, 1, ...
-  toolkit::io::VtuMesh take(std::size_t f, int i) {
-    std::unique_lock<std::mutex> lock(m_);
-    if (i != taken_[f])
-      throw toolkit::InternalError("SharedPieces: piece " + std::to_string(i) + " asked for out of order");
-    for (;;) {
-      if (error_) std::rethrow_exception(error_);
-      Slot& slot = made_[static_cast<std::size_t>(i)];
-      if (slot.ready) {
-        toolkit::io::VtuMesh out = std::move(slot.meshes[f]);
-        slot.meshes[f] = toolkit::io::VtuMesh();
-        ++taken_[f];
-        if (++slot.taken == taken_.size()) slot.meshes.clear(), slot.meshes.shrink_to_fit();
-        changed_.notify_all();
-        return out;
-      }
-      const int slowest = *std::min_element(taken_.begin(), taken_.end());
-      if (!slot.making && i - slowest <= ahead_) {
-        slot.making = true;
-        lock.unlock();
-        std::vector<toolkit::io::VtuMesh> meshes;
-        try {
-          meshes = make_(i);
-        } catch (...) {
-          fail(std::current_exception());
-          throw;
-        }
-        lock.lock();
-        slot.meshes = std::move(meshes);
-        slot.ready = true;
-        continue;
-      }
-      changed_.wait(lock);
-    }
-  }
-
-  void fail(std::exception_ptr e) {
-    std::lock_guard<std::mutex> lock(m_);
-    if (!error_) error_ = e;
-    changed_.notify_all();
-  }
-
- private:
-  struct Slot {
-    std::vector<toolkit::io::VtuMesh> meshes;
-    bool making = false, ready = false;
-    std::size_t taken = 0;
-  };
-  std::mutex m_;
-  std::condition_variable changed_;
-  std::vector<Slot> made_;
-  std::vector<int> taken_;
-  int ahead_;
-  Make make_;
-  std::exception_ptr error_;
-};
 
 }  // namespace
 
@@ -267,7 +194,7 @@ void write_multipatch_outputs(const MultiPatchResult& R, const std::string& out_
   };
   // Piece i of the three files made from the Bezier elements: one extraction
   // per patch (three before: 15 % of Newfoundland's files).
-  SharedPieces shared(pieces, shared_files.size(), 1, [&](int i) {
+  detail::SharedPieces<toolkit::io::VtuMesh> shared(pieces, shared_files.size(), 1, [&](int i) {
     const std::size_t first = piece_begin[static_cast<std::size_t>(i)];
     const std::size_t m = patches_of(i);
     std::array<std::vector<toolkit::io::VtuMesh>, 3> parts;
