@@ -2,7 +2,6 @@
 
 #include <Eigen/LU>
 #include <array>
-#include <optional>
 
 #include "tspline/detail/vtu_fields.h"
 #include "tspline/spline/bezier_extraction.h"
@@ -53,9 +52,8 @@ int vtk_bezier_quad_index(int i, int j) {
 
 toolkit::io::VtuMesh bezier_vtu(const TSplineMap& map, const MapCertification* certification,
                                 const CertificationOptions& options, const BezierExtraction* given) {
-  const std::optional<BezierExtraction> own =
-      given ? std::nullopt : std::optional<BezierExtraction>(std::in_place, map.basis());
-  const BezierExtraction& extraction = given ? *given : *own;
+  const ExtractionOrOwn extraction_or_own(map.basis(), given);
+  const BezierExtraction& extraction = extraction_or_own.get();
   const std::vector<BezierElement>& elements = extraction.elements();
   const std::vector<Eigen::Vector2d>& P = map.control_points();
   const std::vector<int> certified = element_certified(map, extraction, certification, options);

@@ -7,7 +7,6 @@
 #include <cstdio>
 #include <filesystem>
 #include <limits>
-#include <optional>
 #include <stdexcept>
 #include <unordered_map>
 #include <utility>
@@ -52,9 +51,8 @@ toolkit::io::VtuMesh surface_vtu(const TSplineMap& map, int k, const BezierExtra
   detail::SampleQualityFields quality;
   quality.reserve(map.mesh().num_cells() * static_cast<std::size_t>((k + 1) * (k + 1)));
   // The samples of a cell from its Bezier elements (element_map.h).
-  const std::optional<BezierExtraction> own =
-      given ? std::nullopt : std::optional<BezierExtraction>(std::in_place, map.basis());
-  const BezierExtraction& extraction = given ? *given : *own;
+  const ExtractionOrOwn extraction_or_own(map.basis(), given);
+  const BezierExtraction& extraction = extraction_or_own.get();
   CellMapEvaluator cell_map(extraction, map.control_points());
   toolkit::io::VtuMesh out = cell_grid_vtu(map.mesh(), k, [&](int c, const Eigen::Vector2d& uv) {
     cell_map.set_cell(c);
@@ -129,9 +127,8 @@ toolkit::io::VtuMesh physical_tmesh_vtu(const TSplineMap& map, int k, const MapC
   };
   std::unordered_map<std::pair<double, double>, int, UvHash> index;
   index.reserve(static_cast<std::size_t>(nc) * static_cast<std::size_t>(2 * k + 2));
-  const std::optional<BezierExtraction> own =
-      given ? std::nullopt : std::optional<BezierExtraction>(std::in_place, map.basis());
-  const BezierExtraction& extraction = given ? *given : *own;
+  const ExtractionOrOwn extraction_or_own(map.basis(), given);
+  const BezierExtraction& extraction = extraction_or_own.get();
   CellMapEvaluator cell_map(extraction, map.control_points());
   auto point = [&](const Eigen::Vector2d& uv, int c, int v) {
     const auto [it, added] = index.emplace(std::make_pair(uv.x(), uv.y()), static_cast<int>(out.points.size()));

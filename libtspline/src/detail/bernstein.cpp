@@ -69,6 +69,12 @@ double BernsteinPoly::operator()(double s, double t) const {
 // With scaled coefficients a_ij binomial(m1,i) binomial(n1,j) the product is a plain
 // 2-D convolution (the power-basis identity B_i^m1 B_k^m2 =
 // binomial(m1,i) binomial(m2,k) / binomial(m1+m2,i+k) B_{i+k}^{m1+m2}).
+bool BernsteinPoly::is_zero() const {
+  for (int k = 0; k < size(); ++k)
+    if (c[k] != 0.0) return false;
+  return true;
+}
+
 BernsteinPoly bernstein_product(const BernsteinPoly& a, const BernsteinPoly& b) {
   BernsteinPoly r(a.m + b.m, a.n + b.n);
   double sa[(kMax + 1) * (kMax + 1)], sb[(kMax + 1) * (kMax + 1)];

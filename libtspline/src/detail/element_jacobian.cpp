@@ -39,12 +39,7 @@ ElementJacobian element_jacobian(const BezierElement& e, const std::vector<Eigen
   const BernsteinPoly Ws = bernstein_ds(W), Wt = bernstein_dt(W);
   ElementJacobian J;
   J.weight = W;
-  auto zero = [](const BernsteinPoly& f) {
-    for (int k = 0; k < f.size(); ++k)
-      if (f.c[k] != 0.0) return false;
-    return true;
-  };
-  if (numerator && zero(Ws) && zero(Wt)) {
+  if (numerator && Ws.is_zero() && Wt.is_zero()) {
     // w constant (the functions sum to 1 on the element): the products with
     // w_t and w_s below are +0 in every coefficient, and subtracting them
     // changes none: D = w det(X_s, X_t), the same doubles.

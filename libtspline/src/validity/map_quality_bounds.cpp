@@ -381,12 +381,7 @@ ElementQualityBound bound_element(const BezierElement& e, const std::vector<Eige
   // (1): N_s = X_s w - X w_s, N_t = X_t w - X w_t per component. Where w is
   // constant (the functions sum to 1 on the element) w_s = w_t = 0: X w_s is
   // +0 everywhere and subtracting it changes no coefficient, so it is not made.
-  auto zero = [](const BernsteinPoly& f) {
-    for (int k = 0; k < f.size(); ++k)
-      if (f.c[k] != 0.0) return false;
-    return true;
-  };
-  const bool ws_zero = zero(Ws), wt_zero = zero(Wt);
+  const bool ws_zero = Ws.is_zero(), wt_zero = Wt.is_zero();
   auto ns = [&](const BernsteinPoly& X) {
     const BernsteinPoly a = bernstein_product(bernstein_ds(X), W);
     return ws_zero ? a : bernstein_axpy(a, -1.0, bernstein_product(X, Ws));

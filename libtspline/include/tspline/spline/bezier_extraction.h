@@ -20,6 +20,7 @@
 #include <Eigen/Core>
 #include <array>
 #include <cstddef>
+#include <optional>
 #include <vector>
 
 #include "tspline/spline/tspline_basis.h"
@@ -73,6 +74,22 @@ class BezierExtraction {
  private:
   std::vector<BezierElement> elements_;
   std::vector<std::size_t> cell_begin_;
+};
+
+/// A basis's extraction as given, or made here if none is given (for
+/// functions that take an extraction made already by their caller).
+class ExtractionOrOwn {
+ public:
+  ExtractionOrOwn(const TSplineBasis& basis, const BezierExtraction* given)
+      : own_(given ? std::nullopt : std::optional<BezierExtraction>(std::in_place, basis)),
+        extraction_(given ? given : &*own_) {}
+  ExtractionOrOwn(const ExtractionOrOwn&) = delete;
+  ExtractionOrOwn& operator=(const ExtractionOrOwn&) = delete;
+  const BezierExtraction& get() const { return *extraction_; }
+
+ private:
+  std::optional<BezierExtraction> own_;
+  const BezierExtraction* extraction_;
 };
 
 /// A quadrature point of a cell: parametric position and weight (parametric

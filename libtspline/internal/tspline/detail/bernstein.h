@@ -21,6 +21,8 @@ struct BernsteinPoly {
   double at(int i, int j) const { return c[i + (m + 1) * j]; }
   double min_coefficient() const;
   double max_abs_coefficient() const;
+  /// Every coefficient is 0 (+0 or -0).
+  bool is_zero() const;
   /// Direct evaluation (sum of coefficients times basis values).
   double operator()(double s, double t) const;
 };
