@@ -144,8 +144,9 @@ TEST_SUITE("poisson_app") {
     }
     CHECK(!fs::exists(out / "solution" / "step_003.vtu"));
     {
-      // Read back with VTK: 64 analysis cells x 2 x 2 sub-quads (default --samples 2),
-      // u_h - u_exact = error, small at the coarsest step; eta per cell.
+      // Read back with VTK: 64 analysis cells x 2 x 2 sub-quads (default --samples 2)
+      // on the cells' shared grid points, (8 x 2 + 1)^2; u_h - u_exact = error,
+      // small at the coarsest step; eta per cell.
       vtkNew<vtkXMLUnstructuredGridReader> reader;
       reader->SetFileName((out / "solution" / "step_000.vtu").c_str());
       reader->Update();
@@ -153,7 +154,7 @@ TEST_SUITE("poisson_app") {
       vtkUnstructuredGrid* g = reader->GetOutput();
       REQUIRE(g != nullptr);
       CHECK(g->GetNumberOfCells() == 64 * 4);
-      CHECK(g->GetNumberOfPoints() == 64 * 9);
+      CHECK(g->GetNumberOfPoints() == 17 * 17);
       vtkDataArray* uh = g->GetPointData()->GetArray("u_h");
       vtkDataArray* ue = g->GetPointData()->GetArray("u_exact");
       vtkDataArray* er = g->GetPointData()->GetArray("error");

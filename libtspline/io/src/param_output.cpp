@@ -8,11 +8,11 @@
 #include <filesystem>
 #include <limits>
 #include <stdexcept>
-#include <unordered_map>
 #include <utility>
 
 #include "toolkit/errors.h"
 #include "toolkit/io/atomic_file.h"
+#include "tspline/detail/uv_point_index.h"
 #include "tspline/detail/vtu_fields.h"
 #include "tspline/io/bezier_vtu.h"
 #include "tspline/io/cell_grid.h"
@@ -49,7 +49,7 @@ namespace tspline::io {
 toolkit::io::VtuMesh surface_vtu(const TSplineMap& map, int k, const BezierExtraction* given) {
   if (k < 1 || k > 64) throw toolkit::InputError("samples per cell edge must be in [1, 64]");
   detail::SampleQualityFields quality;
-  quality.reserve(map.mesh().num_cells() * static_cast<std::size_t>((k + 1) * (k + 1)));
+  quality.reserve(cell_grid_point_estimate(map.mesh(), k));
   // The samples of a cell from its Bezier elements (element_map.h).
   const ExtractionOrOwn extraction_or_own(map.basis(), given);
   const BezierExtraction& extraction = extraction_or_own.get();
@@ -116,22 +116,12 @@ toolkit::io::VtuMesh physical_tmesh_vtu(const TSplineMap& map, int k, const MapC
   std::vector<int> vertex;
   // One point per parametric position: a segment is sampled from its
   // lexicographically smaller end, so both cells along it get the same doubles.
-  // (Hashed by the bits of the two doubles, +0 for -0; parametric positions
-  // are finite.)
-  struct UvHash {
-    std::size_t operator()(const std::pair<double, double>& p) const {
-      const std::uint64_t a = std::bit_cast<std::uint64_t>(p.first + 0.0);
-      const std::uint64_t b = std::bit_cast<std::uint64_t>(p.second + 0.0);
-      return static_cast<std::size_t>((a * 0x9E3779B97F4A7C15ull) ^ (b + 0x632BE59BD9B4E019ull + (a << 6) + (a >> 2)));
-    }
-  };
-  std::unordered_map<std::pair<double, double>, int, UvHash> index;
-  index.reserve(static_cast<std::size_t>(nc) * static_cast<std::size_t>(2 * k + 2));
+  detail::UvPointIndex index(static_cast<std::size_t>(nc) * static_cast<std::size_t>(2 * k + 2));
   const ExtractionOrOwn extraction_or_own(map.basis(), given);
   const BezierExtraction& extraction = extraction_or_own.get();
   CellMapEvaluator cell_map(extraction, map.control_points());
   auto point = [&](const Eigen::Vector2d& uv, int c, int v) {
-    const auto [it, added] = index.emplace(std::make_pair(uv.x(), uv.y()), static_cast<int>(out.points.size()));
+    const auto [p, added] = index.find_or_add(uv);
     if (added) {
       cell_map.set_cell(c);
       out.points.push_back(cell_map.at(uv).x);
@@ -139,7 +129,7 @@ toolkit::io::VtuMesh physical_tmesh_vtu(const TSplineMap& map, int k, const MapC
                   uv.x() == 0.0 || uv.x() == 1.0 || uv.y() == 0.0 || uv.y() == 1.0);
       vertex.push_back(v);
     }
-    return it->second;
+    return p;
   };
   std::vector<int> level(nc), valid(nc), certified(nc);
   std::vector<double> lower(nc, nan), relative(nc, nan), min_det(nc, nan), min_jr(nc, nan);

@@ -18,10 +18,26 @@ std::pair<std::size_t, double> RingCurve::edge_at(double s) const {
   const double L = length();
   s = std::fmod(s, L);
   if (s < 0.0) s += L;
-  // The edge [i, i+1] with arc(i) <= s < arc(i+1).
+  // The edge [i, i+1] with arc(i) <= s < arc(i+1): that is the edge of this
+  // thread's last call, or one next to it, on most calls (a layout node's
+  // corners look up points near each other); else a binary search.
+  thread_local const RingCurve* last_ring = nullptr;
+  thread_local std::size_t last = 0;
+  if (last_ring == this) {
+    const std::size_t n = v_.size();
+    for (const std::size_t i : {last, last + 1, last + n - 1}) {
+      const std::size_t e = i % n;
+      if (arc_[e] <= s && s < arc_[e + 1]) {
+        last = e;
+        return {e, s};
+      }
+    }
+  }
   const auto it = std::upper_bound(arc_.begin(), arc_.end(), s);
-  const std::size_t i = static_cast<std::size_t>(std::max<std::ptrdiff_t>(0, (it - arc_.begin()) - 1));
-  return {std::min(i, v_.size() - 1), s};
+  const std::size_t i =
+      std::min(static_cast<std::size_t>(std::max<std::ptrdiff_t>(0, (it - arc_.begin()) - 1)), v_.size() - 1);
+  last_ring = this, last = i;
+  return {i, s};
 }
 
 Eigen::Vector2d RingCurve::point(double s_in) const {
