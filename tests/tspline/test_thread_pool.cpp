@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <memory>
 #include <mutex>
 #include <stdexcept>
 #include <thread>
@@ -115,5 +116,38 @@ TEST_SUITE("thread_pool") {
                          std::runtime_error);
     CHECK(started >= 11);
     CHECK(started < 100);
+  }
+
+  TEST_CASE("LentCore: where the cores lent leave the pool one, the same ranges run in the caller") {
+    const int threads = tspline::detail::pool_threads();
+    const std::size_t n = 1001;
+    const std::vector<Range> free_pool = ranges_seen(n);
+    auto run = [&](std::vector<std::thread::id>& ran_on) {
+      std::mutex m;
+      std::vector<Range> seen;
+      tspline::detail::parallel_ranges(n, threads, [&](std::size_t b, std::size_t e, int slot) {
+        std::lock_guard<std::mutex> lock(m);
+        seen.emplace_back(b, e, slot);
+        ran_on.push_back(std::this_thread::get_id());
+      });
+      return seen;
+    };
+    const std::thread::id me = std::this_thread::get_id();
+    {
+      // All but one of the pool's cores lent: the caller runs every range.
+      std::vector<std::unique_ptr<tspline::detail::LentCore>> lent;
+      for (int k = 0; k + 1 < threads; ++k) lent.push_back(std::make_unique<tspline::detail::LentCore>());
+      std::vector<std::thread::id> ran_on;
+      CHECK(run(ran_on) == free_pool);  // in slot order, one after the other
+      for (const auto& id : ran_on) CHECK(id == me);
+    }
+    // Given back: the pool's threads again (the ranges the same).
+    std::vector<std::thread::id> ran_on;
+    std::vector<Range> again = run(ran_on);
+    std::sort(again.begin(), again.end(),
+              [](const Range& a, const Range& b) { return std::get<2>(a) < std::get<2>(b); });
+    CHECK(again == free_pool);
+    if (threads >= 2)
+      CHECK(std::any_of(ran_on.begin(), ran_on.end(), [&](const auto& id) { return id != me; }));
   }
 }

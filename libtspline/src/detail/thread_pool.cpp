@@ -18,6 +18,8 @@ namespace {
 thread_local bool inside_pool = false;
 // Set by SerialRanges: this thread's calls take the busy path.
 thread_local bool serial_ranges = false;
+// Cores busy outside the pool (LentCore).
+std::atomic<int> cores_lent{0};
 
 class Pool {
  public:
@@ -124,7 +126,8 @@ void parallel_ranges(std::size_t n, int threads, const std::function<void(std::s
                      std::size_t min_parallel) {
   const int ranges = std::min(threads, pool_threads());
   if (ranges > 1 && n >= min_parallel && !inside_pool) {
-    if (!serial_ranges && pool().run(n, ranges, body)) return;
+    const bool one_core_left = pool_threads() - cores_lent.load(std::memory_order_relaxed) <= 1;
+    if (!serial_ranges && !one_core_left && pool().run(n, ranges, body)) return;
     // Busy: the same ranges here, in slot order (as the pool's caller, nested
     // calls inside them run as one range).
     const std::size_t chunk = (n + ranges - 1) / ranges;
@@ -143,6 +146,8 @@ void parallel_ranges(std::size_t n, int threads, const std::function<void(std::s
 }
 
 SerialRanges::SerialRanges() : previous_(serial_ranges) { serial_ranges = true; }
+LentCore::LentCore() { cores_lent.fetch_add(1, std::memory_order_relaxed); }
+LentCore::~LentCore() { cores_lent.fetch_sub(1, std::memory_order_relaxed); }
 SerialRanges::~SerialRanges() { serial_ranges = previous_; }
 
 void parallel_items(std::size_t n, int threads, const std::function<void(std::size_t)>& item,

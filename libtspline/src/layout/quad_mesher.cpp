@@ -1,19 +1,21 @@
 #include "tspline/layout/quad_mesher.h"
 
+#include <fcntl.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
 #include <algorithm>
-#include <cmath>
-#include <mutex>
-#include <exception>
-#include <iostream>
 #include <cerrno>
+#include <cmath>
 #include <cstdint>
 #include <cstdlib>
-#include <sys/wait.h>
-#include <fcntl.h>
-#include <unistd.h>
+#include <exception>
+#include <iostream>
+#include <mutex>
 #include <string>
 #include <unordered_map>
 
+#include "tspline/detail/thread_pool.h"
 #include "tspline/errors.h"
 
 #ifdef TSPLINE_HAVE_GMSH
@@ -211,6 +213,9 @@ bool read_vector(int fd, std::vector<T>& v) {
 PlanarQuadMesh quad_mesh(const std::vector<std::vector<Eigen::Vector2d>>& rings,
                          const std::function<double(const Eigen::Vector2d&)>& size) {
   std::lock_guard<std::mutex> lock(gmsh_mutex);
+  // The mesher keeps a core busy (here, or in its child) while this thread
+  // waits: the pool's callers meanwhile leave it that core.
+  const detail::LentCore lent;
 #if defined(__SANITIZE_ADDRESS__)
   return quad_mesh_here(rings, size);
 #endif

@@ -59,4 +59,18 @@ class SerialRanges {
   bool previous_;
 };
 
+/// While one lives, a core is counted as busy outside the pool (a child
+/// process at work, such as the quad mesher's): where that leaves the pool
+/// one thread, parallel_ranges calls run their ranges one after the other in
+/// the caller (the same ranges, so the same results), instead of two threads
+/// sharing the one core left with the child. (Newfoundland: the mesher waited
+/// for a core while auto's single-patch try ran on two.)
+class LentCore {
+ public:
+  LentCore();
+  ~LentCore();
+  LentCore(const LentCore&) = delete;
+  LentCore& operator=(const LentCore&) = delete;
+};
+
 }  // namespace tspline::detail
