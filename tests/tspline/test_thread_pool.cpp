@@ -150,4 +150,29 @@ TEST_SUITE("thread_pool") {
     if (threads >= 2)
       CHECK(std::any_of(ran_on.begin(), ran_on.end(), [&](const auto& id) { return id != me; }));
   }
+
+  TEST_CASE(
+      "wait_while_one_core_left: returns when the lent cores are given back, or at once when stop() holds") {
+    const int threads = tspline::detail::pool_threads();
+    CHECK(!tspline::detail::one_core_left());
+    tspline::detail::wait_while_one_core_left([] { return false; });  // nothing lent: returns at once
+    std::atomic<bool> returned{false};
+    std::thread waiter;
+    {
+      std::vector<std::unique_ptr<tspline::detail::LentCore>> lent;
+      for (int k = 0; k < std::max(1, threads - 1); ++k)
+        lent.push_back(std::make_unique<tspline::detail::LentCore>());
+      CHECK(tspline::detail::one_core_left());
+      tspline::detail::wait_while_one_core_left([] { return true; });  // stop(): returns at once
+      waiter = std::thread([&] {
+        tspline::detail::wait_while_one_core_left([] { return false; });
+        returned = true;
+      });
+      std::this_thread::sleep_for(std::chrono::milliseconds(30));
+      CHECK(!returned);  // still lent
+    }
+    waiter.join();  // returns once the last LentCore has ended
+    CHECK(returned);
+    CHECK(!tspline::detail::one_core_left());
+  }
 }

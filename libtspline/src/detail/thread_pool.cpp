@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <chrono>
 #include <condition_variable>
 #include <exception>
 #include <mutex>
@@ -18,8 +19,10 @@ namespace {
 thread_local bool inside_pool = false;
 // Set by SerialRanges: this thread's calls take the busy path.
 thread_local bool serial_ranges = false;
-// Cores busy outside the pool (LentCore).
+// Cores busy outside the pool (LentCore), and what wait_while_one_core_left waits on.
 std::atomic<int> cores_lent{0};
+std::mutex lent_mutex;
+std::condition_variable lent_returned;
 
 class Pool {
  public:
@@ -126,8 +129,7 @@ void parallel_ranges(std::size_t n, int threads, const std::function<void(std::s
                      std::size_t min_parallel) {
   const int ranges = std::min(threads, pool_threads());
   if (ranges > 1 && n >= min_parallel && !inside_pool) {
-    const bool one_core_left = pool_threads() - cores_lent.load(std::memory_order_relaxed) <= 1;
-    if (!serial_ranges && !one_core_left && pool().run(n, ranges, body)) return;
+    if (!serial_ranges && !one_core_left() && pool().run(n, ranges, body)) return;
     // Busy: the same ranges here, in slot order (as the pool's caller, nested
     // calls inside them run as one range).
     const std::size_t chunk = (n + ranges - 1) / ranges;
@@ -146,8 +148,21 @@ void parallel_ranges(std::size_t n, int threads, const std::function<void(std::s
 }
 
 SerialRanges::SerialRanges() : previous_(serial_ranges) { serial_ranges = true; }
-LentCore::LentCore() { cores_lent.fetch_add(1, std::memory_order_relaxed); }
-LentCore::~LentCore() { cores_lent.fetch_sub(1, std::memory_order_relaxed); }
+LentCore::LentCore() { cores_lent.fetch_add(1); }
+LentCore::~LentCore() {
+  {
+    const std::lock_guard<std::mutex> lock(lent_mutex);
+    cores_lent.fetch_sub(1);
+  }
+  lent_returned.notify_all();
+}
+
+bool one_core_left() { return cores_lent.load() > 0 && pool_threads() - cores_lent.load() <= 1; }
+
+void wait_while_one_core_left(const std::function<bool()>& stop) {
+  std::unique_lock<std::mutex> lock(lent_mutex);
+  while (one_core_left() && !stop()) lent_returned.wait_for(lock, std::chrono::milliseconds(5));
+}
 SerialRanges::~SerialRanges() { serial_ranges = previous_; }
 
 void parallel_items(std::size_t n, int threads, const std::function<void(std::size_t)>& item,

@@ -32,8 +32,13 @@ void for_each_concurrently(std::size_t n, Body&& body) {
   std::atomic<std::size_t> next{0};
   std::atomic<bool> failed{false};
   std::vector<std::exception_ptr> errors(n);
-  auto work = [&] {
-    for (std::size_t k; !failed && (k = next.fetch_add(1)) < n;) {
+  // The extra threads take no item while a core is lent to the quad mesher
+  // and one is left (detail::LentCore): the calling thread goes on alone.
+  // The items are independent, so neither matters to the results.
+  auto work = [&](bool extra) {
+    for (std::size_t k;;) {
+      if (extra) detail::wait_while_one_core_left([&] { return failed || next >= n; });
+      if (failed || (k = next.fetch_add(1)) >= n) break;
       try {
         body(k);
       } catch (...) {
@@ -43,8 +48,8 @@ void for_each_concurrently(std::size_t n, Body&& body) {
     }
   };
   std::vector<std::thread> pool;
-  for (std::size_t t = 1; t < threads; ++t) pool.emplace_back(work);
-  work();
+  for (std::size_t t = 1; t < threads; ++t) pool.emplace_back(work, true);
+  work(false);
   for (std::thread& t : pool) t.join();
   for (const std::exception_ptr& e : errors)
     if (e) std::rethrow_exception(e);

@@ -73,4 +73,13 @@ class LentCore {
   LentCore& operator=(const LentCore&) = delete;
 };
 
+/// Whether the cores lent (LentCore) leave the pool at most one.
+bool one_core_left();
+
+/// Blocks while one_core_left() and not stop(): for a thread of one's own
+/// (one of several working through independent items) that should not share
+/// the last core with a lent one. Woken when a LentCore ends; stop() is read
+/// again every few milliseconds.
+void wait_while_one_core_left(const std::function<bool()>& stop);
+
 }  // namespace tspline::detail
