@@ -3,7 +3,7 @@
 # Needs root (or sudo) only when something must be installed.
 set -euo pipefail
 PACKAGES=(build-essential cmake ninja-build pkg-config libeigen3-dev libcgal-dev libgmp-dev libmpfr-dev libceres-dev
-          libvtk9-dev libdeflate-dev doctest-dev nlohmann-json3-dev libcli11-dev
+          libvtk9-dev libdeflate-dev libgoogle-perftools-dev doctest-dev nlohmann-json3-dev libcli11-dev
           libmuparser-dev libsuitesparse-dev libgmsh-dev gmsh libpetsc-real-dev openmpi-bin
           libgdal-dev libcairo2-dev fonts-dejavu-core
           pybind11-dev python3-dev python3-numpy python3-pytest python3-shapely python3-vtk9
