@@ -29,7 +29,7 @@ void TSplineMap::set_control_points(std::vector<Eigen::Vector2d> control_points)
 
 TSplineMap::TSplineMap(const TSplineMap& o)
     : mesh_(std::make_unique<TMesh>(*o.mesh_)),
-      basis_(std::make_unique<TSplineBasis>(*mesh_)),
+      basis_(std::make_unique<TSplineBasis>(*o.basis_, *mesh_)),
       control_points_(o.control_points_) {}
 
 TSplineMap& TSplineMap::operator=(const TSplineMap& o) {

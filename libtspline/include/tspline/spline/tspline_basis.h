@@ -73,6 +73,10 @@ class TSplineBasis {
  public:
   /// \pre mesh.has_topology().
   explicit TSplineBasis(const TMesh& mesh);
+  /// The basis of `mesh`, a copy of other's mesh: other's functions, copied
+  /// instead of made again (what TSplineBasis(mesh) would make).
+  TSplineBasis(const TSplineBasis& other, const TMesh& mesh)
+      : mesh_(&mesh), functions_(other.functions_), cell_functions_(other.cell_functions_) {}
 
   std::size_t size() const { return functions_.size(); }
   const BlendingFunction& function(int a) const { return functions_[a]; }
