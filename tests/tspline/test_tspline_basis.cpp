@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
+#include <optional>
 #include <random>
 #include <set>
 
@@ -247,6 +248,31 @@ TEST_SUITE("tspline_basis") {
     }
     CHECK(points == 4 * 457);
     CHECK_THROWS_AS(tspline::MapSide(map, 4), tspline::InputError);
+  }
+
+  TEST_CASE("a copied map's basis is the basis of its own T-mesh, the same as one made from it") {
+    TMesh m = boundary_mesh(3);
+    const tspline::TSplineMap shape(m);
+    std::vector<Eigen::Vector2d> P;
+    for (const BlendingFunction& f : shape.basis().functions())
+      P.emplace_back(f.interpolation_point.x() + 0.05 * f.interpolation_point.y(), f.interpolation_point.y());
+    std::optional<tspline::TSplineMap> original(std::in_place, m, P);
+    const tspline::TSplineMap copy(*original);
+    const tspline::TSplineBasis made(copy.mesh());  // made afresh from the copy's T-mesh
+    CHECK(&copy.basis().mesh() == &copy.mesh());
+    REQUIRE(copy.basis().size() == made.size());
+    for (int a = 0; a < static_cast<int>(made.size()); ++a) {
+      CHECK(copy.basis().function(a).knots_xi == made.function(a).knots_xi);
+      CHECK(copy.basis().function(a).knots_eta == made.function(a).knots_eta);
+      CHECK(copy.basis().function(a).vertex == made.function(a).vertex);
+    }
+    for (int c = 0; c < static_cast<int>(copy.mesh().num_cells()); ++c)
+      CHECK(copy.basis().functions_on_cell(c) == made.functions_on_cell(c));
+    // The original gone, the copy evaluates as it did (nothing points into the original).
+    const Eigen::Vector2d uv(0.3, 0.7);
+    const Eigen::Vector2d before = original->point(uv);
+    original.reset();
+    CHECK(copy.point(uv) == before);
   }
 
   TEST_CASE("cubic_bspline matches Cox-de Boor, values and derivatives") {
