@@ -15,7 +15,7 @@ namespace {
 // Arc length from a to b going in direction dir on a ring of length L, in [0, L).
 double arc_between(double a, double b, double dir, double L) {
   double d = dir > 0.0 ? b - a : a - b;
-  d = std::fmod(d, L);
+  d = arc_mod(d, L);
   return d < 0.0 ? d + L : d;
 }
 
@@ -145,7 +145,7 @@ LayoutQuality::SideVertices LayoutQuality::side_vertices(const LayoutMesh& m, co
   const double len = side_length(m, t, q, j);
   // The side covers arc lengths (start, start + len) going forward.
   double start = rings_.direction(r) > 0.0 ? m.arc[a] : m.arc[b];
-  start = std::fmod(start, c.length());
+  start = arc_mod(start, c.length());
   if (start < 0.0) start += c.length();
   const std::size_t i0 = c.first_vertex_after(start);
   // The first vertex at or past start + len, by binary search on the doubled

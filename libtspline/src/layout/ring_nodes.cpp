@@ -16,7 +16,7 @@ RingCurve::RingCurve(const std::vector<Eigen::Vector2d>& vertices) : v_(vertices
 
 std::pair<std::size_t, double> RingCurve::edge_at(double s) const {
   const double L = length();
-  s = std::fmod(s, L);
+  s = arc_mod(s, L);
   if (s < 0.0) s += L;
   // The edge [i, i+1] with arc(i) <= s < arc(i+1): that is the edge of this
   // thread's last call, or one next to it, on most calls (a layout node's
@@ -73,7 +73,7 @@ double RingCurve::turn(std::size_t i) const {
 
 std::size_t RingCurve::first_vertex_after(double s) const {
   const double L = length();
-  s = std::fmod(s, L);
+  s = arc_mod(s, L);
   if (s < 0.0) s += L;
   return static_cast<std::size_t>(std::upper_bound(arc_.begin(), arc_.end() - 1, s) - arc_.begin());
 }

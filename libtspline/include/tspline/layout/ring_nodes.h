@@ -15,6 +15,7 @@
 // features smaller than `min_size` are not resolved: they stay inside one
 // side and the patch's T-mesh follows them.
 #include <Eigen/Core>
+#include <cmath>
 #include <cstddef>
 #include <functional>
 #include <utility>
@@ -23,6 +24,10 @@
 #include "tspline/boundary/domain.h"
 
 namespace tspline {
+
+/// std::fmod(s, length), without its division where s lies in [0, length)
+/// already (then fmod returns s itself): ring arc lengths mostly do.
+inline double arc_mod(double s, double length) { return s >= 0.0 && s < length ? s : std::fmod(s, length); }
 
 /// Arc-length parameterization of one closed ring (a validated, CCW ring).
 class RingCurve {
