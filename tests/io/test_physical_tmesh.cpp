@@ -2,34 +2,23 @@
 // data what the certificate says (param_output.h), read back with VTK.
 #include <doctest/doctest.h>
 
-#include <cmath>
 #include <algorithm>
+#include <cmath>
 #include <cstddef>
 #include <filesystem>
-#include <string>
 #include <stdexcept>
+#include <string>
 #include <vector>
 
+#include "coastline_maps.h"
 #include "test_support.h"
 #include "toolkit/io/vtu_reader.h"
 #include "tspline/io/front_output.h"
 #include "tspline/io/param_output.h"
-#include "tspline/io/polygon_reader.h"
-#include "tspline/pipeline/adaptive_parameterization.h"
-
-namespace {
-
-tspline::ParameterizationResult isle_of_man() {
-  const tspline::Polygon p =
-      tspline::io::read_polygon(std::string(TSPLINE_TEST_DATA_DIR) + "/coastlines/isle_of_man.txt");
-  return tspline::run_parameterization(p, {}, {});
-}
-
-}  // namespace
 
 TEST_SUITE("physical_tmesh") {
   TEST_CASE("a certified map: every cell drawn through the map, none flagged invalid, one VTK cell per T-mesh cell") {
-    const tspline::ParameterizationResult r = isle_of_man();
+    const tspline::ParameterizationResult r = test_support::isle_of_man_map();
     REQUIRE(r.map);
     REQUIRE(r.certified_valid());
     const tspline::TMesh& mesh = r.map->mesh();
@@ -83,7 +72,7 @@ TEST_SUITE("physical_tmesh") {
   }
 
   TEST_CASE("without a certificate: valid from the quadrature points, certified -1, bounds NaN") {
-    const tspline::ParameterizationResult r = isle_of_man();
+    const tspline::ParameterizationResult r = test_support::isle_of_man_map();
     REQUIRE(r.map);
     const std::size_t nc = r.map->mesh().num_cells();
     const toolkit::io::VtuMesh q = tspline::io::physical_tmesh_vtu(*r.map, 2, nullptr, {}, &r.cell_quality);

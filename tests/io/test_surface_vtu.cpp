@@ -12,26 +12,15 @@
 #include <utility>
 #include <vector>
 
+#include "coastline_maps.h"
 #include "tspline/io/cell_grid.h"
 #include "tspline/io/param_output.h"
-#include "tspline/io/polygon_reader.h"
-#include "tspline/pipeline/adaptive_parameterization.h"
 #include "tspline/validity/map_quality.h"
-
-namespace {
-
-tspline::ParameterizationResult isle_of_man() {
-  const tspline::Polygon p =
-      tspline::io::read_polygon(std::string(TSPLINE_TEST_DATA_DIR) + "/coastlines/isle_of_man.txt");
-  return tspline::run_parameterization(p, {}, {});
-}
-
-}  // namespace
 
 TEST_SUITE("surface_vtu") {
   TEST_CASE(
       "one point per parametric grid position, each the map's image there, the quads on their cells' grids") {
-    const tspline::ParameterizationResult r = isle_of_man();
+    const tspline::ParameterizationResult r = test_support::isle_of_man_map();
     REQUIRE(r.map);
     const tspline::TMesh& mesh = r.map->mesh();
     REQUIRE(mesh.num_cells() > 100);
@@ -92,7 +81,7 @@ TEST_SUITE("surface_vtu") {
   }
 
   TEST_CASE("cell_grid_vtu samples each point once, in the order of its first cell") {
-    const tspline::ParameterizationResult r = isle_of_man();
+    const tspline::ParameterizationResult r = test_support::isle_of_man_map();
     REQUIRE(r.map);
     const tspline::TMesh& mesh = r.map->mesh();
     std::vector<std::pair<int, Eigen::Vector2d>> calls;
