@@ -10,19 +10,15 @@
 
 #include <algorithm>
 #include <atomic>
-#include <cctype>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
-#include <fstream>
 #include <memory>
 #include <mutex>
-#include <sstream>
 
 #include "tspline/boundary/plane.h"
 #include "tspline/detail/gis_backend.h"
 #include "tspline/errors.h"
-#include "tspline/io/polygon_reader.h"
 
 namespace tspline::io {
 namespace {
