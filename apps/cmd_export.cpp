@@ -16,6 +16,7 @@
 #include "tspline/io/multipatch_file.h"
 #include "tspline/io/multipatch_output.h"
 #include "tspline/io/tspline_file.h"
+#include "vtu_compression_option.h"
 
 namespace tspline_app {
 
@@ -23,6 +24,7 @@ namespace {
 
 struct ExportArgs {
   std::string file, bezier, msh, vtk_bezier;
+  toolkit::io::VtuCompression vtu_compression = toolkit::io::VtuCompression::LZ4;
   bool quiet = false;
 };
 
@@ -34,7 +36,7 @@ void export_vtk_bezier(const tspline::io::LoadedMaps& maps, const ExportArgs& a)
   std::vector<toolkit::io::VtuMesh> parts;
   for (const tspline::io::LoadedTSpline& t : maps.patches) parts.push_back(tspline::io::bezier_vtu(t.map));
   const toolkit::io::VtuMesh cells = tspline::io::merge_patches(parts);
-  toolkit::io::write_vtu(a.vtk_bezier, cells);
+  toolkit::io::write_vtu(a.vtk_bezier, cells, a.vtu_compression);
   if (!a.quiet)
     std::cout << "wrote " << a.vtk_bezier << ": " << cells.cells.size()
               << " rational bicubic Bezier cells (VTK_BEZIER_QUADRILATERAL) on " << maps.patches.size()
@@ -93,6 +95,7 @@ void add_export_command(CLI::App& app, CommandAction& action) {
   cmd->add_option("--vtk-bezier", a->vtk_bezier,
                   "Output VTK file (.vtu) for ParaView: the map exactly, one rational bicubic Bezier cell "
                   "(VTK_BEZIER_QUADRILATERAL) per Bezier element, with J_r, det J and the certificate");
+  add_vtu_compression_option(cmd, a->vtu_compression);
   cmd->add_flag("--quiet,-q", a->quiet, "Print errors only");
   cmd->callback([a, &action] {
     if (a->bezier.empty() && a->msh.empty() && a->vtk_bezier.empty())

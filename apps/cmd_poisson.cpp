@@ -28,19 +28,20 @@
 
 #include "commands.h"
 #include "exit_codes.h"
-#include "progress.h"
 #include "expression.h"
-#include "tspline/errors.h"
+#include "petsc_session.h"
+#include "progress.h"
 #include "toolkit/io/atomic_file.h"
+#include "toolkit/io/vtu_writer.h"
+#include "toolkit/timing.h"
+#include "tspline/analysis/poisson.h"
+#include "tspline/errors.h"
+#include "tspline/io/multipatch_file.h"
 #include "tspline/io/output_files.h"
 #include "tspline/io/poisson_output.h"
-#include "tspline/io/multipatch_file.h"
 #include "tspline/io/tspline_file.h"
-#include "toolkit/io/vtu_writer.h"
-#include "petsc_session.h"
 #include "tspline/petsc_solver.h"
-#include "tspline/analysis/poisson.h"
-#include "toolkit/timing.h"
+#include "vtu_compression_option.h"
 
 namespace tspline_app {
 
@@ -85,6 +86,7 @@ struct PoissonArgs {
   double gamma = 0.5;
   std::size_t max_dofs = 200000;
   int samples = 2;
+  toolkit::io::VtuCompression vtu_compression = toolkit::io::VtuCompression::LZ4;
   bool quiet = false;
   bool json = false;
   CLI::Option *f_opt = nullptr, *g_opt = nullptr, *exact_opt = nullptr, *problem_opt = nullptr;
@@ -245,7 +247,8 @@ int run_poisson_process(const PoissonArgs& args, const PetscSession& session,
       {"quadrature", {{"assembly", "4x4 Gauss"}, {"errors", "6x6 Gauss"}, {"estimator", "4x4 Gauss"}}}};
   report["options"]["processes"] = session.size();
   Progress progress(root ? output_mode(args.quiet, args.json) : OutputMode::Quiet);
-  tspline::io::PoissonOutputWriter output(args.out_dir, args.samples, setup.problem, std::move(report));
+  tspline::io::PoissonOutputWriter output(args.out_dir, args.samples, setup.problem, std::move(report),
+                                          args.vtu_compression);
   tspline::AdaptiveSolveResult run;
   try {
     run = tspline::solve_adaptive(geometry, setup.problem, opt,
@@ -362,6 +365,7 @@ void add_poisson_command(CLI::App& app, CommandAction& action) {
   cmd->add_option("--samples", a->samples,
                   "solution/step_NNN.vtu: k x k sub-quads per analysis cell, k in [1, 64]")
       ->capture_default_str();
+  add_vtu_compression_option(cmd, a->vtu_compression);
   cmd->add_option("--solver", a->solver,
                   "Linear solver of each step: direct (CHOLMOD sparse Cholesky), iterative (PETSc CG with an "
                   "algebraic multigrid preconditioner, distributed under mpirun), or auto: direct below "

@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "tspline/errors.h"
+#include "vtu_compression_option.h"
 
 namespace tspline_app {
 namespace {
@@ -278,6 +279,15 @@ std::vector<ParamOption> make_table() {
   t.push_back(number<int>(
       "samples", "surface.vtu: k x k sub-quads per T-mesh cell", [](auto& s) -> auto& { return s.samples; }));
   t.back().range = {{1.0, 64.0}};
+  t.push_back(option(
+      "vtu-compression", OptionKind::Text, kVtuCompressionHelp,
+      [](ParamSettings& s, const std::string& v) {
+        s.vtu_compression = toolkit::io::parse_vtu_compression(v);
+      },
+      [](const ParamSettings& s) {
+        return json(std::string(toolkit::io::vtu_compression_name(s.vtu_compression)));
+      }));
+  t.back().choices = {"lz4", "zlib", "none"};
   const std::vector<std::pair<const char*, std::vector<std::string>>> fields = {
       {"layout", {"layout"}},
       {"cuts", {"cuts"}},
@@ -302,7 +312,8 @@ std::vector<ParamOption> make_table() {
       {"cert-depth", {"certification.max_depth"}},
       {"optimizer", {"untangling.optimizer"}},
       {"samples", {"samples"}},
-};
+      {"vtu-compression", {"vtu_compression"}},
+  };
   for (const auto& [name, names] : fields)
     for (ParamOption& o : t)
       if (o.name == name) o.fields = names;

@@ -14,6 +14,7 @@
 #include <utility>
 #include <vector>
 
+#include "toolkit/io/vtu_writer.h"
 #include "tspline/io/gis_reader.h"
 #include "tspline/pipeline/adaptive_parameterization.h"
 #include "tspline/pipeline/domain_parameterization.h"
@@ -39,6 +40,9 @@ struct ParamSettings {
   /// A previous map (tspline.json) of the same boundary before it moved: warm start ("" for none).
   std::string from_file;
   int samples = 4;        ///< surface.vtu: k x k sub-quads per cell
+  /// The .vtu files' compression: LZ4 by default (zlib takes about five times
+  /// its CPU for files about a quarter smaller; bench/README.md, "LZ4 files").
+  toolkit::io::VtuCompression vtu_compression = toolkit::io::VtuCompression::LZ4;
 };
 
 /// How an option's value is written (on the command line and in Python).

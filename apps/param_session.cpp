@@ -235,14 +235,15 @@ ParamRun run_param(tspline::io::DomainInput domain, std::string source, const Pa
 void write_param_run(const ParamRun& run, const std::string& out_dir) {
   toolkit::io::ensure_writable_directory(out_dir);
   const int samples = run.settings.samples;
+  const toolkit::io::VtuCompression compression = run.settings.vtu_compression;
   if (run.result.patches) {
-    tspline::io::write_multipatch_outputs(*run.result.patches, out_dir, run.report, samples);
+    tspline::io::write_multipatch_outputs(*run.result.patches, out_dir, run.report, samples, compression);
     return;
   }
-  tspline::io::AdaptSeriesWriter series(out_dir, samples);
+  tspline::io::AdaptSeriesWriter series(out_dir, samples, compression);
   for (const ParamIteration& s : run.iterations) series.add(s.iteration, s.map, &s.cells);
   series.finish();
-  tspline::io::write_param_outputs(*run.result.single, out_dir, run.report, samples);
+  tspline::io::write_param_outputs(*run.result.single, out_dir, run.report, samples, compression);
 }
 
 std::vector<std::string> param_run_files(const ParamRun& run) {

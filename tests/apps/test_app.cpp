@@ -96,6 +96,49 @@ TEST_SUITE("app") {
     for (const auto& e : fs::directory_iterator(d / "out")) CHECK(e.path().filename().string()[0] != '.');
   }
 
+  TEST_CASE(
+      "--vtu-compression: every .vtu file with the compression asked for, LZ4 by default; the map the same") {
+    const fs::path d = scratch("vtu_compression");
+    // (compressor attribute of the files, or "" for none; the option, "" for the default)
+    const std::vector<std::pair<std::string, std::string>> cases = {
+        {"vtkLZ4DataCompressor", ""}, {"vtkZLibDataCompressor", "zlib"}, {"", "none"}};
+    std::set<std::string> maps;
+    for (const std::string layout : {"single", "quad"})
+      for (const auto& [compressor, option] : cases) {
+        CAPTURE(layout);
+        CAPTURE(option);
+        const fs::path out = d / (layout + "_" + option);
+        const RunResult r =
+            run("param --layout " + layout + " '" + polygons("square.txt") + "' --out '" + out.string() +
+                    "'" + (option.empty() ? "" : " --vtu-compression " + option),
+                d);
+        CAPTURE(r.err);
+        REQUIRE(r.exit_code == 0);
+        int files = 0;
+        for (const auto& e : fs::directory_iterator(out)) {
+          if (e.path().extension() != ".vtu") continue;
+          CAPTURE(e.path().filename().string());
+          const std::string text = slurp(e.path());
+          const std::string header = text.substr(0, text.find("<AppendedData"));
+          CHECK(header.find("<AppendedData") == std::string::npos);
+          if (compressor.empty())
+            CHECK(header.find("compressor=") == std::string::npos);
+          else
+            CHECK(header.find("compressor=\"" + compressor + "\"") != std::string::npos);
+          ++files;
+        }
+        CHECK(files >= 6);
+        const auto rep = nlohmann::json::parse(slurp(out / "report.json"));
+        CHECK(rep["options"]["vtu-compression"] == (option.empty() ? "lz4" : option));
+        maps.insert(slurp(out / "tspline.json"));
+      }
+    CHECK(maps.size() == 2);  // one map per layout, whatever the files' compression
+    const fs::path bad = scratch("vtu_compression_bad");
+    expect_clean_failure("param '" + polygons("square.txt") + "' --out '" + (bad / "out").string() +
+                             "' --vtu-compression gzip",
+                         bad, "--vtu-compression: gzip not in {lz4,zlib,none}", 1);
+  }
+
   TEST_CASE("an invalid final map: exit 3, one clear line, files written and saying so") {
     // The gear's interpolating map folds at reflex tooth roots; without the
     // control point repair and without adaptive rounds it stays invalid.

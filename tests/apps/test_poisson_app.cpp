@@ -72,9 +72,10 @@ TEST_SUITE("poisson_app") {
     // `param` maps the square onto itself with a uniform T-mesh, so u is in the
     // discrete space; uniform refinement keeps the mesh free of T-junctions.
     const fs::path d = scratch("polynomial");
-    const auto r = run_app("poisson " + q(geometry("square.txt")) +
-                               " --problem polynomial --refine uniform --steps 2 --out " + q(d / "out"),
-                           d);
+    const auto r = run_app(
+        "poisson " + q(geometry("square.txt")) +
+            " --problem polynomial --refine uniform --steps 2 --vtu-compression zlib --out " + q(d / "out"),
+        d);
     CAPTURE(r.err);
     CAPTURE(r.out);
     REQUIRE(r.exit_code == 0);
@@ -93,6 +94,14 @@ TEST_SUITE("poisson_app") {
     CHECK(rep["problem"]["exact_gradient"] == "analytic");
     CHECK(rep["options"]["refine"] == "uniform");
     CHECK(rep["finished"] == true);
+    int solution_files = 0;  // each step's, zlib-compressed as asked (LZ4 by default)
+    for (const auto& e : fs::directory_iterator(d / "out" / "solution")) {
+      const std::string text = slurp(e.path());
+      CHECK(text.substr(0, text.find("<AppendedData")).find("compressor=\"vtkZLibDataCompressor\"") !=
+            std::string::npos);
+      ++solution_files;
+    }
+    CHECK(solution_files == 2);
     REQUIRE(rep["steps"].size() == 2);
     for (const auto& s : rep["steps"]) {
       for (const char* k : {"assembly_seconds", "solve_seconds", "dirichlet_seconds", "step_seconds", "l2",

@@ -181,11 +181,15 @@ TEST_SUITE("bezier_vtu") {
     const tspline::io::LoadedMaps maps = tspline::io::read_maps_file((d / "plate" / "tspline.json").string());
     REQUIRE(maps.patches.size() >= 2);
     const auto e = test_support::run_app("export " + test_support::quoted(d / "plate" / "tspline.json") +
-                                             " --vtk-bezier " + test_support::quoted(d / "exported.vtu"),
+                                             " --vtk-bezier " + test_support::quoted(d / "exported.vtu") +
+                                             " --vtu-compression none",
                                          d);
     CAPTURE(e.err);
     REQUIRE(e.exit_code == 0);
     CHECK(test_support::contains(e.out, "Bezier cells"));
+    // The arrays raw, as asked (param's files LZ4-compressed, the default).
+    const std::string exported = test_support::slurp(d / "exported.vtu");
+    CHECK(exported.substr(0, exported.find("<AppendedData")).find("compressor=") == std::string::npos);
     for (const char* file : {"plate/surface_bezier.vtu", "exported.vtu"}) {
       CAPTURE(file);
       const vtkSmartPointer<vtkUnstructuredGrid> g = read_back(d / file);

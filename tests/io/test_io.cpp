@@ -203,10 +203,10 @@ TEST_SUITE("io") {
       CHECK(entries_of(dir.path) == std::vector<std::string>{"mesh.vtu"});
       check_same(m, read_vtu(path));
 
-      // Binary appended, raw (not base64), zlib-compressed.
+      // Binary appended, raw (not base64), LZ4-compressed by default.
       const std::string text = read_all(path);
       CHECK(text.find("type=\"UnstructuredGrid\"") != std::string::npos);
-      CHECK(text.find("compressor=\"vtkZLibDataCompressor\"") != std::string::npos);
+      CHECK(text.find("compressor=\"vtkLZ4DataCompressor\"") != std::string::npos);
       CHECK(text.find("format=\"appended\"") != std::string::npos);
       CHECK(text.find("<AppendedData encoding=\"raw\">") != std::string::npos);
       CHECK(text.find("format=\"ascii\"") == std::string::npos);
@@ -216,10 +216,34 @@ TEST_SUITE("io") {
     }
   }
 
+  TEST_CASE("write_vtu: each compression named in the file and read back bit for bit") {
+    TempDir dir;
+    const VtuMesh m = sample_mesh();
+    const std::vector<std::pair<VtuCompression, std::string>> cases = {
+        {VtuCompression::LZ4, "vtkLZ4DataCompressor"}, {VtuCompression::Zlib, "vtkZLibDataCompressor"}};
+    for (const auto& [compression, compressor] : cases) {
+      CAPTURE(compressor);
+      const std::string path = dir / "mesh.vtu";
+      write_vtu(path, m, compression);
+      check_same(m, read_vtu(path));
+      CHECK(read_all(path).find("compressor=\"" + compressor + "\"") != std::string::npos);
+    }
+    const std::string path = dir / "raw.vtu";
+    write_vtu(path, m, VtuCompression::None);
+    check_same(m, read_vtu(path));
+    CHECK(read_all(path).find("compressor=") == std::string::npos);
+    // The names of the command-line option and of the Python keyword.
+    for (const VtuCompression c : {VtuCompression::LZ4, VtuCompression::Zlib, VtuCompression::None})
+      CHECK(parse_vtu_compression(vtu_compression_name(c)) == c);
+    CHECK(vtu_compression_name(VtuCompression::LZ4) == "lz4");
+    CHECK_THROWS_WITH_AS(parse_vtu_compression("gzip"), "unknown .vtu compression 'gzip' (lz4, zlib or none)",
+                         toolkit::InputError);
+  }
+
   TEST_CASE("write_vtu: arrays of many zlib blocks (libdeflate), read back bit for bit through zlib") {
     // 40,000 points: every array spans several of VTK's 32 KiB blocks. VTK's
     // reader inflates them with zlib (vtkZLibDataCompressor), so a stream that
-    // is not zlib's format, or a block lost, fails here.
+    // is not zlib's format, or a block lost, fails here. LZ4's blocks alike.
     TempDir dir;
     VtuMesh m;
     const std::size_t n = 40000;
@@ -237,7 +261,7 @@ TEST_SUITE("io") {
     m.point_scalars = {{"noise", noise}, {"ramp", ramp}};
     m.point_ints = {{"id", ids}};
     const std::string path = dir / "big.vtu";
-    write_vtu(path, m);
+    write_vtu(path, m, VtuCompression::Zlib);
     check_same(m, read_vtu(path));
     const std::string text = read_all(path);
     CHECK(text.find("compressor=\"vtkZLibDataCompressor\"") != std::string::npos);
@@ -246,6 +270,16 @@ TEST_SUITE("io") {
     // and the cells compress to little, the noise and the points' x and y not.
     const std::size_t raw = n * (24 + 8 + 8 + 4 + 4 + 4 + 1);
     CHECK(text.size() < raw * 3 / 4);
+    const std::string lz4_path = dir / "big_lz4.vtu";
+    write_vtu(lz4_path, m);
+    check_same(m, read_vtu(lz4_path));
+    const std::string lz4_text = read_all(lz4_path);
+    CHECK(lz4_text.find("compressor=\"vtkLZ4DataCompressor\"") != std::string::npos);
+    // LZ4 packs the repeated bytes (z = 0, the cells' types) but finds fewer
+    // of zlib's short matches: between zlib's file and the raw arrays.
+    MESSAGE("raw arrays ", raw, " B, zlib file ", text.size(), " B, LZ4 file ", lz4_text.size(), " B");
+    CHECK(lz4_text.size() > text.size());
+    CHECK(lz4_text.size() < raw * 9 / 10);
   }
 
   TEST_CASE("first use of VTK on two threads at once, in new processes: both files written, nothing leaked") {

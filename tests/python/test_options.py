@@ -68,6 +68,7 @@ BAD_VALUES = {
     "sweep_tol": (0.0, SQUARE), "min_jacobian": (1.5, SQUARE), "max_adapt": (-1, SQUARE),
     "max_cells": (0, SQUARE), "cert_depth": (30, SQUARE), "samples": (0, SQUARE), "blunt_tips": (95.0, SQUARE),
     "polygon": (5, GEOJSON), "feature": (99, GEOJSON), "layer": ("0", SQUARE),
+    "vtu_compression": ("gzip", SQUARE),
 }
 MISSING_PATHS = {"cuts", "from"}  # a path that does not exist: an IoError / exit 2 naming the file
 

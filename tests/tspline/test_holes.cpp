@@ -397,7 +397,8 @@ TEST_SUITE("holes") {
 
       // The VTU files in pieces of one patch each: the same grids as in one piece.
       const auto pieces_dir = test_support::scratch_dir("holes", "v2_pieces");
-      tspline::io::write_multipatch_outputs(R, pieces_dir.string(), report, 2, 1);
+      tspline::io::write_multipatch_outputs(R, pieces_dir.string(), report, 2,
+                                            toolkit::io::VtuCompression::LZ4, 1);
       for (const char* f : {"surface.vtu", "surface_bezier.vtu", "physical_tmesh.vtu", "control_net.vtu",
                             "boundary.vtu", "parametric_tmesh.vtu"}) {
         CAPTURE(f);

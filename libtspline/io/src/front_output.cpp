@@ -132,14 +132,18 @@ nlohmann::json front_report(const FrontResult& r, const std::string& input_path)
   };
 }
 
-void write_front_meshes(const FrontResult& r, const std::string& out_dir, bool physical) {
+void write_front_meshes(const FrontResult& r, const std::string& out_dir, bool physical,
+                        toolkit::io::VtuCompression compression) {
   toolkit::io::ensure_writable_directory(out_dir);
   const std::filesystem::path dir(out_dir);
   std::vector<Eigen::Vector2d> param(r.mesh.num_vertices());
   for (int v = 0; v < static_cast<int>(param.size()); ++v) param[v] = r.mesh.vertex_param(v);
-  toolkit::io::write_vtu((dir / output_files::kParametricTMesh).string(), tmesh_vtu(r.mesh, param));
-  if (physical) toolkit::io::write_vtu((dir / output_files::kPhysicalTMesh).string(), tmesh_vtu(r.mesh, r.optimized));
-  toolkit::io::write_vtu((dir / output_files::kBoundary).string(), boundary_vtu(r.boundary));
+  toolkit::io::write_vtu((dir / output_files::kParametricTMesh).string(), tmesh_vtu(r.mesh, param),
+                         compression);
+  if (physical)
+    toolkit::io::write_vtu((dir / output_files::kPhysicalTMesh).string(), tmesh_vtu(r.mesh, r.optimized),
+                           compression);
+  toolkit::io::write_vtu((dir / output_files::kBoundary).string(), boundary_vtu(r.boundary), compression);
 }
 
 }  // namespace tspline::io

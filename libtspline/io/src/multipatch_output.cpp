@@ -131,7 +131,7 @@ json multipatch_report(const MultiPatchResult& R, const std::string& input_path,
 }
 
 void write_multipatch_outputs(const MultiPatchResult& R, const std::string& out_dir, const json& report,
-                              int samples, std::size_t piece_cells) {
+                              int samples, toolkit::io::VtuCompression compression, std::size_t piece_cells) {
   const std::filesystem::path dir(out_dir);
   const std::size_t n = R.patches.size();
   std::vector<const TSplineMap*> maps(n);
@@ -218,16 +218,21 @@ void write_multipatch_outputs(const MultiPatchResult& R, const std::string& out_
   auto write_own = [&](std::size_t f) {
     std::future<toolkit::io::VtuMesh> ahead;
     int ahead_piece = -1;
-    toolkit::io::write_vtu_pieces((dir / files[f].first).string(), pieces, [&](int i) {
-      toolkit::io::VtuMesh piece;
-      if (ahead.valid() && ahead_piece == i)
-        piece = ahead.get();
-      else
-        piece = make_piece(f, i);
-      if (ahead.valid()) ahead.wait();  // not the one asked for (VTK asks in order): dropped
-      if (i + 1 < pieces) ahead_piece = i + 1, ahead = std::async(std::launch::async, make_piece, f, i + 1);
-      return piece;
-    });
+    toolkit::io::write_vtu_pieces((dir / files[f].first).string(), pieces,
+                                  [&](int i) {
+                                    toolkit::io::VtuMesh piece;
+                                    if (ahead.valid() && ahead_piece == i)
+                                      piece = ahead.get();
+                                    else
+                                      piece = make_piece(f, i);
+                                    if (ahead.valid())
+                                      ahead.wait();  // not the one asked for (VTK asks in order): dropped
+                                    if (i + 1 < pieces)
+                                      ahead_piece = i + 1,
+                                      ahead = std::async(std::launch::async, make_piece, f, i + 1);
+                                    return piece;
+                                  },
+                                  compression);
     if (ahead.valid()) ahead.get();  // raises its error, if any
   };
   auto write_lane = [&](std::size_t s, std::initializer_list<std::string_view> own, bool with_tspline_file) {
@@ -236,7 +241,7 @@ void write_multipatch_outputs(const MultiPatchResult& R, const std::string& out_
         write_multipatch_file((dir / output_files::kTSpline).string(), maps, metas, R.layout.interfaces,
                               R.layout.cuts, report.value("input", ""), &R.domain);
       toolkit::io::write_vtu_pieces((dir / shared_files[s]).string(), pieces,
-                                    [&](int i) { return shared.take(s, i); });
+                                    [&](int i) { return shared.take(s, i); }, compression);
       for (const std::string_view name : own)
         for (std::size_t f = 0; f < files.size(); ++f)
           if (files[f].first == name) write_own(f);

@@ -197,7 +197,9 @@ toolkit::io::VtuMesh physical_tmesh_vtu(const ParameterizationResult& r, int k,
                             r.adaptive.certification, &r.cell_quality, extraction);
 }
 
-AdaptSeriesWriter::AdaptSeriesWriter(std::string out_dir, int samples) : out_dir_(std::move(out_dir)), samples_(samples) {}
+AdaptSeriesWriter::AdaptSeriesWriter(std::string out_dir, int samples,
+                                     toolkit::io::VtuCompression compression)
+    : out_dir_(std::move(out_dir)), samples_(samples), compression_(compression) {}
 
 void AdaptSeriesWriter::add(int it, const TSplineMap& map, const std::vector<CellMapQuality>* quality) {
   // Created on first use, so that a run failing before the first fit leaves nothing.
@@ -208,8 +210,9 @@ void AdaptSeriesWriter::add(int it, const TSplineMap& map, const std::vector<Cel
   std::snprintf(name, sizeof name, "adapt/surface_%03d.vtu", it);
   const std::string surface_file = name;
   const std::filesystem::path dir(out_dir_);
-  toolkit::io::write_vtu((dir / mesh_file).string(), physical_tmesh_vtu(map, samples_, nullptr, {}, quality));
-  toolkit::io::write_vtu((dir / surface_file).string(), surface_vtu(map, samples_));
+  toolkit::io::write_vtu((dir / mesh_file).string(), physical_tmesh_vtu(map, samples_, nullptr, {}, quality),
+                         compression_);
+  toolkit::io::write_vtu((dir / surface_file).string(), surface_vtu(map, samples_), compression_);
   entries_.push_back({static_cast<double>(it), mesh_file, 0});
   entries_.push_back({static_cast<double>(it), surface_file, 1});
 }
@@ -459,19 +462,20 @@ nlohmann::json param_report(const ParameterizationResult& r, const std::string& 
   return rep;
 }
 
-void write_param_outputs(const ParameterizationResult& r, const std::string& out_dir, const nlohmann::json& report,
-                         int samples) {
+void write_param_outputs(const ParameterizationResult& r, const std::string& out_dir,
+                         const nlohmann::json& report, int samples, toolkit::io::VtuCompression compression) {
   const std::filesystem::path dir(out_dir);
-  write_front_meshes(r.front, out_dir, /*physical=*/false);
-  toolkit::io::write_vtu((dir / output_files::kPhysicalTMesh).string(), physical_tmesh_vtu(r, samples));
+  write_front_meshes(r.front, out_dir, /*physical=*/false, compression);
+  toolkit::io::write_vtu((dir / output_files::kPhysicalTMesh).string(), physical_tmesh_vtu(r, samples),
+                         compression);
   TSplineFileMeta meta;
   meta.source = report.value("input", "");
   meta.boundary = r.front.boundary.polygon();
   meta.corners = r.front.boundary.corners().index;
   write_tspline_file((dir / output_files::kTSpline).string(), *r.map, meta);
-  toolkit::io::write_vtu((dir / output_files::kSurface).string(), surface_vtu(*r.map, samples));
-  toolkit::io::write_vtu((dir / output_files::kBezierSurface).string(), bezier_vtu(r));
-  toolkit::io::write_vtu((dir / output_files::kControlNet).string(), control_net_vtu(*r.map));
+  toolkit::io::write_vtu((dir / output_files::kSurface).string(), surface_vtu(*r.map, samples), compression);
+  toolkit::io::write_vtu((dir / output_files::kBezierSurface).string(), bezier_vtu(r), compression);
+  toolkit::io::write_vtu((dir / output_files::kControlNet).string(), control_net_vtu(*r.map), compression);
   toolkit::io::write_text_atomic((dir / output_files::kReport).string(), report.dump(2) + "\n");  // last: the run's summary
 }
 

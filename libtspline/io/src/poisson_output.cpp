@@ -77,8 +77,13 @@ std::string short_solver_name(const SolverStats& s) {
   return s.kind;
 }
 
-PoissonOutputWriter::PoissonOutputWriter(std::string out_dir, int samples, const PoissonProblem& problem, json report)
-    : out_dir_(std::move(out_dir)), samples_(samples), problem_(problem), report_(std::move(report)) {
+PoissonOutputWriter::PoissonOutputWriter(std::string out_dir, int samples, const PoissonProblem& problem,
+                                         json report, toolkit::io::VtuCompression compression)
+    : out_dir_(std::move(out_dir)),
+      samples_(samples),
+      compression_(compression),
+      problem_(problem),
+      report_(std::move(report)) {
   report_["steps"] = json::array();
 }
 
@@ -94,7 +99,7 @@ json PoissonOutputWriter::add_step(const PoissonStep& st, const PoissonSolution&
   }
   char name[64];
   std::snprintf(name, sizeof name, "%s/step_%03d.vtu", std::string(output_files::kSolutionFolder).c_str(), st.step);
-  toolkit::io::write_vtu((out / name).string(), solution_vtu(sol, problem_, eta, samples_));
+  toolkit::io::write_vtu((out / name).string(), solution_vtu(sol, problem_, eta, samples_), compression_);
   pvd_.push_back({static_cast<double>(st.step), name, 0});
 
   int max_level = 0;

@@ -25,6 +25,7 @@ nlohmann::json front_report(const FrontResult& result, const std::string& input_
 /// of the front half's vertex positions (straight cell edges; valid by the
 /// straight-polygon test), each atomically, into out_dir. A run with a map
 /// writes physical_tmesh.vtu through the map instead (param_output.h).
-void write_front_meshes(const FrontResult& result, const std::string& out_dir, bool physical = true);
+void write_front_meshes(const FrontResult& result, const std::string& out_dir, bool physical = true,
+                        toolkit::io::VtuCompression compression = toolkit::io::VtuCompression::LZ4);
 
 }  // namespace tspline::io

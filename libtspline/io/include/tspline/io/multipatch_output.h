@@ -28,10 +28,12 @@ nlohmann::json multipatch_report(const MultiPatchResult& result, const std::stri
 /// parametric_tmesh.vtu (patch p shifted by 1.25 p in xi), physical_tmesh.vtu,
 /// boundary.vtu and report.json (last) into out_dir, each atomically. Each VTU
 /// file is written in pieces of whole patches of about `piece_cells` T-mesh
-/// cells (toolkit::io::write_vtu_pieces); two files are written at once (VTK
+/// cells (toolkit::io::write_vtu_pieces); three files are written at once (VTK
 /// compresses serially), each with one piece in memory and the next one being
 /// made.
 void write_multipatch_outputs(const MultiPatchResult& result, const std::string& out_dir,
-                              const nlohmann::json& report, int samples, std::size_t piece_cells = 8192);
+                              const nlohmann::json& report, int samples,
+                              toolkit::io::VtuCompression compression = toolkit::io::VtuCompression::LZ4,
+                              std::size_t piece_cells = 8192);
 
 }  // namespace tspline::io

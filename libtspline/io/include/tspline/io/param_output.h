@@ -64,13 +64,15 @@ toolkit::io::VtuMesh physical_tmesh_vtu(const ParameterizationResult& result, in
 /// physical T-mesh, part 1 the surface).
 class AdaptSeriesWriter {
  public:
-  AdaptSeriesWriter(std::string out_dir, int samples);
+  AdaptSeriesWriter(std::string out_dir, int samples,
+                    toolkit::io::VtuCompression compression = toolkit::io::VtuCompression::LZ4);
   void add(int iteration, const TSplineMap& map, const std::vector<CellMapQuality>* quality = nullptr);
   void finish() const;
 
  private:
   std::string out_dir_;
   int samples_;
+  toolkit::io::VtuCompression compression_;
   std::vector<toolkit::io::PvdEntry> entries_;
 };
 
@@ -123,6 +125,7 @@ toolkit::io::VtuMesh bezier_vtu(const ParameterizationResult& result,
 /// `samples` segments per cell edge), boundary.vtu, tspline.json, surface.vtu,
 /// surface_bezier.vtu, control_net.vtu and report.json into out_dir (each atomically).
 void write_param_outputs(const ParameterizationResult& result, const std::string& out_dir,
-                         const nlohmann::json& report, int samples);
+                         const nlohmann::json& report, int samples,
+                         toolkit::io::VtuCompression compression = toolkit::io::VtuCompression::LZ4);
 
 }  // namespace tspline::io

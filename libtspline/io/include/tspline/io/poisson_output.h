@@ -30,7 +30,8 @@ class PoissonOutputWriter {
  public:
   /// `report`: the run's description (command, input, options, problem, ...);
   /// the writer adds "steps" and "finished". Nothing is written before add_step.
-  PoissonOutputWriter(std::string out_dir, int samples, const PoissonProblem& problem, nlohmann::json report);
+  PoissonOutputWriter(std::string out_dir, int samples, const PoissonProblem& problem, nlohmann::json report,
+                      toolkit::io::VtuCompression compression = toolkit::io::VtuCompression::LZ4);
 
   /// Writes the step's .vtu (creating the folder on the first step) and
   /// rewrites the tables. peak_mib: peak resident memory of every process so
@@ -54,6 +55,7 @@ class PoissonOutputWriter {
  private:
   std::string out_dir_;
   int samples_;
+  toolkit::io::VtuCompression compression_;
   const PoissonProblem& problem_;
   nlohmann::json report_;
   std::vector<PoissonStep> steps_;
