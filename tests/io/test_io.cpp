@@ -351,6 +351,20 @@ TEST_SUITE("io") {
     CHECK(pieces == 3);
     check_same(merged, read_vtu(dir / "pieces.vtu"));
     check_same(merged, read_vtu(dir / "parts.vtu"));
+    // Pieces made of parts (piece 0: the first two, piece 1: the third), their
+    // part indices counted from each piece's first part: the merged mesh again.
+    write_vtu_part_pieces(dir / "part_pieces.vtu", 2, [&](int i) {
+      VtuParts piece;
+      piece.part_array = "part";
+      piece.first_part = 2 * i;
+      if (i == 0)
+        piece.parts = {parts[0], parts[1]};
+      else
+        piece.parts = {parts[2]};
+      return piece;
+    });
+    const vtkSmartPointer<vtkUnstructuredGrid> g = read_vtu(dir / "part_pieces.vtu");
+    check_same(merged, g);  // (its `part` array: 0 0 0 0 1 1 1 1 2)
     // A piece that cannot be made: its error, and no file.
     CHECK_THROWS_WITH_AS(write_vtu_pieces(dir / "broken.vtu", 2,
                                           [&](int i) -> VtuMesh {

@@ -183,12 +183,13 @@ void gather(std::span<Part> parts, Map VtuMesh::*member, const std::string& name
   }
 }
 
-// Each cell's part index.
+// Each cell's part index, counted from `first`.
 template <class Part>
-std::vector<int> part_index(std::span<Part> parts, std::size_t cells) {
+std::vector<int> part_index(std::span<Part> parts, std::size_t cells, int first = 0) {
   std::vector<int> index;
   index.reserve(cells);
-  for (std::size_t k = 0; k < parts.size(); ++k) index.insert(index.end(), parts[k].cells.size(), static_cast<int>(k));
+  for (std::size_t k = 0; k < parts.size(); ++k)
+    index.insert(index.end(), parts[k].cells.size(), first + static_cast<int>(k));
   return index;
 }
 
@@ -305,12 +306,14 @@ void add_higher_order_degrees(vtkUnstructuredGrid* grid, std::span<Part> parts, 
 // released once VTK has its copy, so that the two are never whole at once (a
 // sea of 9,000 patches: surface.vtu's mesh and its grid were 1 GB together).
 template <class Part>
-vtkNew<vtkUnstructuredGrid> build_grid(std::span<Part> parts, const std::string& part_array) {
+vtkNew<vtkUnstructuredGrid> build_grid(std::span<Part> parts, const std::string& part_array,
+                                       int first_part = 0) {
   const PartsLayout L = parts_layout(std::span<const VtuMesh>(parts.data(), parts.size()), part_array);
   vtkNew<vtkUnstructuredGrid> grid;
   set_points(grid.Get(), parts, L);
   // Part indices before the parts' cells are released.
-  const std::vector<int> index = part_array.empty() ? std::vector<int>() : part_index(parts, L.cells);
+  const std::vector<int> index =
+      part_array.empty() ? std::vector<int>() : part_index(parts, L.cells, first_part);
   set_cells(grid.Get(), parts, L);
   add_fields(grid.Get(), parts, L, part_array, index);
   add_higher_order_degrees(grid.Get(), parts, L);
@@ -416,8 +419,7 @@ namespace {
 class PieceSource : public vtkUnstructuredGridAlgorithm {
  public:
   static PieceSource* New();
-  vtkTypeMacro(PieceSource, vtkUnstructuredGridAlgorithm)
-  std::function<VtuMesh(int)> make;
+  vtkTypeMacro(PieceSource, vtkUnstructuredGridAlgorithm) std::function<VtuParts(int)> make;
   std::exception_ptr error;  // of the first piece that could not be made
 
  protected:
@@ -435,9 +437,10 @@ class PieceSource : public vtkUnstructuredGridAlgorithm {
     vtkUnstructuredGrid* output = vtkUnstructuredGrid::GetData(info);
     if (error) return set_empty(output);
     try {
-      VtuMesh mesh = make(piece);
-      validate(mesh);
-      vtkNew<vtkUnstructuredGrid> grid = build_grid(std::span<VtuMesh>(&mesh, 1), "");
+      VtuParts made = make(piece);
+      for (const VtuMesh& part : made.parts) validate(part);
+      vtkNew<vtkUnstructuredGrid> grid =
+          build_grid(std::span<VtuMesh>(made.parts), made.part_array, made.first_part);
       output->ShallowCopy(grid);
     } catch (...) {
       error = std::current_exception();
@@ -583,6 +586,18 @@ void write_vtu_parts(const std::string& path, std::vector<VtuMesh>&& parts, cons
 
 void write_vtu_pieces(const std::string& path, int pieces, const std::function<VtuMesh(int)>& piece,
                       VtuCompression compression) {
+  write_vtu_part_pieces(
+      path, pieces,
+      [&piece](int i) {
+        VtuParts one;
+        one.parts.push_back(piece(i));
+        return one;
+      },
+      compression);
+}
+
+void write_vtu_part_pieces(const std::string& path, int pieces, const std::function<VtuParts(int)>& piece,
+                           VtuCompression compression) {
   detail::prepare_vtk_for_threads();
   if (pieces < 1) throw toolkit::InputError("write_vtu_pieces: the number of pieces must be >= 1");
   vtkNew<PieceSource> source;

@@ -83,6 +83,18 @@ void write_vtu_parts(const std::string& path, std::vector<VtuMesh>&& parts,
 void write_vtu_pieces(const std::string& path, int pieces, const std::function<VtuMesh(int)>& piece,
                       VtuCompression compression = VtuCompression::LZ4);
 
+/// A piece given as parts: written as merge_vtu(parts, part_array) would give
+/// it, with the part indices counted from `first_part`, without that merged
+/// copy being made (each part's arrays go to VTK and are released).
+struct VtuParts {
+  std::vector<VtuMesh> parts;
+  std::string part_array;  ///< "" for none
+  int first_part = 0;
+};
+/// write_vtu_pieces with each piece made as parts.
+void write_vtu_part_pieces(const std::string& path, int pieces, const std::function<VtuParts(int)>& piece,
+                           VtuCompression compression = VtuCompression::LZ4);
+
 /// One dataset of a .pvd collection.
 struct PvdEntry {
   double timestep = 0.0;
