@@ -5,14 +5,12 @@
 #include <chrono>
 #include <iostream>
 #include <memory>
-#include <optional>
 #include <sstream>
 #include <string>
 #include <string_view>
 #include <vector>
 
 #include "commands.h"
-#include "gmsh_module.h"
 #include "kept_until_exit.h"
 #include "param_multipatch.h"
 #include "param_options_cli.h"
@@ -32,11 +30,6 @@ int param_command(const std::string& input, const std::string& out_dir, const Pa
   const bool quiet = mode != tspline_app::OutputMode::Human;
   // Fail on an unwritable output directory before any computation.
   toolkit::io::ensure_writable_directory(out_dir);
-  // Gmsh loaded while the input is read, where the run may make a quad layout.
-  std::optional<GmshPreload> gmsh;
-  if (settings.choice.layout != tspline::LayoutMode::Single && settings.cuts_file.empty() &&
-      settings.from_file.empty())
-    gmsh.emplace();
   const auto t0 = std::chrono::steady_clock::now();
   ParamHooks hooks;
   hooks.progress = [&progress](const tspline::ProgressEvent& e) { progress.report(e); };

@@ -1,0 +1,93 @@
+// The tspline program reads GIS input through the GDAL module it loads at its
+// first GIS input (apps/gis_module.cpp): the program itself does not load GDAL;
+// without the module a GIS input is one clear error (a text polygon still
+// works), and TSPLINE_GIS_MODULE points to it from anywhere.
+#include <doctest/doctest.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "test_support.h"
+
+namespace fs = std::filesystem;
+using test_support::contains;
+using test_support::count_lines;
+using test_support::quoted;
+using test_support::run_app;
+using test_support::run_program;
+
+namespace {
+
+const std::string kGeojson = std::string(TSPLINE_TEST_DATA_DIR) + "/gis/corsica_lonlat.geojson";
+
+std::string param_args(const std::string& input, const fs::path& out) {
+  return "param " + quoted(fs::path(input)) + " -q --out " + quoted(out) + " --layout single --max-adapt 0";
+}
+
+// Sets an environment variable for the scope (the programs run inherit it).
+struct ScopedEnv {
+  ScopedEnv(const char* name, const std::string& value) : name_(name) { ::setenv(name, value.c_str(), 1); }
+  ~ScopedEnv() { ::unsetenv(name_); }
+  ScopedEnv(const ScopedEnv&) = delete;
+  ScopedEnv& operator=(const ScopedEnv&) = delete;
+
+ private:
+  const char* name_;
+};
+
+}  // namespace
+
+TEST_SUITE("gis_app") {
+  TEST_CASE("GIS input through the module: the program does not load GDAL, reads GeoJSON with it") {
+    const fs::path dir = test_support::scratch_dir("gis_app", "module");
+    // What the dynamic linker loads for the program (ldd's way): no GDAL.
+    // (Set by env for the program only: the shell that runs it would list its own.)
+    {
+      const test_support::AppRun r =
+          run_program("/usr/bin/env", "LD_TRACE_LOADED_OBJECTS=1 " + quoted(fs::path(TSPLINE_APP_PATH)), dir);
+      REQUIRE(r.exit_code == 0);
+      CHECK(contains(r.out, "libc.so"));  // the listing itself
+      CHECK(contains(r.out, "libvtkIOXML"));
+      CHECK(!contains(r.out, "libgdal"));
+    }
+    const test_support::AppRun r = run_app(param_args(kGeojson, dir / "out"), dir);
+    CAPTURE(r.err);
+    REQUIRE(r.exit_code == 0);
+    std::ifstream f(dir / "out" / "report.json");
+    const nlohmann::json report = nlohmann::json::parse(f);
+    CHECK(report["input_geometry"]["format"] == "GeoJSON");
+    CHECK(report["input_geometry"]["units"] == "m");  // longitude/latitude projected by PROJ, through GDAL
+    CHECK(report["input_geometry"]["projection"]["name"] == "Lambert azimuthal equal-area");
+  }
+
+  TEST_CASE(
+      "without the module: one clear error for GIS input, text polygons as before; TSPLINE_GIS_MODULE") {
+    const fs::path dir = test_support::scratch_dir("gis_app", "no_module");
+    // The program alone, in a folder without the module (nor ../lib/tspline).
+    const fs::path alone = dir / "bin" / "tspline";
+    fs::create_directories(alone.parent_path());
+    fs::copy_file(TSPLINE_APP_PATH, alone, fs::copy_options::overwrite_existing);
+    const test_support::AppRun gis = run_program(alone.string(), param_args(kGeojson, dir / "gis"), dir);
+    CAPTURE(gis.err);
+    CHECK(gis.exit_code == 2);  // an I/O error: a file the program needs is missing
+    CHECK(count_lines(gis.err) == 1);
+    CHECK(contains(gis.err, "libtspline_gis.so"));
+    CHECK(contains(gis.err, "TSPLINE_GIS_MODULE"));
+    CHECK(!fs::exists(dir / "gis" / "report.json"));
+    const test_support::AppRun text =
+        run_program(alone.string(), param_args(test_support::polygon_file("square.txt"), dir / "text"), dir);
+    CAPTURE(text.err);
+    CHECK(text.exit_code == 0);
+    CHECK(fs::exists(dir / "text" / "report.json"));
+    // The module named by TSPLINE_GIS_MODULE: read as next to the program.
+    const ScopedEnv module("TSPLINE_GIS_MODULE",
+                           (fs::path(TSPLINE_APP_PATH).parent_path() / "libtspline_gis.so").string());
+    const test_support::AppRun found = run_program(alone.string(), param_args(kGeojson, dir / "found"), dir);
+    CAPTURE(found.err);
+    CHECK(found.exit_code == 0);
+    CHECK(fs::exists(dir / "found" / "report.json"));
+  }
+}
