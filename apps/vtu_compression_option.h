@@ -10,8 +10,7 @@ namespace tspline_app {
 
 inline constexpr const char* kVtuCompressionHelp =
     "Compression of the .vtu files: 'lz4' (fast to write and to read), 'zlib' (files about a quarter "
-    "smaller, "
-    "several times the CPU to write) or 'none'; ParaView and VTK read all three";
+    "smaller, several times the CPU to write) or 'none'; ParaView and VTK read all three";
 
 /// Adds --vtu-compression lz4|zlib|none (default lz4) to `cmd`, setting `target`.
 inline void add_vtu_compression_option(CLI::App* cmd, toolkit::io::VtuCompression& target) {

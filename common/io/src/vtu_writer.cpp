@@ -419,7 +419,9 @@ namespace {
 class PieceSource : public vtkUnstructuredGridAlgorithm {
  public:
   static PieceSource* New();
-  vtkTypeMacro(PieceSource, vtkUnstructuredGridAlgorithm) std::function<VtuParts(int)> make;
+  vtkTypeMacro(PieceSource, vtkUnstructuredGridAlgorithm)
+  // Piece i of the file, as parts (write_vtu_pieces: one part per piece).
+  std::function<VtuParts(int)> make;
   std::exception_ptr error;  // of the first piece that could not be made
 
  protected:
