@@ -65,10 +65,12 @@ double corner_energy(const LayoutMesh& m, const LayoutTopology& t, const LayoutQ
   return corner_term(vectors, scales, p, eps_rel, barrier);
 }
 
-// The term of side j's kinks (0 for a cut or a side without kinks).
+// The term of a side of kink figure k (0 for a cut or a side without kinks).
+double kink_term(double k, double p) { return k < 1.0 ? power(2.0 / std::max(k, 1e-9), p) : 0.0; }
+
+// The term of side j's kinks.
 double kink_energy(const LayoutMesh& m, const LayoutTopology& t, const LayoutQuality& Q, int q, int j, double p) {
-  const double k = Q.side_kinks(m, t, q, j);
-  return k < 1.0 ? power(2.0 / std::max(k, 1e-9), p) : 0.0;
+  return kink_term(Q.side_kinks(m, t, q, j), p);
 }
 
 // The term of a side of shape figure g (0 for a cut or a side that keeps its shape).
@@ -144,6 +146,11 @@ LayoutMovingEnergy::LayoutMovingEnergy(const LayoutMesh& m, const LayoutTopology
           c.fixed_norm[s] = c.fixed[s].norm();
         }
       }
+      if (m.ring[n] < 0) {
+        const auto known = std::find(edge_nodes_.begin(), edge_nodes_.end(), c.node);
+        c.edge = static_cast<int>(known - edge_nodes_.begin());
+        if (known == edge_nodes_.end()) edge_nodes_.push_back(c.node);
+      }
       neighbours_.push_back(c);
     }
   for (const auto& [q, j] : t.corners_of(n))
@@ -157,16 +164,37 @@ double LayoutMovingEnergy::operator()(double stop_at) const {
   std::size_t at = 0, side = 0;
   CornerVectors v;
   CornerNorms norms;
+  // At an inner n, each cut's vectors (from n, and to n) and length, once:
+  // the same operations on the same values as corner_vectors_at and
+  // corner_term make them, so the same sums.
+  constexpr std::size_t kEdges = 16;
+  std::array<Eigen::Vector2d, kEdges> from_n, to_n_of;
+  std::array<double, kEdges> length;
+  const bool cached = !edge_nodes_.empty() && edge_nodes_.size() <= kEdges;
+  if (cached)
+    for (std::size_t i = 0; i < edge_nodes_.size(); ++i) {
+      const Eigen::Vector2d& x = m_.x[n_];
+      const Eigen::Vector2d& y = m_.x[edge_nodes_[i]];
+      from_n[i] = y - x, to_n_of[i] = x - y;
+      length[i] = from_n[i].norm();
+    }
   for (const auto& [q, j] : t_.corners_of(n_)) {
     for (const int k : {0, 1, 3}) {
       double e;
       if (k == 0) {
-        e = corner_energy(m_, t_, Q_, q, j, p_, eps_rel_, barrier_);
+        if (cached) {  // an inner corner: one scale, its sides to corners j + 1 and j - 1
+          const int a = neighbours_[at].edge, b = neighbours_[at + 1].edge;
+          v[0] = {from_n[a], from_n[b]};
+          norms[0] = {length[a], length[b]};
+          e = corner_term(v, norms, 1, p_, eps_rel_, barrier_);
+        } else {
+          e = corner_energy(m_, t_, Q_, q, j, p_, eps_rel_, barrier_);
+        }
       } else if (const Neighbour& c = neighbours_[at++]; c.fresh) {
         e = corner_energy(m_, t_, Q_, q, (j + k) % 4, p_, eps_rel_, barrier_);
       } else {
-        const Eigen::Vector2d to_n = m_.x[n_] - m_.x[c.node];
-        const double to_n_norm = to_n.norm();
+        const Eigen::Vector2d to_n = cached ? to_n_of[c.edge] : Eigen::Vector2d(m_.x[n_] - m_.x[c.node]);
+        const double to_n_norm = cached ? length[c.edge] : to_n.norm();
         for (int s = 0; s < c.scales; ++s) {
           v[s] = c.n_is_next ? std::pair{to_n, c.fixed[s]} : std::pair{c.fixed[s], to_n};
           norms[s] =
@@ -185,7 +213,9 @@ double LayoutMovingEnergy::operator()(double stop_at) const {
     if (on_ring)
       for (const int k : {0, 3}) {
         const int ring_side = (j + k) % 4;
-        sum += kink_energy(m_, t_, Q_, q, ring_side, p_) + shape_energy(m_, t_, Q_, q, ring_side, p_);
+        // (The side's ring vertices once for both terms: the same values.)
+        const LayoutQuality::SideVertices sv = Q_.side_vertices(m_, t_, q, ring_side);
+        sum += kink_term(Q_.side_kinks(sv), p_) + shape_term(Q_.side_shape(m_, q, ring_side, sv), p_);
       }
     if (sum >= stop_at) return sum;
   }

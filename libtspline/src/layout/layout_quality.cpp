@@ -163,8 +163,7 @@ LayoutQuality::SideVertices LayoutQuality::side_vertices(const LayoutMesh& m, co
 }
 
 double LayoutQuality::side_kinks(const LayoutMesh& m, const LayoutTopology& t, int q, int j) const {
-  const SideVertices v = side_vertices(m, t, q, j);
-  return v.ring < 0 ? 1.0 : kink_min(v.ring, v.i0, v.i1);
+  return side_kinks(side_vertices(m, t, q, j));
 }
 
 double LayoutQuality::side_shape(const LayoutMesh& m, const LayoutTopology& t, int q, int j) const {
@@ -182,6 +181,11 @@ double LayoutQuality::side_shape(const LayoutMesh& m, int q, int j, const SideVe
   const Eigen::Vector2d o0 = m.x[m.quads[q][(j + 2) % 4]], o1 = m.x[m.quads[q][(j + 3) % 4]];
   const double olen = (o1 - o0).norm();
   const Eigen::Vector2d ou = olen > 0.0 ? Eigen::Vector2d((o1 - o0) / olen) : Eigen::Vector2d(-u);
+  // The adjacent sides' directions (from a to corner j + 3, from b to corner
+  // j + 2), once for the loop: the same values at every vertex.
+  const bool to_o1 = (o1 - a).norm() > 0.0, to_o0 = (o0 - b).norm() > 0.0;
+  const Eigen::Vector2d u1 = to_o1 ? Eigen::Vector2d((o1 - a).normalized()) : Eigen::Vector2d::Zero();
+  const Eigen::Vector2d u0 = to_o0 ? Eigen::Vector2d((o0 - b).normalized()) : Eigen::Vector2d::Zero();
   double pinch = 1.0, out = 0.0;
   for (std::size_t i = v.i0; i < v.i1; ++i) {
     const Eigen::Vector2d p = c.vertex(i);
@@ -197,8 +201,8 @@ double LayoutQuality::side_shape(const LayoutMesh& m, int q, int j, const SideVe
     // that side and the direction to p (the corner as the map sees it on p's
     // scale; a vertex on the chord gives the corner's own sine).
     const double pa = (p - a).norm(), pb = (p - b).norm();
-    if (pa > 0.0 && (o1 - a).norm() > 0.0) pinch = std::min(pinch, cross(p - a, (o1 - a).normalized()) / pa);
-    if (pb > 0.0 && (o0 - b).norm() > 0.0) pinch = std::min(pinch, cross((o0 - b).normalized(), p - b) / pb);
+    if (pa > 0.0 && to_o1) pinch = std::min(pinch, cross(p - a, u1) / pa);
+    if (pb > 0.0 && to_o0) pinch = std::min(pinch, cross(u0, p - b) / pb);
   }
   return std::min(pinch, 1.0 - 0.5 * out / chord);
 }

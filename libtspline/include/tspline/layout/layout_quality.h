@@ -98,6 +98,8 @@ class LayoutQuality {
   /// side_shape with the side's vertices given (side_vertices of the same
   /// side, its end nodes where they were then): the same value.
   double side_shape(const LayoutMesh& m, int q, int j, const SideVertices& v) const;
+  /// side_kinks with the side's vertices given: the same value.
+  double side_kinks(const SideVertices& v) const { return v.ring < 0 ? 1.0 : kink_min(v.ring, v.i0, v.i1); }
 
  private:
   // Minimum of the kink figures of ring r's vertices i0 .. i1 - 1 (i1 may pass

@@ -60,6 +60,7 @@ class LayoutMovingEnergy {
     int scales = 1;          ///< as corner_vectors_at
     bool n_is_next = false;  ///< n is the corner's next corner (its first side), else its previous
     bool fresh = false;      ///< the side to n runs along a ring: the corner is computed afresh
+    int edge = -1;           ///< at an inner n: the node's index in edge_nodes_
     std::array<Eigen::Vector2d, LayoutQuality::corner_scales.size()> fixed;  ///< the other side, per scale
     std::array<double, LayoutQuality::corner_scales.size()> fixed_norm;      ///< its length, per scale
   };
@@ -70,6 +71,10 @@ class LayoutMovingEnergy {
   double p_, eps_rel_;
   bool barrier_;
   std::vector<Neighbour> neighbours_;  ///< per quad at n, corners j + 1 and j - 1
+  /// At an inner n, the nodes joined to it by a cut, each once: every cut
+  /// from n is a side of two quads and of corners at both its ends, so its
+  /// vector and length are taken once per call instead of four times.
+  std::vector<int> edge_nodes_;
   /// per quad at n, the ring vertices of sides j + 1 and j + 2 (which do not
   /// end at n: they stay where n goes)
   std::vector<LayoutQuality::SideVertices> far_sides_;
