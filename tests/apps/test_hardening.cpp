@@ -39,7 +39,8 @@ namespace {
 fs::path scratch(const std::string& name) { return test_support::scratch_dir("hardening", name); }
 
 std::string coastline(const std::string& name) {
-  return std::string(TSPLINE_TEST_DATA_DIR) + "/coastlines/" + name;
+  std::string path = TSPLINE_TEST_DATA_DIR;  // (as test_support::polygon_file)
+  return path.append("/coastlines/").append(name);
 }
 
 /// The polygon file `src` with its k-th vertex (0-based, comments skipped)

@@ -23,7 +23,10 @@ using nlohmann::json;
 
 namespace {
 
-std::string gis_file(const std::string& name) { return std::string(TSPLINE_TEST_DATA_DIR) + "/gis/" + name; }
+std::string gis_file(const std::string& name) {
+  std::string path = TSPLINE_TEST_DATA_DIR;  // (as test_support::polygon_file)
+  return path.append("/gis/").append(name);
+}
 
 using Ring = std::vector<Eigen::Vector2d>;
 
