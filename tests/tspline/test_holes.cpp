@@ -31,7 +31,10 @@ using test_support::contains;
 using test_support::make_polygon;
 using test_support::message_of;
 
-std::string holes_file(const std::string& name) { return std::string(TSPLINE_TEST_DATA_DIR) + "/holes/" + name; }
+std::string holes_file(const std::string& name) {
+  std::string path = TSPLINE_TEST_DATA_DIR;  // (as test_support::polygon_file)
+  return path.append("/holes/").append(name);
+}
 
 tspline::Polygon square(double x0, double y0, double x1, double y1) {
   return make_polygon({{x0, y0}, {x1, y0}, {x1, y1}, {x0, y1}});
