@@ -99,9 +99,11 @@ TEST_SUITE("lbfgs") {
       g[0] = v[0] - 0.3, g[1] = v[1] + 0.7;
       return 1.0 + 0.5 * (g[0] * g[0] + g[1] * g[1]);
     };
-    Eigen::VectorXd x(2);
-    x << 0.3 + 1e-14, -0.7;
-    const Eigen::VectorXd x0 = x;
+    // (Both made from a fixed-size vector: a copy of one filled by `<<` gave
+    // GCC 12 a false -Wmaybe-uninitialized at -O1.)
+    const Eigen::Vector2d start(0.3 + 1e-14, -0.7);
+    Eigen::VectorXd x = start;
+    const Eigen::VectorXd x0 = start;
     Lbfgs lbfgs;
     const Lbfgs::Result r = lbfgs.run(x, f, 50, 0.0);
     CHECK(r.iterations == 0);
