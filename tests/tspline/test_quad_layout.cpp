@@ -387,6 +387,37 @@ TEST_SUITE("quad_layout") {
     CHECK(R.max_gap() <= 1e-12 * R.diameter);
   }
 
+  TEST_CASE(
+      "an absolute tolerance as large as the domain's: each patch fitted at least as closely as alone") {
+    if (!tspline::quad_mesher_available()) return;
+    // The flange's default tolerance given as an area (--tol): its small
+    // patches near the bolt holes once took it as their own, and their ring
+    // cleaning removed patch corners ("patch 50 of the layout: corner 1: vertex
+    // 1 was removed from the input"). Each patch takes the smaller of the area
+    // and tolerance_relative times its own squared diagonal: here the latter
+    // everywhere, so the map is the default one, bit for bit.
+    const tspline::io::DomainInput in =
+        tspline::io::read_domain(std::string(TSPLINE_TEST_DATA_DIR) + "/holes/flange.txt");
+    const tspline::Domain d = tspline::validate_domain({in.outer, in.holes});
+    const tspline::QuadLayout L = tspline::build_quad_layout(d);
+    tspline::AdaptiveOptions ad;
+    ad.max_adapt = 2;
+    const tspline::MultiPatchResult R =
+        tspline::run_multipatch_parameterization(d, L.layout, L.explanation(), {}, ad);
+    tspline::ParameterizationOptions po;
+    po.tolerance_absolute = po.tolerance_relative * R.diameter * R.diameter;
+    const tspline::MultiPatchResult A =
+        tspline::run_multipatch_parameterization(d, L.layout, L.explanation(), po, ad);
+    CHECK(A.certified_valid());
+    REQUIRE(A.patches.size() == R.patches.size());
+    for (std::size_t p = 0; p < A.patches.size(); ++p) {
+      const double diag = tspline::bounding_box_diagonal(L.layout.patches[p].polygon);
+      CHECK(A.patches[p].front.tolerance_area == po.tolerance_relative * diag * diag);
+      CHECK(A.patches[p].front.tolerance_area < *po.tolerance_absolute);
+      CHECK(A.patches[p].map->control_points() == R.patches[p].map->control_points());
+    }
+  }
+
   TEST_CASE("multi-patch map on a quad layout: certified, conforming after adaptive refinement, area") {
     if (!tspline::quad_mesher_available()) return;
     // A rectangular and a round hole (a 48-gon: its patches refine to the boundary tolerance,

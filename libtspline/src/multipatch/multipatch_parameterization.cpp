@@ -285,6 +285,13 @@ MultiPatchResult run_multipatch_parameterization(const Domain& domain, PatchLayo
       po.corners = std::array<long long, 4>{};
       for (int k = 0; k < 4; ++k) (*po.corners)[k] = static_cast<long long>(patch.corners[k]);
       po.corner_trials = 1;
+      // A patch is fitted at least as closely as alone (tolerance_relative of
+      // its own diagonal), however large an absolute tolerance: an area near
+      // a small patch's own would let its fit drop the patch's corners.
+      if (po.tolerance_absolute) {
+        const double d = bounding_box_diagonal(patch.polygon);
+        po.tolerance_absolute = std::min(*po.tolerance_absolute, po.tolerance_relative * d * d);
+      }
       po.border_params = required[p];
       po.progress = patch_progress(shared.progress, p);
       try {

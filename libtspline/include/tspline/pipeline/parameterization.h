@@ -29,7 +29,9 @@ struct ParameterizationOptions {
   /// (a trial over max_cells ranks last). 1: no trials.
   int corner_trials = 4;
   /// Boundary tolerance epsilon (an AREA, Sect. 3). If unset, epsilon =
-  /// tolerance_relative * (bounding-box diagonal)^2.
+  /// tolerance_relative * (bounding-box diagonal)^2. Each patch of a layout
+  /// (run_multipatch_parameterization) takes the smaller of this and
+  /// tolerance_relative * (its own bounding-box diagonal)^2.
   std::optional<double> tolerance_absolute;
   double tolerance_relative = 1e-5;
   /// Initial uniform level: 2^L x 2^L cells before boundary refinement.
