@@ -249,11 +249,18 @@ std::size_t element_energy(const ElementKernel& in, const double* xv, double eps
 
 }  // namespace
 
-MapEnergy::Samples::Samples(const MapEnergy& energy) {
-  const std::size_t n = energy.levels_.back().grid.size();
+MapEnergy::Samples::Samples(const MapEnergy& energy, int level) {
+  const detail::TensorGrid& grid = energy.levels_[static_cast<std::size_t>(level)].grid;
+  const std::size_t n = grid.size();
   for (std::vector<double>* v : {&x, &xs, &xt, &y, &ys, &yt, &rw, &rs, &rt, &J00, &J01, &J10, &J11, &term})
     v->resize(n);
-  scratch.resize(8 * static_cast<std::size_t>(energy.levels_.back().grid.m));
+  scratch.resize(8 * static_cast<std::size_t>(grid.m));
+}
+
+int MapEnergy::finest_active_level() const {
+  int level = 0;
+  for (const int k : active_) level = std::max(level, elements_[static_cast<std::size_t>(k)].level);
+  return level;
 }
 
 MapEnergy::MapEnergy(const TSplineMap& map, const MapEnergyOptions& opt, const BezierExtraction* extraction)
@@ -341,7 +348,7 @@ MapEnergy::MapEnergy(const TSplineMap& map, const MapEnergyOptions& opt, const B
     // Integrate det J with area weights regardless of the weighting option.
     const Eigen::VectorXd x0 = variables(map);
     const Level& level = levels_[0];
-    Samples s(*this);
+    Samples s(*this, 0);
     for (std::size_t k = 0; k < es.size(); ++k) {
       const Element& d = elements_[k];
       std::array<double, 16> X, Y;
@@ -424,9 +431,10 @@ double MapEnergy::evaluate(const double* xv, double eps, double* gradient, std::
   std::vector<std::vector<double>> grads(gradient ? threads - 1 : 0, std::vector<double>(num_variables(), 0.0));
   if (gradient) std::fill(gradient, gradient + num_variables(), 0.0);
   const double theta = options_.theta;
+  const int finest = finest_active_level();
   detail::parallel_ranges(active_.size(), threads, [&](std::size_t b, std::size_t e_end, int slot) {
     double* g = gradient ? (slot == 0 ? gradient : grads[slot - 1].data()) : nullptr;
-    Samples s(*this);
+    Samples s(*this, finest);
     const KernelBuffers buffers{s.x.data(),   s.xs.data(),  s.xt.data(),  s.y.data(),    s.ys.data(),
                                 s.yt.data(),  s.rw.data(),  s.rs.data(),  s.rt.data(),   s.J00.data(),
                                 s.J01.data(), s.J10.data(), s.J11.data(), s.term.data(), s.scratch.data()};
@@ -461,7 +469,7 @@ SampleStats MapEnergy::stats(const double* xv) const {
   st.min_det = std::numeric_limits<double>::infinity();
   st.min_mean_ratio = std::numeric_limits<double>::infinity();
   double wsum = 0.0, jsum = 0.0;
-  Samples s(*this);
+  Samples s(*this, finest_active_level());
   for (const int ka : active_) {
     const std::size_t k = static_cast<std::size_t>(ka);
     const Element& d = elements_[k];
@@ -490,8 +498,9 @@ double MapEnergy::max_positive_step(const double* xv, const double* dv, double a
   // coefficients of x + t d are X + t (X(d) - X(0)) with the fixed points in X(0).
   const std::vector<double> zero(num_variables(), 0.0);
   std::vector<double> result(static_cast<std::size_t>(std::max(1, options_.threads)), a_max);
+  const int finest = finest_active_level();
   detail::parallel_ranges(active_.size(), options_.threads, [&](std::size_t b, std::size_t e_end, int slot) {
-    Samples s(*this), sd(*this);
+    Samples s(*this, finest), sd(*this, finest);
     double best = a_max;
     for (std::size_t i = b; i < e_end; ++i) {
       const std::size_t k = static_cast<std::size_t>(active_[i]);

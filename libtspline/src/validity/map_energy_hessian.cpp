@@ -1,14 +1,14 @@
 // The Hessian of the map's energy for projected Newton: each sample's 4 x 4
 // Hessian in J, projected to positive semi-definite in closed form, and its
 // assembly over the free control points; see map_energy.h.
-#include "tspline/validity/map_energy.h"
-#include "tspline/detail/simd_clones.h"
-#include "tspline/detail/thread_pool.h"
-
+#include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
+#include <optional>
 
-#include <Eigen/Dense>
+#include "tspline/detail/simd_clones.h"
+#include "tspline/detail/thread_pool.h"
+#include "tspline/validity/map_energy.h"
 
 namespace tspline {
 
@@ -305,78 +305,104 @@ void MapEnergy::hessian(const double* xv, double eps, Eigen::SparseMatrix<double
   const double theta = options_.theta;
   const int* outer = H.outerIndexPtr();
   double* val = H.valuePtr();
-  const std::size_t max_points = levels_.back().grid.size();
+  // Each slot's buffers, made once per call by the first range that runs on
+  // it (one call has a range per colour and slot: with the buffers made per
+  // range, zeroing them was more than the assembly of a small patch).
+  const int finest = finest_active_level();
+  const std::size_t max_points = levels_[static_cast<std::size_t>(finest)].grid.size();
+  const std::size_t mr = hp.max_rows;
+  struct Work {
+    Work(const MapEnergy& energy, int level, std::size_t points, std::size_t rows)
+        : s(energy, level),
+          as(16 * points),
+          at(16 * points),
+          h(10 * points),
+          Bbuf(3 * 256),
+          C(16 * rows),
+          T(16 * rows),
+          Kbuf(3 * rows * rows),
+          rows(rows) {}
+    Samples s;
+    std::vector<double> as, at, h, Bbuf, C, T, Kbuf;
+    std::vector<int> rows;
+  };
+  std::vector<std::optional<Work>> work(static_cast<std::size_t>(std::max(1, detail::pool_threads())));
   for (const std::vector<int>& group : hp.colors) {
-    detail::parallel_ranges(group.size(), options_.threads, [&](std::size_t b, std::size_t e_end, int) {
-      Samples s(*this);
-      std::vector<double> as(16 * max_points), at(16 * max_points), h(10 * max_points);
-      const std::size_t mr = hp.max_rows;
-      std::vector<double> Bbuf(3 * 256), C(16 * mr), T(16 * mr), Kbuf(3 * mr * mr);
-      const double* Bp[3] = {Bbuf.data(), Bbuf.data() + 256, Bbuf.data() + 512};
-      double* Kp[3] = {Kbuf.data(), Kbuf.data() + mr * mr, Kbuf.data() + 2 * mr * mr};
-      std::vector<int> rows(mr);
-      for (std::size_t gi = b; gi < e_end; ++gi) {
-        const std::size_t k = static_cast<std::size_t>(group[gi]);
-        const BezierElement& e = es[k];
-        const Element& d = elements_[k];
-        const Level& level = levels_[d.level];
-        const detail::TensorGrid& grid = level.grid;
-        const std::size_t nq = level.weight.size();
-        std::array<double, 16> X, Y;
-        element_coefficients(k, xv, X, Y);
-        element_samples(k, X.data(), Y.data(), s);
-        const double ihx = 1.0 / d.hx, ihy = 1.0 / d.hy;
-        for (std::size_t q = 0; q < nq; ++q) {
-          const PhiDerivatives f = phi_derivatives(s.J00[q], s.J01[q], s.J10[q], s.J11[q], eps, theta, power);
-          double* hq = &h[10 * q];
-          sample_hessian_packed(f.z0, f.z1, f.w0, f.w1, f.fP, f.fQ, f.fPP, f.fQQ, f.fPQ, project, hq);
-          const double omega = level.weight[q] * d.weight;
-          for (int i = 0; i < 10; ++i) hq[i] *= omega;
-          // J00 = a_s . X, J01 = a_t . X (element_samples): a_s = (B_s - B w_s / w) / (w hx),
-          // a_t alike, B_(i1 + 4 j1) = B_i1(s) B_j1(t).
-          const double* bp = &grid.b[4 * (q % grid.m)];
-          const double* dp = &grid.db[4 * (q % grid.m)];
-          const double* br = &grid.b[4 * (q / grid.m)];
-          const double* dr = &grid.db[4 * (q / grid.m)];
-          const double rw = d.rational ? s.rw[q] : 1.0, rs = d.rational ? s.rs[q] : 0.0;
-          const double rt = d.rational ? s.rt[q] : 0.0;
-          double* aq = &as[16 * q];
-          double* tq = &at[16 * q];
-          for (int j1 = 0; j1 < 4; ++j1)
-            for (int i1 = 0; i1 < 4; ++i1) {
-              const double B = bp[i1] * br[j1];
-              aq[i1 + 4 * j1] = (dp[i1] * br[j1] - B * rs) * rw * ihx;
-              tq[i1 + 4 * j1] = (bp[i1] * dr[j1] - B * rt) * rw * ihy;
+    detail::parallel_ranges(
+        group.size(), options_.threads,
+        [&](std::size_t b, std::size_t e_end, int slot) {
+          std::optional<Work>& w = work[static_cast<std::size_t>(slot)];
+          if (!w) w.emplace(*this, finest, max_points, mr);
+          Samples& s = w->s;
+          std::vector<double>&as = w->as, &at = w->at, &h = w->h, &Bbuf = w->Bbuf, &C = w->C, &T = w->T;
+          const double* Bp[3] = {Bbuf.data(), Bbuf.data() + 256, Bbuf.data() + 512};
+          double* Kp[3] = {w->Kbuf.data(), w->Kbuf.data() + mr * mr, w->Kbuf.data() + 2 * mr * mr};
+          std::vector<int>& rows = w->rows;
+          for (std::size_t gi = b; gi < e_end; ++gi) {
+            const std::size_t k = static_cast<std::size_t>(group[gi]);
+            const BezierElement& e = es[k];
+            const Element& d = elements_[k];
+            const Level& level = levels_[d.level];
+            const detail::TensorGrid& grid = level.grid;
+            const std::size_t nq = level.weight.size();
+            std::array<double, 16> X, Y;
+            element_coefficients(k, xv, X, Y);
+            element_samples(k, X.data(), Y.data(), s);
+            const double ihx = 1.0 / d.hx, ihy = 1.0 / d.hy;
+            for (std::size_t q = 0; q < nq; ++q) {
+              const PhiDerivatives f =
+                  phi_derivatives(s.J00[q], s.J01[q], s.J10[q], s.J11[q], eps, theta, power);
+              double* hq = &h[10 * q];
+              sample_hessian_packed(f.z0, f.z1, f.w0, f.w1, f.fP, f.fQ, f.fPP, f.fQQ, f.fPQ, project, hq);
+              const double omega = level.weight[q] * d.weight;
+              for (int i = 0; i < 10; ++i) hq[i] *= omega;
+              // J00 = a_s . X, J01 = a_t . X (element_samples): a_s = (B_s - B w_s / w) / (w hx),
+              // a_t alike, B_(i1 + 4 j1) = B_i1(s) B_j1(t).
+              const double* bp = &grid.b[4 * (q % grid.m)];
+              const double* dp = &grid.db[4 * (q % grid.m)];
+              const double* br = &grid.b[4 * (q / grid.m)];
+              const double* dr = &grid.db[4 * (q / grid.m)];
+              const double rw = d.rational ? s.rw[q] : 1.0, rs = d.rational ? s.rs[q] : 0.0;
+              const double rt = d.rational ? s.rt[q] : 0.0;
+              double* aq = &as[16 * q];
+              double* tq = &at[16 * q];
+              for (int j1 = 0; j1 < 4; ++j1)
+                for (int i1 = 0; i1 < 4; ++i1) {
+                  const double B = bp[i1] * br[j1];
+                  aq[i1 + 4 * j1] = (dp[i1] * br[j1] - B * rs) * rw * ihx;
+                  tq[i1 + 4 * j1] = (bp[i1] * dr[j1] - B * rt) * rw * ihy;
+                }
             }
-        }
-        bernstein_blocks(nq, as.data(), at.data(), h.data(), Bbuf.data(), Bbuf.data() + 256, Bbuf.data() + 512);
-        // To the element's free control points: K = C_f B C_f^T.
-        int nf = 0;
-        for (Eigen::Index r = 0; r < e.C.rows(); ++r)
-          if (variable_of_[e.functions[r]] >= 0) rows[nf++] = static_cast<int>(r);
-        for (int r = 0; r < nf; ++r)
-          for (int i = 0; i < 16; ++i) C[16 * r + i] = e.C(rows[r], i);
-        project_blocks(nf, C.data(), Bp, Kp, T.data());
-        const double* Kxx = Kp[0];
-        const double* Kxy = Kp[1];
-        const double* Kyy = Kp[2];
-        const std::size_t m = e.functions.size();
-        const int* slot = &hp.slots[hp.slot_offset[k]];
-        for (int c = 0; c < nf; ++c) {
-          const int j = variable_of_[e.functions[rows[c]]] / 2;
-          for (int r = 0; r < nf; ++r) {
-            const int sl = slot[rows[r] * m + rows[c]];
-            if (sl < 0) continue;
-            double* c0 = val + outer[2 * j] + 2 * sl;
-            double* c1 = val + outer[2 * j + 1] + 2 * sl;
-            c0[0] += Kxx[nf * r + c];  // (x_i, x_j)
-            c0[1] += Kxy[nf * c + r];  // (y_i, x_j) = (x_j, y_i)
-            c1[0] += Kxy[nf * r + c];  // (x_i, y_j)
-            c1[1] += Kyy[nf * r + c];  // (y_i, y_j)
+            bernstein_blocks(nq, as.data(), at.data(), h.data(), Bbuf.data(), Bbuf.data() + 256,
+                             Bbuf.data() + 512);
+            // To the element's free control points: K = C_f B C_f^T.
+            int nf = 0;
+            for (Eigen::Index r = 0; r < e.C.rows(); ++r)
+              if (variable_of_[e.functions[r]] >= 0) rows[nf++] = static_cast<int>(r);
+            for (int r = 0; r < nf; ++r)
+              for (int i = 0; i < 16; ++i) C[16 * r + i] = e.C(rows[r], i);
+            project_blocks(nf, C.data(), Bp, Kp, T.data());
+            const double* Kxx = Kp[0];
+            const double* Kxy = Kp[1];
+            const double* Kyy = Kp[2];
+            const std::size_t m = e.functions.size();
+            const int* slot = &hp.slots[hp.slot_offset[k]];
+            for (int c = 0; c < nf; ++c) {
+              const int j = variable_of_[e.functions[rows[c]]] / 2;
+              for (int r = 0; r < nf; ++r) {
+                const int sl = slot[rows[r] * m + rows[c]];
+                if (sl < 0) continue;
+                double* c0 = val + outer[2 * j] + 2 * sl;
+                double* c1 = val + outer[2 * j + 1] + 2 * sl;
+                c0[0] += Kxx[nf * r + c];  // (x_i, x_j)
+                c0[1] += Kxy[nf * c + r];  // (y_i, x_j) = (x_j, y_i)
+                c1[0] += Kxy[nf * r + c];  // (x_i, y_j)
+                c1[1] += Kyy[nf * r + c];  // (y_i, y_j)
+              }
+            }
           }
-        }
-      }
-    }, 8);
+        },
+        8);
   }
 }
 

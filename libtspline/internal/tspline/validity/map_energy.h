@@ -129,9 +129,9 @@ class MapEnergy {
 
  private:
   // Per-thread buffers for one element's samples (element_samples), sized
-  // for the finest sample level.
+  // for sample level `level` (a finer element's samples do not fit).
   struct Samples {
-    explicit Samples(const MapEnergy& energy);
+    Samples(const MapEnergy& energy, int level);
     // At the samples: X, Y and their derivatives in the local (s, t), then
     // (after element_samples) the adjoints of evaluate's gradient in place.
     std::vector<double> x, xs, xt, y, ys, yt;
@@ -161,6 +161,11 @@ class MapEnergy {
     bool built = false;
   };
   void build_hessian_pattern() const;
+  // The finest sample level of the active elements: what a pass over them
+  // needs of its Samples (the finest level possible, max_sample_level, has
+  // 1,600 points: zeroing buffers that large for every range of every call
+  // cost more than a small patch's evaluation).
+  int finest_active_level() const;
   // X and Y Bernstein coefficients of element k at the variables x.
   void element_coefficients(std::size_t k, const double* x, std::array<double, 16>& X,
                             std::array<double, 16>& Y) const;
