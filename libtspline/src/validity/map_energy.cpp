@@ -257,12 +257,6 @@ MapEnergy::Samples::Samples(const MapEnergy& energy, int level) {
   scratch.resize(8 * static_cast<std::size_t>(grid.m));
 }
 
-int MapEnergy::finest_active_level() const {
-  int level = 0;
-  for (const int k : active_) level = std::max(level, elements_[static_cast<std::size_t>(k)].level);
-  return level;
-}
-
 MapEnergy::MapEnergy(const TSplineMap& map, const MapEnergyOptions& opt, const BezierExtraction* extraction)
     : options_(opt),
       own_extraction_(extraction ? std::nullopt
@@ -414,6 +408,7 @@ void MapEnergy::set_sample_level(std::size_t element, int level) {
   if (level < 0 || level > options_.max_sample_level)
     throw toolkit::InputError("MapEnergy::set_sample_level: level out of range");
   elements_[element].level = level;
+  finest_level_ = std::max(finest_level_, level);
 }
 
 std::size_t MapEnergy::num_samples() const {

@@ -161,11 +161,11 @@ class MapEnergy {
     bool built = false;
   };
   void build_hessian_pattern() const;
-  // The finest sample level of the active elements: what a pass over them
-  // needs of its Samples (the finest level possible, max_sample_level, has
-  // 1,600 points: zeroing buffers that large for every range of every call
-  // cost more than a small patch's evaluation).
-  int finest_active_level() const;
+  // A sample level no element is finer than (the finest set so): what a pass
+  // over the elements needs of its Samples (the finest level possible,
+  // max_sample_level, has 1,600 points: zeroing buffers that large for every
+  // range of every call cost more than a small patch's evaluation).
+  int finest_active_level() const { return finest_level_; }
   // X and Y Bernstein coefficients of element k at the variables x.
   void element_coefficients(std::size_t k, const double* x, std::array<double, 16>& X,
                             std::array<double, 16>& Y) const;
@@ -180,6 +180,7 @@ class MapEnergy {
   std::vector<Element> elements_;
   std::vector<int> active_;  // the elements that touch a variable, in order
   std::vector<Level> levels_;
+  int finest_level_ = 0;                     // at least every element's level
   std::vector<int> variable_of_;             // per function: index of its x coordinate, or -1
   std::vector<int> free_functions_;
   std::vector<Eigen::Vector2d> normalized_;  // all control points, normalized
