@@ -388,6 +388,33 @@ TEST_SUITE("quad_layout") {
   }
 
   TEST_CASE(
+      "the options are checked before the layout: a bad one stops the run naming the option, not a patch") {
+    if (!tspline::quad_mesher_available()) return;
+    const tspline::Domain d{rectangle(0, 0, 4, 3), {rectangle(1, 1, 2, 2)}};
+    tspline::DomainParameterizationOptions choice;
+    choice.layout = tspline::LayoutMode::Quad;
+    tspline::ParameterizationOptions po;
+    po.smoothing.max_sweeps = 0;
+    std::string m = message_of<tspline::InputError>([&] { tspline::parameterize_domain(d, po, {}, choice); });
+    CHECK(contains(m, "`smoothing.max_sweeps` must be >= 1"));
+    CHECK(!contains(m, "patch"));
+    tspline::AdaptiveOptions ad;
+    ad.min_jacobian = 0.0;
+    m = message_of<tspline::InputError>([&] { tspline::parameterize_domain(d, {}, ad, choice); });
+    CHECK(contains(m, "`min_jacobian` must be in (0, 1]"));
+    CHECK(!contains(m, "patch"));
+    // A maximum level below the default initial level is left to each patch:
+    // a quad layout's patches start at level 2.
+    po = {};
+    po.max_level = 2;
+    ad = {};
+    ad.max_adapt = 1;
+    const tspline::DomainParameterization P = tspline::parameterize_domain(d, po, ad, choice);
+    REQUIRE(P.patches);
+    CHECK(P.patches->certified_valid());
+  }
+
+  TEST_CASE(
       "an absolute tolerance as large as the domain's: each patch fitted at least as closely as alone") {
     if (!tspline::quad_mesher_available()) return;
     // The flange's default tolerance given as an area (--tol): its small

@@ -129,6 +129,16 @@ bool keep_layout_over_single(const DenseMapQuality& layout, const DenseMapQualit
 DomainParameterization parameterize_domain(const Domain& input, const ParameterizationOptions& options,
                                            const AdaptiveOptions& adaptive, const DomainParameterizationOptions& c,
                                            const IterationCallback& on_iteration, const PatchCallback& on_patch) {
+  // The options before any work (a layout takes seconds before its first
+  // patch would check them). The levels only as far as a patch's initial
+  // level is not yet known (a quad layout's patches start at 2 unless given):
+  // each run checks its own.
+  {
+    ParameterizationOptions check = options;
+    check.initial_level = std::min(check.initial_level, std::max(1, check.max_level));
+    validate_options(check);
+    validate_options(adaptive);
+  }
   if (c.first_try_rounds < 0) throw InputError("the first try's adaptive rounds must be >= 0");
   if (!(c.first_try_max_folded >= 0.0 && c.first_try_max_folded <= 1.0))
     throw InputError("the first try's largest folded fraction must be in [0, 1]");
