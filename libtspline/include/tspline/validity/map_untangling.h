@@ -18,11 +18,13 @@
 //     certified (map_certification.h) and the elements that are not certified
 //     get a finer sample level (map_energy.h), so that the next stages see the
 //     fold between the old samples.
-//  3. The last certified map is kept: later stages (the quality phase) cannot
+//  3. A certified map is kept: later stages (the quality phase) cannot
 //     turn a certified map into an uncertified result. At the floor eps the
 //     energy refuses any step that makes a sample's det J <= 0.
 //
-// The map returned is the last certified one if there was one, else the last
+// The map returned is certified if an iterate was: the last certified one, or
+// the certified one with the highest min J_r at the samples where its whole
+// map is better (MapUntanglingOptions::keep_best_certified); else the last
 // iterate (then report.certified is false).
 //
 // Projected Newton (Teran et al. 2005, Smith et al. 2019): each
@@ -130,6 +132,10 @@ struct MapUntanglingOptions {
   /// rest of the map fixed and finer samples there (a small problem), instead
   /// of continuing on the whole map from a raised eps.
   bool local_repair = true;
+  /// Of the last certified iterate and the certified iterate with the highest
+  /// min J_r at the samples, keep the one whose whole map (a dense sample) has
+  /// the higher min(J_r, scaled Jacobian); false: always the last.
+  bool keep_best_certified = true;
   std::function<void(const UntanglingProgress&)> progress;
 };
 
@@ -155,6 +161,9 @@ struct MapUntanglingReport {
   double local_repair_seconds = 0.0;  ///< time in the local repairs (also in seconds)
   SampleStats before, after;   ///< at the initial samples / at the final samples, of the returned map
   bool certified = false;
+  /// The map returned is an earlier certified iterate than the last, whose
+  /// whole map was better (MapUntanglingOptions::keep_best_certified).
+  bool kept_earlier_iterate = false;
   MapCertification certification;  ///< of the returned map
   std::string stop_reason;
   double seconds = 0.0;
