@@ -174,8 +174,7 @@ std::vector<ParamOption> make_table() {
       "tol", OptionKind::Real,
       "Boundary tolerance epsilon as an absolute AREA (units^2): a boundary cell is refined while a polygon "
       "vertex forms with its edge a triangle larger than epsilon (Brovka 2013 Sect. 3); each patch of a "
-      "layout "
-      "takes the smaller of epsilon and --tol-rel times its own squared diagonal",
+      "layout takes the smaller of epsilon and --tol-rel times its own squared diagonal",
       [](ParamSettings& s, const std::string& v) { s.opt.tolerance_absolute = parse_real(v); },
       [](const ParamSettings& s) {
         return s.opt.tolerance_absolute ? json(*s.opt.tolerance_absolute) : json();

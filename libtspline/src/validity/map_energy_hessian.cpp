@@ -1,15 +1,16 @@
 // The Hessian of the map's energy for projected Newton: each sample's 4 x 4
 // Hessian in J, projected to positive semi-definite in closed form, and its
 // assembly over the free control points; see map_energy.h.
-#include <Eigen/Dense>
+#include "tspline/validity/map_energy.h"
+#include "tspline/detail/simd_clones.h"
+#include "tspline/detail/thread_pool.h"
+
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
 #include <optional>
 
-#include "tspline/detail/simd_clones.h"
-#include "tspline/detail/thread_pool.h"
-#include "tspline/validity/map_energy.h"
+#include <Eigen/Dense>
 
 namespace tspline {
 
