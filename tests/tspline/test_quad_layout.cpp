@@ -445,6 +445,54 @@ TEST_SUITE("quad_layout") {
     }
   }
 
+  TEST_CASE("a coarse relative tolerance: the domain cleaned with it, the patches' rings not cleaned again") {
+    if (!tspline::quad_mesher_available()) return;
+    // tolerance_relative 1e-2 (--tol-rel) once stopped the flange with "patch
+    // 50 of the layout: corner 1: vertex 1 was removed from the input": at a
+    // small patch's own needle width, an acute patch corner beside a short
+    // edge looked like a needle's tip. The domain's rings are cleaned with the
+    // run's tolerance; the patches' rings, cut from them, are not cleaned again.
+    const tspline::io::DomainInput in =
+        tspline::io::read_domain(std::string(TSPLINE_TEST_DATA_DIR) + "/holes/flange.txt");
+    tspline::Domain d{in.outer, in.holes};
+    tspline::ParameterizationOptions po;
+    po.tolerance_relative = 1e-2;
+    // A needle out of the outer ring's first edge, half as wide as the run's
+    // needle width and twice as long: removed at that width, not at the default.
+    const double w = tspline::needle_width_for_ring(d.outer, std::nullopt, po.tolerance_relative);
+    {
+      std::vector<Eigen::Vector2d> v = d.outer.vertices;
+      double area2 = 0.0;
+      for (std::size_t i = 0; i < v.size(); ++i)
+        area2 += v[i].x() * v[(i + 1) % v.size()].y() - v[i].y() * v[(i + 1) % v.size()].x();
+      const Eigen::Vector2d t = (v[1] - v[0]).normalized();
+      const Eigen::Vector2d out =
+          area2 > 0.0 ? Eigen::Vector2d(t.y(), -t.x()) : Eigen::Vector2d(-t.y(), t.x());
+      const Eigen::Vector2d mid = 0.5 * (v[0] + v[1]);
+      v.insert(v.begin() + 1, {mid, mid + 2.0 * w * out + 0.25 * w * t, mid + 0.5 * w * t});
+      d.outer = make_polygon(v);
+    }
+    tspline::AdaptiveOptions ad;
+    ad.max_adapt = 2;
+    tspline::DomainParameterizationOptions choice;
+    choice.layout = tspline::LayoutMode::Quad;
+    const tspline::DomainParameterization P = tspline::parameterize_domain(d, po, ad, choice);
+    REQUIRE(P.patches);
+    const tspline::MultiPatchResult& R = *P.patches;
+    CHECK(R.certified_valid());
+    REQUIRE(R.patches.size() == R.layout.patches.size());
+    for (std::size_t p = 0; p < R.patches.size(); ++p)
+      CHECK(R.patches[p].front.boundary.polygon().vertices.size() ==
+            R.layout.patches[p].polygon.vertices.size());
+    // The rings the layout was made from: those of the run's needle width.
+    tspline::DomainCleaningOptions how;
+    how.needle_width = w;
+    const tspline::Domain cleaned = tspline::validate_domain(d, how);
+    CHECK(R.domain.outer.vertices == cleaned.outer.vertices);
+    // (The needle's tip and one of its base vertices: kept at the default width.)
+    CHECK(cleaned.outer.vertices.size() + 2 == tspline::validate_domain(d).outer.vertices.size());
+  }
+
   TEST_CASE("multi-patch map on a quad layout: certified, conforming after adaptive refinement, area") {
     if (!tspline::quad_mesher_available()) return;
     // A rectangular and a round hole (a 48-gon: its patches refine to the boundary tolerance,

@@ -292,6 +292,9 @@ MultiPatchResult run_multipatch_parameterization(const Domain& domain, PatchLayo
         const double d = bounding_box_diagonal(patch.polygon);
         po.tolerance_absolute = std::min(*po.tolerance_absolute, po.tolerance_relative * d * d);
       }
+      // Its ring was cleaned with the domain: nothing more is removed from it
+      // (ParameterizationOptions::needle_width).
+      po.needle_width = 0.0;
       po.border_params = required[p];
       po.progress = patch_progress(shared.progress, p);
       try {

@@ -11,6 +11,8 @@
 #include <sstream>
 #include <vector>
 
+#include "tspline/boundary/domain.h"
+#include "tspline/boundary/polygon_validation.h"
 #include "tspline/detail/enum_names.h"
 #include "tspline/errors.h"
 #include "tspline/layout/quad_mesher.h"
@@ -24,6 +26,24 @@ namespace {
 
 constexpr std::array<detail::EnumName<LayoutMode>, 3> kLayoutModeNames{
     {{LayoutMode::Auto, "auto"}, {LayoutMode::Single, "single"}, {LayoutMode::Quad, "quad"}}};
+
+// The domain's rings cleaned and validated with the run's boundary tolerance
+// (needles narrower than its width removed, ParameterizationOptions::
+// needle_width): a layout's patches are cut from these rings and not cleaned
+// again. `notes`: where the notes go (nullptr: where a single-patch try of
+// the same ring reports its own).
+Domain cleaned_domain(const Domain& input, const ParameterizationOptions& options, bool notes) {
+  DomainCleaningOptions how;
+  how.needle_width = options.needle_width ? *options.needle_width
+                                          : needle_width_for_ring(input.outer, options.tolerance_absolute,
+                                                                  options.tolerance_relative);
+  std::vector<std::string> said;
+  if (notes) how.notes = &said;
+  Domain d = validate_domain(input, how);
+  for (const std::string& note : said)
+    report_step(options.progress, "cleaning", "note: " + note, -1, ProgressEvent::Kind::Note);
+  return d;
+}
 
 }  // namespace
 
@@ -146,7 +166,8 @@ DomainParameterization parameterize_domain(const Domain& input, const Parameteri
   // itself, with the run's tolerance, and reports the notes); rings with holes
   // are validated here.
   const bool holes = !input.holes.empty();
-  const Domain domain = holes || c.cuts || c.layout == LayoutMode::Quad ? validate_domain(input) : input;
+  const Domain domain =
+      holes || c.cuts || c.layout == LayoutMode::Quad ? cleaned_domain(input, options, true) : input;
   DomainParameterization out;
   // The layouts of this domain share a memo (a second layout from the same
   // ring nodes takes the first's mesh and first optimization pass).
@@ -295,7 +316,7 @@ DomainParameterization parameterize_domain(const Domain& input, const Parameteri
       held.release();  // the run ahead is kept: what it reported so far, then as it goes
       a = ahead.get();
     } else {
-      a.valid = holes || c.layout == LayoutMode::Quad ? domain : validate_domain(input);
+      a.valid = holes || c.layout == LayoutMode::Quad ? domain : cleaned_domain(input, options, false);
       QuadLayoutOptions q = layout_options;
       q.progress = layout_progress("quad layout: ");
       a.layout = build_quad_layout(a.valid, q);
@@ -412,7 +433,7 @@ DomainParameterization parameterize_domain(const Domain& input, const Parameteri
       ahead_on_patch = [&held, on_patch](std::size_t p, int round) { held.pass([on_patch, p, round] { on_patch(p, round); }); };
     ahead = std::async(std::launch::async, [&input, q, &adaptive, ahead_multi, ahead_options, ahead_on_patch] {
       LayoutAhead a;
-      a.valid = validate_domain(input);
+      a.valid = cleaned_domain(input, ahead_options, false);
       a.layout = build_quad_layout(a.valid, q);
       a.explanation = a.layout.explanation();
       report_step(ahead_options.progress, "layout", a.explanation);

@@ -28,6 +28,8 @@ void validate_options(const ParameterizationOptions& opt) {
     fail("`tolerance_absolute` must be a positive finite area, got " + str(*opt.tolerance_absolute));
   if (!(opt.tolerance_relative > 0.0 && std::isfinite(opt.tolerance_relative)))
     fail("`tolerance_relative` must be a positive finite number, got " + str(opt.tolerance_relative));
+  if (opt.needle_width && !(*opt.needle_width >= 0.0 && std::isfinite(*opt.needle_width)))
+    fail("`needle_width` must be a finite width >= 0, got " + str(*opt.needle_width));
   if (opt.max_repair_rounds < 0)
     fail("`max_repair_rounds` must be >= 0, got " + std::to_string(opt.max_repair_rounds));
   if (opt.corner_trials < 1) fail("`corner_trials` must be >= 1, got " + std::to_string(opt.corner_trials));

@@ -80,7 +80,9 @@ struct CleanBoundary {
 };
 
 CleanBoundary clean_boundary(const Polygon& input, const ParameterizationOptions& opt) {
-  const double needle_width = needle_width_for_ring(input, opt.tolerance_absolute, opt.tolerance_relative);
+  const double needle_width =
+      opt.needle_width ? *opt.needle_width
+                       : needle_width_for_ring(input, opt.tolerance_absolute, opt.tolerance_relative);
   PolygonCleaning cleaning = clean_polygon(input, needle_width);
   if (!cleaning.notes.empty())
     report_step(opt.progress, "cleaning", "note: " + cleaning_summary("the boundary", cleaning), -1,

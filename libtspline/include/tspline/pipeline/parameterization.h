@@ -34,6 +34,14 @@ struct ParameterizationOptions {
   /// tolerance_relative * (its own bounding-box diagonal)^2.
   std::optional<double> tolerance_absolute;
   double tolerance_relative = 1e-5;
+  /// Needles and spikes narrower than this are removed from the input ring
+  /// (clean_polygon). Unset: the boundary tolerance's width,
+  /// needle_width_for_ring(ring, tolerance_absolute, tolerance_relative).
+  /// The patches of a layout take 0 (run_multipatch_parameterization): their
+  /// rings were cleaned with the domain, and a patch's own width could take
+  /// away one of its corners (an acute corner beside a short edge looks like
+  /// a needle's tip) or a vertex of a cut that the patch across keeps.
+  std::optional<double> needle_width;
   /// Initial uniform level: 2^L x 2^L cells before boundary refinement.
   int initial_level = 3;
   /// No cell is refined beyond this level.
