@@ -1,7 +1,9 @@
 // The tspline program reads GIS input through the GDAL module it loads at its
-// first GIS input (apps/gis_module.cpp): the program itself does not load GDAL;
-// without the module a GIS input is one clear error (a text polygon still
-// works), and TSPLINE_GIS_MODULE points to it from anywhere.
+// first GIS input (apps/gis_module.cpp), and makes quad layouts with the Gmsh
+// module it loads at its first layout (apps/gmsh_module.cpp): the program
+// itself loads neither GDAL nor Gmsh; without a module what needs it is one
+// clear error (the rest still works), and TSPLINE_GIS_MODULE and
+// TSPLINE_GMSH_MODULE point to them from anywhere.
 #include <doctest/doctest.h>
 
 #include <cstdlib>
@@ -23,9 +25,12 @@ namespace {
 
 const std::string kGeojson = std::string(TSPLINE_TEST_DATA_DIR) + "/gis/corsica_lonlat.geojson";
 
-std::string param_args(const std::string& input, const fs::path& out) {
-  return "param " + quoted(fs::path(input)) + " -q --out " + quoted(out) + " --layout single --max-adapt 0";
+std::string param_args(const std::string& input, const fs::path& out, const std::string& layout = "single") {
+  return "param " + quoted(fs::path(input)) + " -q --out " + quoted(out) + " --layout " + layout +
+         " --max-adapt 0";
 }
+
+const std::string kPlate = std::string(TSPLINE_TEST_DATA_DIR) + "/holes/plate_with_hole.txt";
 
 // Sets an environment variable for the scope (the programs run inherit it).
 struct ScopedEnv {
@@ -40,7 +45,7 @@ struct ScopedEnv {
 
 }  // namespace
 
-TEST_SUITE("gis_app") {
+TEST_SUITE("modules_app") {
   TEST_CASE("GIS input through the module: the program does not load GDAL, reads GeoJSON with it") {
     const fs::path dir = test_support::scratch_dir("gis_app", "module");
     // What the dynamic linker loads for the program (ldd's way): no GDAL.
@@ -52,6 +57,7 @@ TEST_SUITE("gis_app") {
       CHECK(contains(r.out, "libc.so"));  // the listing itself
       CHECK(contains(r.out, "libvtkIOXML"));
       CHECK(!contains(r.out, "libgdal"));
+      CHECK(!contains(r.out, "libgmsh"));
     }
     const test_support::AppRun r = run_app(param_args(kGeojson, dir / "out"), dir);
     CAPTURE(r.err);
@@ -86,6 +92,47 @@ TEST_SUITE("gis_app") {
     const ScopedEnv module("TSPLINE_GIS_MODULE",
                            (fs::path(TSPLINE_APP_PATH).parent_path() / "libtspline_gis.so").string());
     const test_support::AppRun found = run_program(alone.string(), param_args(kGeojson, dir / "found"), dir);
+    CAPTURE(found.err);
+    CHECK(found.exit_code == 0);
+    CHECK(fs::exists(dir / "found" / "report.json"));
+  }
+
+  TEST_CASE("quad layouts through the Gmsh module; without it one clear error, one patch as before") {
+    if (!fs::exists(fs::path(TSPLINE_APP_PATH).parent_path() / "libtspline_gmsh.so"))
+      return;  // (a build without Gmsh)
+    const fs::path dir = test_support::scratch_dir("modules_app", "gmsh");
+    {
+      const test_support::AppRun r = run_app(param_args(kPlate, dir / "quad", "quad"), dir);
+      CAPTURE(r.err);
+      REQUIRE(r.exit_code == 0);
+      std::ifstream f(dir / "quad" / "report.json");
+      const nlohmann::json report = nlohmann::json::parse(f);
+      CHECK(report["layout"]["chosen"] == "quad");
+      CHECK(report["patches_count"].get<int>() > 1);
+    }
+    // The program alone, in a folder without the module (nor ../lib/tspline).
+    const fs::path alone = dir / "bin" / "tspline";
+    fs::create_directories(alone.parent_path());
+    fs::copy_file(TSPLINE_APP_PATH, alone, fs::copy_options::overwrite_existing);
+    const test_support::AppRun quad =
+        run_program(alone.string(), param_args(kPlate, dir / "no_module", "quad"), dir);
+    CAPTURE(quad.err);
+    CHECK(quad.exit_code == 2);  // an I/O error: a file the program needs is missing
+    CHECK(count_lines(quad.err) == 1);
+    CHECK(contains(quad.err, "libtspline_gmsh.so"));
+    CHECK(contains(quad.err, "TSPLINE_GMSH_MODULE"));
+    CHECK(!fs::exists(dir / "no_module" / "report.json"));
+    const test_support::AppRun single = run_program(alone.string(), param_args(kPlate, dir / "single"), dir);
+    CAPTURE(single.err);
+    CHECK(single.exit_code != 0);  // (holes need several patches: not one)
+    const test_support::AppRun text =
+        run_program(alone.string(), param_args(test_support::polygon_file("square.txt"), dir / "text"), dir);
+    CAPTURE(text.err);
+    CHECK(text.exit_code == 0);
+    const ScopedEnv module("TSPLINE_GMSH_MODULE",
+                           (fs::path(TSPLINE_APP_PATH).parent_path() / "libtspline_gmsh.so").string());
+    const test_support::AppRun found =
+        run_program(alone.string(), param_args(kPlate, dir / "found", "quad"), dir);
     CAPTURE(found.err);
     CHECK(found.exit_code == 0);
     CHECK(fs::exists(dir / "found" / "report.json"));
