@@ -19,7 +19,7 @@ namespace tspline::detail {
 const QuadMesherBackend& quad_mesher_backend() {
   // Loaded once (thread-safe); a failure is thrown again at every call.
   static const QuadMesherBackend* const backend = tspline_app::load_module<QuadMesherBackend>(
-      {"libtspline_gmsh.so", "TSPLINE_GMSH_MODULE", "tspline_quad_mesher_backend", "automatic quad layouts",
+      {"libtspline_gmsh.so", "TSPLINE_GMSH_MODULE", "tspline_quad_mesher_backend", "a quad layout",
        "Gmsh module", TSPLINE_MODULE_FROM_BINDIR});
   return *backend;
 }

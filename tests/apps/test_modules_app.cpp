@@ -32,6 +32,26 @@ std::string param_args(const std::string& input, const fs::path& out, const std:
 
 const std::string kPlate = std::string(TSPLINE_TEST_DATA_DIR) + "/holes/plate_with_hole.txt";
 
+// The program alone, copied into dir/bin: no module next to it (nor in ../lib/tspline).
+fs::path program_alone(const fs::path& dir) {
+  const fs::path alone = dir / "bin" / "tspline";
+  fs::create_directories(alone.parent_path());
+  fs::copy_file(TSPLINE_APP_PATH, alone, fs::copy_options::overwrite_existing);
+  return alone;
+}
+
+// A run that needed a missing module: one line naming the module and the
+// variable, an I/O error (a file the program needs is missing), no report.
+void check_missing_module(const test_support::AppRun& r, const std::string& module,
+                          const std::string& variable, const fs::path& out) {
+  CAPTURE(r.err);
+  CHECK(r.exit_code == 2);
+  CHECK(count_lines(r.err) == 1);
+  CHECK(contains(r.err, module));
+  CHECK(contains(r.err, variable));
+  CHECK(!fs::exists(out / "report.json"));
+}
+
 // Sets an environment variable for the scope (the programs run inherit it).
 struct ScopedEnv {
   ScopedEnv(const char* name, const std::string& value) : name_(name) { ::setenv(name, value.c_str(), 1); }
@@ -47,7 +67,7 @@ struct ScopedEnv {
 
 TEST_SUITE("modules_app") {
   TEST_CASE("GIS input through the module: the program does not load GDAL, reads GeoJSON with it") {
-    const fs::path dir = test_support::scratch_dir("gis_app", "module");
+    const fs::path dir = test_support::scratch_dir("modules_app", "gis");
     // What the dynamic linker loads for the program (ldd's way): no GDAL.
     // (Set by env for the program only: the shell that runs it would list its own.)
     {
@@ -71,18 +91,10 @@ TEST_SUITE("modules_app") {
 
   TEST_CASE(
       "without the module: one clear error for GIS input, text polygons as before; TSPLINE_GIS_MODULE") {
-    const fs::path dir = test_support::scratch_dir("gis_app", "no_module");
-    // The program alone, in a folder without the module (nor ../lib/tspline).
-    const fs::path alone = dir / "bin" / "tspline";
-    fs::create_directories(alone.parent_path());
-    fs::copy_file(TSPLINE_APP_PATH, alone, fs::copy_options::overwrite_existing);
-    const test_support::AppRun gis = run_program(alone.string(), param_args(kGeojson, dir / "gis"), dir);
-    CAPTURE(gis.err);
-    CHECK(gis.exit_code == 2);  // an I/O error: a file the program needs is missing
-    CHECK(count_lines(gis.err) == 1);
-    CHECK(contains(gis.err, "libtspline_gis.so"));
-    CHECK(contains(gis.err, "TSPLINE_GIS_MODULE"));
-    CHECK(!fs::exists(dir / "gis" / "report.json"));
+    const fs::path dir = test_support::scratch_dir("modules_app", "no_gis");
+    const fs::path alone = program_alone(dir);
+    check_missing_module(run_program(alone.string(), param_args(kGeojson, dir / "gis"), dir),
+                         "libtspline_gis.so", "TSPLINE_GIS_MODULE", dir / "gis");
     const test_support::AppRun text =
         run_program(alone.string(), param_args(test_support::polygon_file("square.txt"), dir / "text"), dir);
     CAPTURE(text.err);
@@ -110,21 +122,9 @@ TEST_SUITE("modules_app") {
       CHECK(report["layout"]["chosen"] == "quad");
       CHECK(report["patches_count"].get<int>() > 1);
     }
-    // The program alone, in a folder without the module (nor ../lib/tspline).
-    const fs::path alone = dir / "bin" / "tspline";
-    fs::create_directories(alone.parent_path());
-    fs::copy_file(TSPLINE_APP_PATH, alone, fs::copy_options::overwrite_existing);
-    const test_support::AppRun quad =
-        run_program(alone.string(), param_args(kPlate, dir / "no_module", "quad"), dir);
-    CAPTURE(quad.err);
-    CHECK(quad.exit_code == 2);  // an I/O error: a file the program needs is missing
-    CHECK(count_lines(quad.err) == 1);
-    CHECK(contains(quad.err, "libtspline_gmsh.so"));
-    CHECK(contains(quad.err, "TSPLINE_GMSH_MODULE"));
-    CHECK(!fs::exists(dir / "no_module" / "report.json"));
-    const test_support::AppRun single = run_program(alone.string(), param_args(kPlate, dir / "single"), dir);
-    CAPTURE(single.err);
-    CHECK(single.exit_code != 0);  // (holes need several patches: not one)
+    const fs::path alone = program_alone(dir);
+    check_missing_module(run_program(alone.string(), param_args(kPlate, dir / "no_module", "quad"), dir),
+                         "libtspline_gmsh.so", "TSPLINE_GMSH_MODULE", dir / "no_module");
     const test_support::AppRun text =
         run_program(alone.string(), param_args(test_support::polygon_file("square.txt"), dir / "text"), dir);
     CAPTURE(text.err);
