@@ -3,7 +3,7 @@
 // and loaded at the first quad layout. Linked before libtspline, this
 // quad_mesher_backend() takes the place of the one linked into the libraries,
 // so the program does not load Gmsh and the ninety libraries it needs at
-// every start (0.24 s of each run: `tspline --help` 0.33 -> 0.09 s). The
+// every start (0.24 s of each run: `tspline --help` 0.33 -> 0.07 s). The
 // module is looked for in TSPLINE_GMSH_MODULE (a path), next to the program
 // (the build tree), and where `cmake --install` puts it.
 #include "module_loader.h"

@@ -4,16 +4,13 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
-#include <algorithm>
 #include <cerrno>
-#include <cmath>
 #include <cstdint>
 #include <cstdlib>
 #include <exception>
 #include <iostream>
 #include <mutex>
 #include <string>
-#include <unordered_map>
 
 #include "tspline/detail/quad_mesher_backend.h"
 #include "tspline/detail/thread_pool.h"

@@ -12,7 +12,6 @@
 #include <vector>
 
 #include "tspline/boundary/domain.h"
-#include "tspline/boundary/polygon_validation.h"
 #include "tspline/detail/enum_names.h"
 #include "tspline/errors.h"
 #include "tspline/layout/quad_mesher.h"
@@ -30,13 +29,11 @@ constexpr std::array<detail::EnumName<LayoutMode>, 3> kLayoutModeNames{
 // The domain's rings cleaned and validated with the run's boundary tolerance
 // (needles narrower than its width removed, ParameterizationOptions::
 // needle_width): a layout's patches are cut from these rings and not cleaned
-// again. `notes`: where the notes go (nullptr: where a single-patch try of
-// the same ring reports its own).
+// again. `notes`: whether its notes are reported (not where a single-patch
+// try of the same ring reports its own).
 Domain cleaned_domain(const Domain& input, const ParameterizationOptions& options, bool notes) {
   DomainCleaningOptions how;
-  how.needle_width = options.needle_width ? *options.needle_width
-                                          : needle_width_for_ring(input.outer, options.tolerance_absolute,
-                                                                  options.tolerance_relative);
+  how.needle_width = run_needle_width(input.outer, options);
   std::vector<std::string> said;
   if (notes) how.notes = &said;
   Domain d = validate_domain(input, how);

@@ -69,6 +69,11 @@ std::size_t best_corner_trial(const std::vector<CornerTrial>& trials) {
   return best;
 }
 
+double run_needle_width(const Polygon& ring, const ParameterizationOptions& opt) {
+  return opt.needle_width ? *opt.needle_width
+                          : needle_width_for_ring(ring, opt.tolerance_absolute, opt.tolerance_relative);
+}
+
 namespace {
 
 // The input ring with needles narrower than the boundary tolerance's width
@@ -80,9 +85,7 @@ struct CleanBoundary {
 };
 
 CleanBoundary clean_boundary(const Polygon& input, const ParameterizationOptions& opt) {
-  const double needle_width =
-      opt.needle_width ? *opt.needle_width
-                       : needle_width_for_ring(input, opt.tolerance_absolute, opt.tolerance_relative);
+  const double needle_width = run_needle_width(input, opt);
   PolygonCleaning cleaning = clean_polygon(input, needle_width);
   if (!cleaning.notes.empty())
     report_step(opt.progress, "cleaning", "note: " + cleaning_summary("the boundary", cleaning), -1,

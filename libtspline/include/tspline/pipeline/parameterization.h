@@ -74,6 +74,10 @@ struct ParameterizationOptions {
   ProgressCallback progress;
 };
 
+/// The needle width of a run on `ring` (ParameterizationOptions::needle_width,
+/// else that of its boundary tolerance).
+double run_needle_width(const Polygon& ring, const ParameterizationOptions& opt);
+
 /// Thrown where a run was stopped on purpose (ParameterizationOptions::
 /// stop_when_tangled, AdaptiveOptions::stop_when_boundary_frozen); what() is
 /// why.
