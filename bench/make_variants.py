@@ -28,14 +28,15 @@ def read_rings(path):
     return [r for r in rings if r]
 
 
-def write_rings(path, rings, what):
+def write_rings(path, rings, what, decimals=None):
+    """The rings in the text format of tests/data; every digit of a double, or `decimals` after the point."""
     with open(path, "w") as f:
         f.write(f"# {what}\n")
         for i, ring in enumerate(rings):
             if i:
                 f.write("\n")
             for x, y in ring:
-                f.write(f"{x:.17g} {y:.17g}\n")
+                f.write(f"{x:.17g} {y:.17g}\n" if decimals is None else f"{x:.{decimals}f} {y:.{decimals}f}\n")
 
 
 def variants(rings):

@@ -18,7 +18,10 @@ import json
 import math
 import sys
 
+from make_variants import write_rings  # (the same directory: the text format of tests/data)
+
 EARTH_RADIUS_KM = 6371.0
+MM = 6  # decimals of a km written: a millimetre, below the data's own precision
 
 
 def outer_rings(path):
@@ -53,22 +56,12 @@ def project(rings, lon0, lat0):
     return out
 
 
-def write(path, rings, comment):
-    with open(path, "w") as f:
-        f.write(f"# {comment}\n")
-        for k, ring in enumerate(rings):
-            if k:
-                f.write("\n")
-            for x, y in ring:
-                f.write(f"{x:.6f} {y:.6f}\n")
-
-
 def island(src, k, out):
     rings = sorted(outer_rings(src), key=lonlat_area, reverse=True)
     ring = rings[k]
     lon0 = sum(p[0] for p in ring) / len(ring)
     lat0 = sum(p[1] for p in ring) / len(ring)
-    write(out, project([ring], lon0, lat0), f"polygon {k} (by area) of {src}, km about ({lon0:.4f}, {lat0:.4f})")
+    write_rings(out, project([ring], lon0, lat0), f"polygon {k} (by area) of {src}, km about ({lon0:.4f}, {lat0:.4f})", MM)
 
 
 def sea(src, out, box=None):
@@ -84,8 +77,8 @@ def sea(src, out, box=None):
     rings.sort(key=lonlat_area, reverse=True)
     lon0, lat0 = 0.5 * (w + e), 0.5 * (s + n)
     box_ring = [(w, s), (e, s), (e, n), (w, n)]
-    write(out, project([box_ring] + rings, lon0, lat0),
-          f"sea box ({w}, {s}, {e}, {n}) of {src} with {len(rings)} islands as holes, km")
+    write_rings(out, project([box_ring] + rings, lon0, lat0),
+          f"sea box ({w}, {s}, {e}, {n}) of {src} with {len(rings)} islands as holes, km", MM)
 
 
 if __name__ == "__main__":
