@@ -61,7 +61,8 @@ def island(src, k, out):
     ring = rings[k]
     lon0 = sum(p[0] for p in ring) / len(ring)
     lat0 = sum(p[1] for p in ring) / len(ring)
-    write_rings(out, project([ring], lon0, lat0), f"polygon {k} (by area) of {src}, km about ({lon0:.4f}, {lat0:.4f})", MM)
+    write_rings(out, project([ring], lon0, lat0),
+                f"polygon {k} (by area) of {src}, km about ({lon0:.4f}, {lat0:.4f})", MM)
 
 
 def sea(src, out, box=None):
@@ -78,11 +79,11 @@ def sea(src, out, box=None):
     lon0, lat0 = 0.5 * (w + e), 0.5 * (s + n)
     box_ring = [(w, s), (e, s), (e, n), (w, n)]
     write_rings(out, project([box_ring] + rings, lon0, lat0),
-          f"sea box ({w}, {s}, {e}, {n}) of {src} with {len(rings)} islands as holes, km", MM)
+                f"sea box ({w}, {s}, {e}, {n}) of {src} with {len(rings)} islands as holes, km", MM)
 
 
 if __name__ == "__main__":
-    if len(sys.argv) >= 5 and sys.argv[1] == "island":
+    if len(sys.argv) == 5 and sys.argv[1] == "island":
         island(sys.argv[2], int(sys.argv[3]), sys.argv[4])
     elif len(sys.argv) in (4, 8) and sys.argv[1] == "sea":
         sea(sys.argv[2], sys.argv[3], [float(v) for v in sys.argv[4:8]] if len(sys.argv) == 8 else None)
